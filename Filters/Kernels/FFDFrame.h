@@ -1,0 +1,125 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file FFDFrame.h
+ * @brief The lattice frame (X0, S, T, U) and its parameter map (paper equations 1 and 2).
+ *
+ * A frame is the parallelepiped X = X0 + sS + tT + uU, s, t, u in [0, 1]. Its parameter map inverts that
+ * relation with the dual basis of equation 2:
+ *   s = (T x U).(X - X0) / ((T x U).S),  t = (S x U).(X - X0) / ((S x U).T),  u = (S x T).(X - X0) / ((S x T).U).
+ * The dual vectors are the rows of d(s,t,u)/dX, which the Jacobian of a deformation needs.
+ * The 12 numbers of a frame are stored as in the data contract's `FFDFrame` field array: X0, S, T, U.
+ */
+#ifndef FFDFrame_h
+#define FFDFrame_h
+
+#include "FFDVector.h"
+
+#include <cmath>
+
+namespace ffd
+{
+
+/// Why a frame cannot be used.
+enum class FrameStatus
+{
+  Valid,
+  NonFinite,  ///< a component is NaN or infinite
+  ZeroVolume, ///< S, T, U are (nearly) linearly dependent: no inverse parameter map
+};
+
+/// Relative volume |det(S,T,U)| / (|S||T||U|) under which a frame counts as flat.
+constexpr double MinimumRelativeFrameVolume = 1e-12;
+
+/// Checks the 12 numbers X0, S, T, U of a frame. Host only: it runs once per update, not per point.
+inline FrameStatus CheckFrame(const double frame[12])
+{
+  for (int c = 0; c < 12; ++c)
+  {
+    if (!std::isfinite(frame[c]))
+    {
+      return FrameStatus::NonFinite;
+    }
+  }
+  const Vec3<double> s = Vec3<double>::From(frame + 3);
+  const Vec3<double> t = Vec3<double>::From(frame + 6);
+  const Vec3<double> u = Vec3<double>::From(frame + 9);
+  const double lengths = std::sqrt(Dot(s, s) * Dot(t, t) * Dot(u, u));
+  const double volume = std::fabs(Dot(Cross(s, t), u));
+  if (!(lengths > 0.0) || !std::isfinite(lengths) || volume <= MinimumRelativeFrameVolume * lengths)
+  {
+    return FrameStatus::ZeroVolume;
+  }
+  return FrameStatus::Valid;
+}
+
+/// Half-width, in parameter units, of the band around the frame's faces that still counts as inside.
+template <typename Real>
+FFD_INLINE Real ParametricTolerance()
+{
+  return sizeof(Real) >= sizeof(double) ? Real(1e-10) : Real(1e-5);
+}
+
+template <typename Real>
+struct Frame
+{
+  Vec3<Real> Origin, S, T, U;    ///< X = Origin + s S + t T + u U
+  Vec3<Real> DualS, DualT, DualU; ///< rows of d(s,t,u)/dX (equation 2)
+
+  /// Builds the frame and its dual basis in double precision, then rounds to Real.
+  /// The caller has checked the numbers with CheckFrame().
+  static Frame FromArray(const double f[12])
+  {
+    const Vec3<double> s = Vec3<double>::From(f + 3);
+    const Vec3<double> t = Vec3<double>::From(f + 6);
+    const Vec3<double> u = Vec3<double>::From(f + 9);
+    const Vec3<double> tu = Cross(t, u);
+    const Vec3<double> su = Cross(s, u);
+    const Vec3<double> st = Cross(s, t);
+    const Vec3<double> ds = (1.0 / Dot(tu, s)) * tu;
+    const Vec3<double> dt = (1.0 / Dot(su, t)) * su;
+    const Vec3<double> du = (1.0 / Dot(st, u)) * st;
+    return { Vec3<Real>::From(f), Vec3<Real>::From(f + 3), Vec3<Real>::From(f + 6), Vec3<Real>::From(f + 9),
+      Vec3<Real>::From(&ds.x), Vec3<Real>::From(&dt.x), Vec3<Real>::From(&du.x) };
+  }
+
+  /// Equation 2: (s, t, u) of a point.
+  FFD_INLINE Vec3<Real> ToParametric(const Vec3<Real>& x) const
+  {
+    const Vec3<Real> d = x - Origin;
+    return { Dot(DualS, d), Dot(DualT, d), Dot(DualU, d) };
+  }
+
+  /// The lattice space X(s, t, u) = X0 + sS + tT + uU.
+  FFD_INLINE Vec3<Real> ToWorld(const Vec3<Real>& p) const
+  {
+    return Origin + p.x * S + p.y * T + p.z * U;
+  }
+
+  /// d(s,t,u)/dX as a matrix whose rows are the dual vectors.
+  FFD_INLINE Mat3<Real> ParametricGradient() const { return Mat3<Real>::FromRows(DualS, DualT, DualU); }
+
+  /**
+   * Binds a point to the frame: its parameters, clamped to [0, 1], and true when it lies inside the frame or
+   * within ParametricTolerance() of it. Points on a face or corner are inside even where rounding puts them a
+   * hair outside. False for points outside and for non-finite points (every comparison with NaN fails).
+   */
+  FFD_INLINE bool Bind(const Vec3<Real>& x, Vec3<Real>& stu) const
+  {
+    stu = ToParametric(x);
+    const Real lo = -ParametricTolerance<Real>();
+    const Real hi = Real(1) + ParametricTolerance<Real>();
+    if (!(stu.x >= lo && stu.x <= hi && stu.y >= lo && stu.y <= hi && stu.z >= lo && stu.z <= hi))
+    {
+      return false;
+    }
+    stu = { Clamp01(stu.x), Clamp01(stu.y), Clamp01(stu.z) };
+    return true;
+  }
+
+private:
+  FFD_INLINE static Real Clamp01(Real v) { return v < Real(0) ? Real(0) : (v > Real(1) ? Real(1) : v); }
+};
+
+} // namespace ffd
+
+#endif

@@ -1,0 +1,20 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file FFDHostDevice.h
+ * @brief Marks the VTK-free kernel functions callable from host and CUDA device code.
+ *
+ * Everything under Filters/Kernels is plain C++17 with no VTK, OpenVDB, TBB or Eigen, so that the CPU path
+ * (inside vtkSMPTools::For) and the CUDA path compile the very same per-point functions.
+ */
+#ifndef FFDHostDevice_h
+#define FFDHostDevice_h
+
+#if defined(__CUDACC__)
+#define FFD_HOST_DEVICE __host__ __device__
+#else
+#define FFD_HOST_DEVICE
+#endif
+
+#define FFD_INLINE FFD_HOST_DEVICE inline
+
+#endif

@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkFFDVoxelize
+ * @brief   encloses a point set in a frame, divides it into voxels and finds the voxels that hold points
+ *
+ * The first stage of the voxel FFD pipeline (paper section III.D). The frame is the parallelepiped
+ * X0 + sS + tT + uU, s, t, u in [0, 1]:
+ * - AXIS_ALIGNED (default): the bounds of the input's finite points, each side grown by Padding times the
+ *   largest extent of the bounds (so flat and linear inputs still get a frame with a volume);
+ * - PRINCIPAL_AXES: a box along the eigenvectors of the points' covariance (S the major axis, right-handed),
+ *   tight around the points, then padded the same way;
+ * - EXPLICIT: the frame set with SetFrame(), any parallelepiped.
+ *
+ * The output is a vtkStructuredGrid of (nx+1)(ny+1)(nz+1) voxel corners whose cells are the voxels. A voxel is
+ * active when at least one input point lies in it (points on a face shared by two voxels count for the one
+ * with the higher index; points outside an explicit frame count for none). The active set is found with an
+ * OpenVDB MaskGrid, sparse whatever the divisions; inactive voxels are hidden (HIDDENCELL in the ghost array).
+ * The frame and divisions are stored as the `FFDFrame` and `FFDDivisions` field arrays (vtkFFDDataContract).
+ *
+ * Non-finite input points are ignored. An empty input gives an empty output without an error. Divisions below
+ * one, a flat or non-finite frame are errors.
+ *
+ * @sa vtkFFDBuildLattice vtkFFDDeform vtkFFDDataContract
+ */
+#ifndef vtkFFDVoxelize_h
+#define vtkFFDVoxelize_h
+
+#include "vtkFFDFiltersModule.h" // For export macro
+#include "vtkStructuredGridAlgorithm.h"
+
+class VTKFFDFILTERS_EXPORT vtkFFDVoxelize : public vtkStructuredGridAlgorithm
+{
+public:
+  static vtkFFDVoxelize* New();
+  vtkTypeMacro(vtkFFDVoxelize, vtkStructuredGridAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// Voxels along S, T and U. Each must be at least 1 (default 4, 4, 4).
+  vtkSetVector3Macro(Divisions, int);
+  vtkGetVector3Macro(Divisions, int);
+  ///@}
+
+  ///@{
+  /// Fraction of the largest extent added on every side of automatic frames (default 0.05).
+  vtkSetClampMacro(Padding, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(Padding, double);
+  ///@}
+
+  enum FrameModes
+  {
+    AXIS_ALIGNED = 0,
+    PRINCIPAL_AXES = 1,
+    EXPLICIT = 2
+  };
+
+  ///@{
+  /// How the frame is chosen (default AXIS_ALIGNED).
+  vtkSetClampMacro(FrameMode, int, AXIS_ALIGNED, EXPLICIT);
+  vtkGetMacro(FrameMode, int);
+  void SetFrameModeToAxisAligned() { this->SetFrameMode(AXIS_ALIGNED); }
+  void SetFrameModeToPrincipalAxes() { this->SetFrameMode(PRINCIPAL_AXES); }
+  void SetFrameModeToExplicit() { this->SetFrameMode(EXPLICIT); }
+  const char* GetFrameModeAsString();
+  ///@}
+
+  ///@{
+  /// The frame used in EXPLICIT mode: origin X0 and edge vectors S, T, U.
+  void SetFrame(const double origin[3], const double s[3], const double t[3], const double u[3]);
+  vtkSetVector3Macro(FrameOrigin, double);
+  vtkGetVector3Macro(FrameOrigin, double);
+  vtkSetVector3Macro(FrameS, double);
+  vtkGetVector3Macro(FrameS, double);
+  vtkSetVector3Macro(FrameT, double);
+  vtkGetVector3Macro(FrameT, double);
+  vtkSetVector3Macro(FrameU, double);
+  vtkGetVector3Macro(FrameU, double);
+  ///@}
+
+  /// Number of active voxels found by the last execution.
+  vtkGetMacro(NumberOfActiveVoxels, vtkIdType);
+
+protected:
+  vtkFFDVoxelize();
+  ~vtkFFDVoxelize() override = default;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  int Divisions[3];
+  double Padding;
+  int FrameMode;
+  double FrameOrigin[3];
+  double FrameS[3];
+  double FrameT[3];
+  double FrameU[3];
+  vtkIdType NumberOfActiveVoxels;
+
+private:
+  vtkFFDVoxelize(const vtkFFDVoxelize&) = delete;
+  void operator=(const vtkFFDVoxelize&) = delete;
+};
+
+#endif

@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file FFDTestMeshes.h
+ * @brief Reads the real meshes (bear, elephant, armadillo, ...) that Utilities/setup.sh fetches from
+ * Debian's libcgal-demo package into VOXELFFD_MESH_DIR as VTK XML PolyData.
+ */
+#ifndef FFDTestMeshes_h
+#define FFDTestMeshes_h
+
+#include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
+#include "vtkXMLPolyDataReader.h"
+
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+/// The mesh `name` (e.g. "bear"); throws with a hint when the set-up has not fetched it.
+inline vtkSmartPointer<vtkPolyData> ReadTestMesh(const std::string& name)
+{
+  const std::string path = std::string(VOXELFFD_MESH_DIR) + "/" + name + ".vtp";
+  if (!std::ifstream(path).good())
+  {
+    throw std::runtime_error(path + " is missing: run Utilities/setup.sh, which fetches the meshes");
+  }
+  vtkNew<vtkXMLPolyDataReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  vtkSmartPointer<vtkPolyData> mesh = reader->GetOutput();
+  if (mesh->GetNumberOfPoints() == 0)
+  {
+    throw std::runtime_error(path + " holds no points");
+  }
+  return mesh;
+}
+
+#endif

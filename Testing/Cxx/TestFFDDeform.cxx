@@ -1,0 +1,587 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Tests of vtkFFDDeform against the independent float64 reference of equations 1-3 (FFDReference.h), on real
+// meshes and on hand-built lattices; the binding cache; normals and Jacobian determinants; bad input.
+#include "FFDReference.h"
+#include "FFDTestErrorObserver.h"
+#include "FFDTestMeshes.h"
+
+#include "vtkFFDBuildLattice.h"
+#include "vtkFFDDataContract.h"
+#include "vtkFFDDeform.h"
+#include "vtkFFDVoxelize.h"
+
+#include "vtkCallbackCommand.h"
+#include "vtkCellData.h"
+#include "vtkDoubleArray.h"
+#include "vtkExecutive.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkPolyDataNormals.h"
+#include "vtkStructuredGrid.h"
+#include "vtkTransform.h"
+#include "vtkTransformFilter.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <random>
+
+namespace
+{
+using ffdref::Vec;
+
+// A global Bernstein lattice of degree (l, m, n) built by hand from equation 1 and the data contract, so that
+// these tests do not depend on vtkFFDBuildLattice.
+vtkSmartPointer<vtkStructuredGrid> MakeLattice(const ffdref::Frame& f, int l, int m, int n)
+{
+  auto lattice = vtkSmartPointer<vtkStructuredGrid>::New();
+  lattice->SetDimensions(l + 1, m + 1, n + 1);
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkDoubleArray> rest;
+  rest->SetName("RestPosition");
+  rest->SetNumberOfComponents(3);
+  for (const Vec& p : ffdref::RestLattice(f, l, m, n))
+  {
+    points->InsertNextPoint(p.data());
+    rest->InsertNextTuple(p.data());
+  }
+  lattice->SetPoints(points);
+  lattice->GetPointData()->AddArray(rest);
+  const double frame[12] = { f.X0[0], f.X0[1], f.X0[2], f.S[0], f.S[1], f.S[2], f.T[0], f.T[1], f.T[2], f.U[0],
+    f.U[1], f.U[2] };
+  const int divisions[3] = { l, m, n };
+  vtkFFDDataContract::SetFrame(lattice, frame);
+  vtkFFDDataContract::SetDivisions(lattice, divisions);
+  vtkFFDDataContract::SetBasis(lattice, vtkFFDBuildLattice::BERNSTEIN);
+  return lattice;
+}
+
+ffdref::Frame FrameOf(vtkDataObject* data)
+{
+  double f[12];
+  EXPECT_TRUE(vtkFFDDataContract::GetFrame(data, f));
+  return { { f[0], f[1], f[2] }, { f[3], f[4], f[5] }, { f[6], f[7], f[8] }, { f[9], f[10], f[11] } };
+}
+
+double Length(const Vec& v)
+{
+  return std::sqrt(ffdref::Dot(v, v));
+}
+
+double Diagonal(const ffdref::Frame& f)
+{
+  return Length({ f.S[0] + f.T[0] + f.U[0], f.S[1] + f.T[1] + f.U[1], f.S[2] + f.T[2] + f.U[2] });
+}
+
+// Moves every lattice point by a random vector of up to `amplitude` per component.
+void Perturb(vtkPointSet* lattice, std::mt19937& rng, double amplitude)
+{
+  std::uniform_real_distribution<double> d(-amplitude, amplitude);
+  vtkPoints* points = lattice->GetPoints();
+  for (vtkIdType p = 0; p < points->GetNumberOfPoints(); ++p)
+  {
+    double x[3];
+    points->GetPoint(p, x);
+    points->SetPoint(p, x[0] + d(rng), x[1] + d(rng), x[2] + d(rng));
+  }
+  points->Modified();
+}
+
+// The lattice's control points (absolute positions) in VTK order.
+std::vector<Vec> ControlPoints(vtkPointSet* lattice)
+{
+  std::vector<Vec> p(lattice->GetNumberOfPoints());
+  for (vtkIdType i = 0; i < lattice->GetNumberOfPoints(); ++i)
+  {
+    lattice->GetPoint(i, p[i].data());
+  }
+  return p;
+}
+
+// Reference deformation of one point: equation 2, then equation 3 inside the frame (with the filter's
+// documented tolerance of 1e-10 in parameter units at the faces), the point itself outside.
+Vec ReferenceDeform(const ffdref::Frame& f, const std::vector<Vec>& p, const int deg[3], const Vec& x)
+{
+  const Vec stu = ffdref::Parameters(f, x);
+  for (double v : stu)
+  {
+    if (!(v >= -1e-10 && v <= 1 + 1e-10))
+    {
+      return x;
+    }
+  }
+  return ffdref::Evaluate(p, deg[0], deg[1], deg[2],
+    { std::clamp(stu[0], 0.0, 1.0), std::clamp(stu[1], 0.0, 1.0), std::clamp(stu[2], 0.0, 1.0) });
+}
+
+// Largest distance between the deformed points and the reference, over the frame's diagonal.
+double MaxRelativeError(vtkPointSet* input, vtkPointSet* output, vtkPointSet* lattice)
+{
+  const ffdref::Frame f = FrameOf(lattice);
+  int deg[3];
+  EXPECT_TRUE(vtkFFDDataContract::GetDivisions(lattice, deg));
+  const std::vector<Vec> p = ControlPoints(lattice);
+  EXPECT_EQ(input->GetNumberOfPoints(), output->GetNumberOfPoints());
+  double worst = 0.0;
+  for (vtkIdType i = 0; i < input->GetNumberOfPoints(); ++i)
+  {
+    Vec x, y;
+    input->GetPoint(i, x.data());
+    output->GetPoint(i, y.data());
+    worst = std::max(worst, Length(ffdref::Sub(y, ReferenceDeform(f, p, deg, x))));
+  }
+  return worst / Diagonal(f);
+}
+
+struct Pipeline
+{
+  vtkNew<vtkFFDVoxelize> Voxelize;
+  vtkNew<vtkFFDBuildLattice> Build;
+  vtkNew<vtkFFDDeform> Deform;
+  vtkSmartPointer<vtkStructuredGrid> Lattice = vtkSmartPointer<vtkStructuredGrid>::New();
+
+  // Voxelizes `mesh`, builds the Bernstein lattice and copies it into Lattice, which drives Deform.
+  explicit Pipeline(vtkPointSet* mesh, int nx, int ny, int nz)
+  {
+    this->Voxelize->SetInputData(mesh);
+    this->Voxelize->SetDivisions(nx, ny, nz);
+    this->Build->SetInputConnection(this->Voxelize->GetOutputPort());
+    this->Build->SetBasisToBernstein();
+    this->Build->Update();
+    this->Lattice->DeepCopy(this->Build->GetOutput());
+    this->Deform->SetInputData(mesh);
+    this->Deform->SetLatticeData(this->Lattice);
+  }
+
+  vtkPointSet* Output() { return vtkPointSet::SafeDownCast(this->Deform->GetOutputDataObject(0)); }
+};
+} // namespace
+
+// Real meshes through the whole pipeline, random lattices: within 1e-12 of the float64 reference, relative to
+// the frame's diagonal, for double points (rounding of a few dozen operations on numbers of order 1).
+TEST(vtkFFDDeform, MatchesReferenceOnRealMeshes)
+{
+  std::mt19937 rng(20261121);
+  for (const char* name : { "bear", "elephant" })
+  {
+    for (const std::array<int, 3>& div : { std::array<int, 3>{ 2, 3, 4 }, std::array<int, 3>{ 5, 5, 5 } })
+    {
+      vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh(name);
+      Pipeline pipeline(mesh, div[0], div[1], div[2]);
+      Perturb(pipeline.Lattice, rng, 0.2 * Diagonal(FrameOf(pipeline.Lattice)));
+      pipeline.Deform->Update();
+      vtkPointSet* output = pipeline.Output();
+      EXPECT_EQ(output->GetPoints()->GetDataType(), VTK_DOUBLE);
+      EXPECT_EQ(output->GetNumberOfCells(), mesh->GetNumberOfCells());
+      EXPECT_LE(MaxRelativeError(mesh, output, pipeline.Lattice), 1e-12) << name;
+    }
+  }
+}
+
+// Float points are evaluated in float: within 1e-6 of the reference relative to the diagonal (a few float
+// epsilons, 6e-8 each, on sums of up to 125 terms bounded by the displacement).
+TEST(vtkFFDDeform, FloatPointsStayFloatWithinSinglePrecision)
+{
+  std::mt19937 rng(7);
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("bear");
+  vtkNew<vtkPoints> floatPoints;
+  floatPoints->SetDataTypeToFloat();
+  floatPoints->DeepCopy(mesh->GetPoints());
+  vtkNew<vtkPolyData> floatMesh;
+  floatMesh->ShallowCopy(mesh);
+  floatMesh->SetPoints(floatPoints);
+  ASSERT_EQ(floatMesh->GetPoints()->GetDataType(), VTK_FLOAT);
+
+  Pipeline pipeline(floatMesh, 4, 4, 4);
+  Perturb(pipeline.Lattice, rng, 0.2 * Diagonal(FrameOf(pipeline.Lattice)));
+  pipeline.Deform->Update();
+  EXPECT_EQ(pipeline.Output()->GetPoints()->GetDataType(), VTK_FLOAT);
+  EXPECT_LE(MaxRelativeError(floatMesh, pipeline.Output(), pipeline.Lattice), 1e-6);
+
+  pipeline.Deform->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
+  pipeline.Deform->Update();
+  EXPECT_EQ(pipeline.Output()->GetPoints()->GetDataType(), VTK_DOUBLE);
+  EXPECT_LE(MaxRelativeError(floatMesh, pipeline.Output(), pipeline.Lattice), 1e-12);
+}
+
+// Any VTK filter that moves the lattice's points deforms the mesh: an affine motion of the lattice applied by
+// vtkTransformFilter moves the mesh by the same affine map (linear precision), to 1e-12 of the diagonal.
+TEST(vtkFFDDeform, AffineLatticeMotionIsReproduced)
+{
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
+  Pipeline pipeline(mesh, 3, 2, 4);
+  vtkNew<vtkTransform> affine;
+  affine->Translate(0.3, -0.2, 0.1);
+  affine->RotateWXYZ(35, 1, 2, 3);
+  affine->Scale(1.2, 0.8, 1.1);
+  vtkNew<vtkTransformFilter> move;
+  move->SetInputData(pipeline.Lattice);
+  move->SetTransform(affine);
+  pipeline.Deform->SetLatticeConnection(move->GetOutputPort());
+  pipeline.Deform->Update();
+
+  const double diagonal = Diagonal(FrameOf(pipeline.Lattice));
+  double worst = 0.0;
+  for (vtkIdType i = 0; i < mesh->GetNumberOfPoints(); ++i)
+  {
+    double x[3], expected[3], y[3];
+    mesh->GetPoint(i, x);
+    affine->TransformPoint(x, expected);
+    pipeline.Output()->GetPoint(i, y);
+    worst = std::max(worst, std::hypot(y[0] - expected[0], y[1] - expected[1], y[2] - expected[2]));
+  }
+  EXPECT_LE(worst / diagonal, 1e-12);
+}
+
+TEST(vtkFFDDeform, RestLatticeIsTheIdentity)
+{
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
+  Pipeline pipeline(mesh, 4, 3, 2);
+  pipeline.Deform->Update();
+  for (vtkIdType i = 0; i < mesh->GetNumberOfPoints(); ++i)
+  {
+    double x[3], y[3];
+    mesh->GetPoint(i, x);
+    pipeline.Output()->GetPoint(i, y);
+    ASSERT_EQ(x[0], y[0]);
+    ASSERT_EQ(x[1], y[1]);
+    ASSERT_EQ(x[2], y[2]);
+  }
+}
+
+// The binding is computed once and reused while only lattice points move; it is recomputed when the input's
+// points, the lattice's frame or its divisions change, and kept for a rebuilt lattice with the same rest frame.
+TEST(vtkFFDDeform, BindingIsCachedUntilPointsOrRestFrameChange)
+{
+  std::mt19937 rng(3);
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
+  const ffdref::Frame f = { { -0.5, -0.6, -0.4 }, { 1.0, 0.0, 0.0 }, { 0.0, 1.2, 0.0 }, { 0.0, 0.0, 0.8 } };
+  vtkSmartPointer<vtkStructuredGrid> lattice = MakeLattice(f, 3, 3, 3);
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(mesh);
+  deform->SetLatticeData(lattice);
+  deform->Update();
+  EXPECT_EQ(deform->GetNumberOfBindings(), 1);
+
+  Perturb(lattice, rng, 0.05); // lattice points only: evaluation only, and the output follows
+  deform->Update();
+  EXPECT_EQ(deform->GetNumberOfBindings(), 1);
+  EXPECT_LE(MaxRelativeError(mesh, deform->GetOutput(), lattice), 1e-12);
+
+  vtkSmartPointer<vtkStructuredGrid> rebuilt = MakeLattice(f, 3, 3, 3); // new object, same rest frame
+  deform->SetLatticeData(rebuilt);
+  deform->Update();
+  EXPECT_EQ(deform->GetNumberOfBindings(), 1);
+
+  mesh->GetPoints()->Modified(); // the mesh's points changed
+  deform->Update();
+  EXPECT_EQ(deform->GetNumberOfBindings(), 2);
+
+  ffdref::Frame g = f;
+  g.X0[0] -= 0.01; // another rest frame
+  deform->SetLatticeData(MakeLattice(g, 3, 3, 3));
+  deform->Update();
+  EXPECT_EQ(deform->GetNumberOfBindings(), 3);
+
+  vtkSmartPointer<vtkStructuredGrid> reshaped = MakeLattice(g, 2, 3, 3); // another shape
+  Perturb(reshaped, rng, 0.05);
+  deform->SetLatticeData(reshaped);
+  deform->Update();
+  EXPECT_EQ(deform->GetNumberOfBindings(), 4);
+  EXPECT_LE(MaxRelativeError(mesh, deform->GetOutput(), reshaped), 1e-12);
+}
+
+namespace
+{
+// dX_ffd/dX of the reference by central differences (step h), as J[r][c] = d y_r / d x_c.
+std::array<std::array<double, 3>, 3> ReferenceJacobian(
+  const ffdref::Frame& f, const std::vector<Vec>& p, const int deg[3], const Vec& x, double h)
+{
+  std::array<std::array<double, 3>, 3> j{};
+  for (int c = 0; c < 3; ++c)
+  {
+    Vec xp = x, xm = x;
+    xp[c] += h;
+    xm[c] -= h;
+    const Vec yp = ffdref::Deform(f, p, deg[0], deg[1], deg[2], xp);
+    const Vec ym = ffdref::Deform(f, p, deg[0], deg[1], deg[2], xm);
+    for (int r = 0; r < 3; ++r)
+    {
+      j[r][c] = (yp[r] - ym[r]) / (2 * h);
+    }
+  }
+  return j;
+}
+
+double Det(const std::array<std::array<double, 3>, 3>& a)
+{
+  return ffdref::Dot({ a[0][0], a[0][1], a[0][2] },
+    ffdref::Cross({ a[1][0], a[1][1], a[1][2] }, { a[2][0], a[2][1], a[2][2] }));
+}
+} // namespace
+
+// Normals follow the inverse transpose of the Jacobian and det(J) is reported: both against central differences
+// of the reference (h = 1e-6 of the diagonal; truncation and rounding errors stay below 1e-6 relative).
+TEST(vtkFFDDeform, NormalsAndJacobianDeterminantMatchFiniteDifferences)
+{
+  std::mt19937 rng(11);
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputData(mesh);
+  normals->SplittingOff();
+  normals->Update();
+  vtkPolyData* withNormals = normals->GetOutput();
+
+  Pipeline pipeline(withNormals, 3, 3, 3);
+  Perturb(pipeline.Lattice, rng, 0.1 * Diagonal(FrameOf(pipeline.Lattice)));
+  pipeline.Deform->ComputeJacobianDeterminantOn();
+  pipeline.Deform->Update();
+  vtkPointSet* output = pipeline.Output();
+  vtkDataArray* outNormals = output->GetPointData()->GetNormals();
+  vtkDataArray* det = output->GetPointData()->GetArray(vtkFFDDeform::JacobianDeterminantArrayName());
+  ASSERT_NE(outNormals, nullptr);
+  ASSERT_NE(det, nullptr);
+  ASSERT_NE(outNormals, withNormals->GetPointData()->GetNormals());
+
+  const ffdref::Frame f = FrameOf(pipeline.Lattice);
+  int deg[3];
+  vtkFFDDataContract::GetDivisions(pipeline.Lattice, deg);
+  const std::vector<Vec> p = ControlPoints(pipeline.Lattice);
+  const double h = 1e-6 * Diagonal(f);
+  double worstNormal = 0.0, worstDet = 0.0;
+  for (vtkIdType i = 0; i < withNormals->GetNumberOfPoints(); i += 7)
+  {
+    Vec x, n, m;
+    withNormals->GetPoint(i, x.data());
+    withNormals->GetPointData()->GetNormals()->GetTuple(i, n.data());
+    outNormals->GetTuple(i, m.data());
+    const auto j = ReferenceJacobian(f, p, deg, x, h);
+    // J^-T n = (cofactor matrix / det) n; its columns are cross products of J's columns.
+    const Vec c0 = ffdref::Cross({ j[0][1], j[1][1], j[2][1] }, { j[0][2], j[1][2], j[2][2] });
+    const Vec c1 = ffdref::Cross({ j[0][2], j[1][2], j[2][2] }, { j[0][0], j[1][0], j[2][0] });
+    const Vec c2 = ffdref::Cross({ j[0][0], j[1][0], j[2][0] }, { j[0][1], j[1][1], j[2][1] });
+    const double d = Det(j);
+    Vec expected;
+    for (int r = 0; r < 3; ++r)
+    {
+      expected[r] = (c0[r] * n[0] + c1[r] * n[1] + c2[r] * n[2]) / d;
+    }
+    const double len = Length(expected);
+    for (double& e : expected)
+    {
+      e /= len;
+    }
+    worstNormal = std::max(worstNormal, Length(ffdref::Sub(m, expected)));
+    worstDet = std::max(worstDet, std::fabs(det->GetTuple1(i) - d) / std::fabs(d));
+  }
+  EXPECT_LE(worstNormal, 1e-5); // normals are stored as float
+  EXPECT_LE(worstDet, 1e-6);
+}
+
+// Points outside the frame keep their position (det = 1, normal unchanged); points exactly on faces and corners
+// deform: a corner goes exactly to its corner control point, since Bernstein lattices interpolate corners.
+TEST(vtkFFDDeform, OutsidePointsStayAndBoundaryPointsDeform)
+{
+  std::mt19937 rng(5);
+  const ffdref::Frame f = { { 1.0, 2.0, 3.0 }, { 2.0, 0.5, 0.0 }, { -0.3, 1.5, 0.2 }, { 0.1, 0.2, 1.7 } };
+  vtkSmartPointer<vtkStructuredGrid> lattice = MakeLattice(f, 2, 3, 2);
+  Perturb(lattice, rng, 0.3);
+  const std::vector<Vec> p = ControlPoints(lattice);
+
+  auto at = [&](double s, double t, double u) {
+    return Vec{ f.X0[0] + s * f.S[0] + t * f.T[0] + u * f.U[0], f.X0[1] + s * f.S[1] + t * f.T[1] + u * f.U[1],
+      f.X0[2] + s * f.S[2] + t * f.T[2] + u * f.U[2] };
+  };
+  const std::vector<Vec> inputs = { at(0, 0, 0), at(1, 1, 1), at(1, 0, 1), at(0.5, 1, 0.3), at(0.2, 0.7, 0),
+    at(-0.01, 0.5, 0.5), at(0.5, 1.02, 0.5), at(3, 3, 3) };
+  vtkNew<vtkPolyData> mesh;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  for (const Vec& x : inputs)
+  {
+    points->InsertNextPoint(x.data());
+  }
+  mesh->SetPoints(points);
+
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(mesh);
+  deform->SetLatticeData(lattice);
+  deform->ComputeJacobianDeterminantOn();
+  deform->Update();
+  vtkPointSet* out = deform->GetOutput();
+  vtkDataArray* det = out->GetPointData()->GetArray(vtkFFDDeform::JacobianDeterminantArrayName());
+
+  const Vec corner0 = p[0], corner1 = p.back(), cornerSU = p[2 + 3 * (0 + 4 * 2)];
+  const std::vector<Vec> cornerTargets = { corner0, corner1, cornerSU };
+  for (int i = 0; i < 3; ++i)
+  {
+    Vec y;
+    out->GetPoint(i, y.data());
+    EXPECT_LE(Length(ffdref::Sub(y, cornerTargets[i])), 1e-12) << "corner " << i;
+  }
+  const int deg[3] = { 2, 3, 2 };
+  for (int i = 3; i < 5; ++i) // on faces
+  {
+    Vec y;
+    out->GetPoint(i, y.data());
+    EXPECT_LE(Length(ffdref::Sub(y, ffdref::Deform(f, p, deg[0], deg[1], deg[2], inputs[i]))), 1e-12);
+    EXPECT_GT(Length(ffdref::Sub(y, inputs[i])), 1e-3) << "a point on a face must deform";
+  }
+  for (int i = 5; i < 8; ++i) // outside
+  {
+    Vec y;
+    out->GetPoint(i, y.data());
+    EXPECT_EQ(y, inputs[i]);
+    EXPECT_EQ(det->GetTuple1(i), 1.0);
+  }
+}
+
+TEST(vtkFFDDeform, NonFiniteInputPointsPassThroughAndOthersAreUnaffected)
+{
+  std::mt19937 rng(13);
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
+  Pipeline pipeline(mesh, 3, 3, 3);
+  Perturb(pipeline.Lattice, rng, 0.1);
+  pipeline.Deform->Update();
+  vtkNew<vtkPoints> clean;
+  clean->SetDataTypeToDouble(); // DeepCopy keeps the destination's type
+  clean->DeepCopy(pipeline.Output()->GetPoints());
+
+  vtkNew<vtkPolyData> dirty;
+  dirty->DeepCopy(mesh);
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  dirty->GetPoints()->SetPoint(10, nan, 0.0, 0.0);
+  dirty->GetPoints()->SetPoint(20, 0.0, inf, 0.0);
+  dirty->GetPoints()->SetPoint(30, 0.0, 0.0, -inf);
+  pipeline.Deform->SetInputData(dirty);
+  vtkNew<FFDTestErrorObserver> observer;
+  observer->Watch(pipeline.Deform);
+  pipeline.Deform->Update();
+  EXPECT_TRUE(observer->Errors.empty()) << observer->Errors;
+  vtkPointSet* out = pipeline.Output();
+  ASSERT_EQ(out->GetNumberOfPoints(), mesh->GetNumberOfPoints());
+  for (vtkIdType i = 0; i < out->GetNumberOfPoints(); ++i)
+  {
+    double y[3], expected[3];
+    out->GetPoint(i, y);
+    if (i == 10 || i == 20 || i == 30)
+    {
+      dirty->GetPoint(i, expected);
+      for (int c = 0; c < 3; ++c)
+      {
+        EXPECT_TRUE(y[c] == expected[c] || (std::isnan(y[c]) && std::isnan(expected[c])));
+      }
+    }
+    else
+    {
+      clean->GetPoint(i, expected);
+      ASSERT_EQ(y[0], expected[0]);
+      ASSERT_EQ(y[1], expected[1]);
+      ASSERT_EQ(y[2], expected[2]);
+    }
+  }
+}
+
+TEST(vtkFFDDeform, EmptyInputGivesEmptyOutputWithoutError)
+{
+  const ffdref::Frame f = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+  vtkNew<vtkPolyData> empty;
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(empty);
+  deform->SetLatticeData(MakeLattice(f, 1, 1, 1));
+  vtkNew<FFDTestErrorObserver> observer;
+  observer->Watch(deform);
+  deform->Update();
+  EXPECT_TRUE(observer->Errors.empty()) << observer->Errors;
+  EXPECT_EQ(deform->GetOutput()->GetNumberOfPoints(), 0);
+}
+
+// Each broken lattice is refused with a message naming the problem, and the output is empty.
+TEST(vtkFFDDeform, BadLatticesAreRefusedWithAClearError)
+{
+  const ffdref::Frame f = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+  struct Case
+  {
+    const char* Name;
+    std::function<void(vtkStructuredGrid*)> Break;
+    const char* Expected;
+  };
+  const double flat[12] = { 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0 };
+  const double nonFinite[12] = { 0, 0, std::nan(""), 1, 0, 0, 0, 1, 0, 0, 0, 1 };
+  const int zero[3] = { 0, 2, 2 };
+  const std::vector<Case> cases = {
+    { "no frame", [](vtkStructuredGrid* l) { l->GetFieldData()->RemoveArray("FFDFrame"); }, "FFDFrame" },
+    { "flat frame", [&](vtkStructuredGrid* l) { vtkFFDDataContract::SetFrame(l, flat); }, "no volume" },
+    { "non-finite frame", [&](vtkStructuredGrid* l) { vtkFFDDataContract::SetFrame(l, nonFinite); },
+      "FFDFrame" },
+    { "no divisions", [](vtkStructuredGrid* l) { l->GetFieldData()->RemoveArray("FFDDivisions"); },
+      "FFDDivisions" },
+    { "zero divisions", [&](vtkStructuredGrid* l) { vtkFFDDataContract::SetDivisions(l, zero); },
+      "FFDDivisions" },
+    { "no basis", [](vtkStructuredGrid* l) { l->GetFieldData()->RemoveArray("FFDBasis"); }, "FFDBasis" },
+    { "unsupported basis",
+      [](vtkStructuredGrid* l) { vtkFFDDataContract::SetBasis(l, vtkFFDBuildLattice::TRILINEAR); },
+      "not supported" },
+    { "wrong point count",
+      [](vtkStructuredGrid* l) {
+        const int more[3] = { 2, 2, 3 };
+        vtkFFDDataContract::SetDivisions(l, more);
+      },
+      "need 36" },
+    { "no rest position", [](vtkStructuredGrid* l) { l->GetPointData()->RemoveArray("RestPosition"); },
+      "RestPosition" },
+    { "rest position of 2 components",
+      [](vtkStructuredGrid* l) {
+        vtkNew<vtkDoubleArray> rest;
+        rest->SetName("RestPosition");
+        rest->SetNumberOfComponents(2);
+        rest->SetNumberOfTuples(l->GetNumberOfPoints());
+        rest->Fill(0.0);
+        l->GetPointData()->AddArray(rest);
+      },
+      "RestPosition" },
+    { "non-finite control point",
+      [](vtkStructuredGrid* l) { l->GetPoints()->SetPoint(5, 0.0, std::nan(""), 0.0); }, "not finite" },
+  };
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
+  for (const Case& c : cases)
+  {
+    vtkSmartPointer<vtkStructuredGrid> lattice = MakeLattice(f, 2, 2, 2);
+    c.Break(lattice);
+    vtkNew<vtkFFDDeform> deform;
+    deform->SetInputData(mesh);
+    deform->SetLatticeData(lattice);
+    vtkNew<FFDTestErrorObserver> observer;
+    observer->Watch(deform);
+    observer->Watch(deform->GetExecutive());
+    deform->Update();
+    EXPECT_NE(observer->Errors.find(c.Expected), std::string::npos)
+      << c.Name << ": got \"" << observer->Errors << "\"";
+    EXPECT_EQ(deform->GetOutput()->GetNumberOfPoints(), 0) << c.Name;
+  }
+}
+
+TEST(vtkFFDDeform, ReportsProgress)
+{
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("bear");
+  Pipeline pipeline(mesh, 2, 2, 2);
+  std::vector<double> progress;
+  vtkNew<vtkCallbackCommand> onProgress;
+  onProgress->SetClientData(&progress);
+  onProgress->SetCallback([](vtkObject* caller, unsigned long, void* data, void*) {
+    static_cast<std::vector<double>*>(data)->push_back(static_cast<vtkAlgorithm*>(caller)->GetProgress());
+  });
+  pipeline.Deform->AddObserver(vtkCommand::ProgressEvent, onProgress);
+  pipeline.Deform->Update();
+  ASSERT_GE(progress.size(), 2u);
+  EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
+  EXPECT_EQ(progress.back(), 1.0);
+}
