@@ -1,0 +1,199 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
+"""Deforms a real mesh with a global Bernstein (Sederberg-Parry) lattice of 3x4x5 control points.
+
+The set-up of the paper's Figure 12: the mesh is voxelized into 2x3x4 voxels, which gives a Bernstein lattice of
+degree (2, 3, 4), that is 3x4x5 = 60 control points. The lattice's points are moved through numpy (the top layer
+is pulled up and twisted, the middle layers bulge out), the mesh is deformed, and two PNGs are written: the mesh
+with its rest lattice, and the deformed mesh with the moved lattice. A figure-style caption and the time of the
+deformation are printed.
+
+Run it with Debian's /usr/bin/python3 (which has VTK's Python), the built package on PYTHONPATH and an X server
+(Xvfb will do), as Utilities/setup.sh does:
+    PYTHONPATH=build/lib/python3/dist-packages xvfb-run -a /usr/bin/python3 Examples/Python/deform_mesh.py
+"""
+import argparse
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkCommonDataModel import vtkStructuredGrid
+from vtkmodules.vtkFiltersCore import vtkPolyDataNormals
+from vtkmodules.vtkIOImage import vtkPNGWriter
+from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+from vtkmodules.vtkRenderingCore import (
+    vtkActor,
+    vtkPolyDataMapper,
+    vtkRenderer,
+    vtkRenderWindow,
+    vtkWindowToImageFilter,
+)
+import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL implementations of the rendering classes)
+
+try:
+    import vtkffd
+except ImportError as error:
+    sys.exit(f"{error}: put the built package on PYTHONPATH, e.g. PYTHONPATH=build/lib/python3/dist-packages")
+
+REPOSITORY = Path(__file__).resolve().parents[2]
+DIVISIONS = (2, 3, 4)  # voxels per axis; the Bernstein degree per axis, so 3x4x5 control points
+# CGAL's meshes stand along +Y, the frame's T axis: "up" below is T, and the camera looks along -Z.
+TWIST_DEGREES = 40.0  # rotation of the top layer about the vertical axis (zero at the bottom layer)
+BULGE = 0.35  # outward push of the middle layers, as a fraction of their distance to the axis
+STRETCH = 0.25  # lift of the top layer, as a fraction of the frame's height
+EVALUATION_RUNS = 5
+
+
+def parse_arguments():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("mesh", nargs="?", default="bear",
+                        help="a .vtp file, or the name of a mesh in Testing/Data/Meshes (default: bear)")
+    parser.add_argument("--output-dir", type=Path, default=REPOSITORY / "build" / "demo",
+                        help="folder for the PNGs (default: build/demo in the repository)")
+    parser.add_argument("--size", type=int, nargs=2, default=(800, 800), metavar=("WIDTH", "HEIGHT"),
+                        help="image size in pixels (default: 800 800)")
+    return parser.parse_args()
+
+
+def read_mesh(name):
+    path = Path(name)
+    if path.suffix != ".vtp":
+        path = REPOSITORY / "Testing" / "Data" / "Meshes" / f"{name}.vtp"
+    if not path.is_file():
+        sys.exit(f"{path} is missing: pass a .vtp file, or run Utilities/setup.sh to fetch the meshes")
+    reader = vtkXMLPolyDataReader()
+    reader.SetFileName(str(path))
+    # Point normals give smooth shading; vtkFFDDeform transforms them with the deformation.
+    normals = vtkPolyDataNormals()
+    normals.SetInputConnection(reader.GetOutputPort())
+    normals.SplittingOff()
+    normals.Update()
+    mesh = normals.GetOutput()
+    if mesh.GetNumberOfPoints() == 0:
+        sys.exit(f"{path} holds no points")
+    return path.stem, mesh
+
+
+def deform_lattice(lattice):
+    """Moves the lattice's points in place: twist and lift the upper layers, bulge the middle ones."""
+    n_i, n_j, n_k = lattice.GetDimensions()
+    frame = vtk_to_numpy(lattice.GetFieldData().GetArray("FFDFrame"))
+    origin, s_axis, t_axis, u_axis = frame.reshape(4, 3)
+    rest = vtk_to_numpy(lattice.GetPointData().GetArray("RestPosition")).reshape(n_k, n_j, n_i, 3)
+    # A view of the lattice's own points (VTK order: i fastest, so the numpy shape is k, j, i).
+    points = vtk_to_numpy(lattice.GetPoints().GetData()).reshape(n_k, n_j, n_i, 3)
+
+    height = np.linspace(0.0, 1.0, n_j)[None, :, None, None]  # parameter t of each layer along T
+    axis = t_axis / np.linalg.norm(t_axis)
+    centre = origin + 0.5 * s_axis + 0.5 * u_axis + height * t_axis  # the vertical axis through the frame
+    offset = rest - centre
+    angle = np.radians(TWIST_DEGREES) * height
+    # Rotate the part of each offset across the axis (Rodrigues' formula with no along-axis term), scale it.
+    along = (offset @ axis)[..., None] * axis
+    across = offset - along
+    rotated = across * np.cos(angle) + np.cross(axis, across) * np.sin(angle)
+    scale = 1.0 + BULGE * np.sin(np.pi * height)
+    points[...] = centre + along + scale * rotated + STRETCH * height**2 * t_axis
+    lattice.GetPoints().Modified()  # numpy wrote behind VTK's back: tell the pipeline
+
+
+def render(output_path, size, mesh, lattice, camera_bounds):
+    mesh_mapper = vtkPolyDataMapper()
+    mesh_mapper.SetInputData(mesh)
+    mesh_actor = vtkActor()
+    mesh_actor.SetMapper(mesh_mapper)
+    mesh_actor.GetProperty().SetColor(0.93, 0.90, 0.82)  # ivory
+    mesh_actor.GetProperty().SetSpecular(0.2)
+    mesh_actor.GetProperty().SetSpecularPower(20)
+
+    lattice_actor = vtkffd.vtkFFDLatticeActor()  # red control points, dark grey edges
+    lattice_actor.SetInputData(lattice)
+
+    renderer = vtkRenderer()
+    renderer.AddActor(mesh_actor)
+    renderer.AddActor(lattice_actor)
+    renderer.GradientBackgroundOn()
+    renderer.SetBackground(0.72, 0.76, 0.82)
+    renderer.SetBackground2(0.98, 0.98, 0.99)
+    camera = renderer.GetActiveCamera()
+    camera.SetFocalPoint(0.0, 0.0, 0.0)
+    camera.SetPosition(0.0, 0.0, 1.0)
+    camera.SetViewUp(0.0, 1.0, 0.0)
+    camera.Azimuth(30.0)
+    camera.Elevation(15.0)
+    renderer.ResetCamera(camera_bounds)  # the same framing before and after
+    camera.Zoom(1.25)  # ResetCamera fits the bounding sphere, which leaves wide margins around a box
+
+    window = vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetSize(*size)
+    window.AddRenderer(renderer)
+    window.Render()
+    grabber = vtkWindowToImageFilter()
+    grabber.SetInput(window)
+    writer = vtkPNGWriter()
+    writer.SetInputConnection(grabber.GetOutputPort())
+    writer.SetFileName(str(output_path))
+    writer.Write()
+
+
+def union_bounds(*data_sets):
+    bounds = np.array([data.GetBounds() for data in data_sets])
+    return [float(v) for pair in zip(bounds[:, 0::2].min(axis=0), bounds[:, 1::2].max(axis=0)) for v in pair]
+
+
+def main():
+    arguments = parse_arguments()
+    name, mesh = read_mesh(arguments.mesh)
+
+    voxelize = vtkffd.vtkFFDVoxelize()
+    voxelize.SetInputData(mesh)
+    voxelize.SetDivisions(*DIVISIONS)
+    build = vtkffd.vtkFFDBuildLattice()
+    build.SetInputConnection(voxelize.GetOutputPort())
+    build.SetBasisToBernstein()
+    build.Update()
+    rest_lattice = build.GetOutput()
+
+    # Our own copy to move, so that a re-execution of vtkFFDBuildLattice cannot undo the moves.
+    lattice = vtkStructuredGrid()
+    lattice.DeepCopy(rest_lattice)
+    deform_lattice(lattice)
+
+    deform = vtkffd.vtkFFDDeform()
+    deform.SetInputData(mesh)
+    deform.SetLatticeData(lattice)
+    start = time.perf_counter()
+    deform.Update()  # the first run binds every point to the lattice, then evaluates
+    first_run = time.perf_counter() - start
+    evaluation_runs = []
+    for _ in range(EVALUATION_RUNS):
+        lattice.GetPoints().Modified()  # as after moving control points: the binding is reused
+        start = time.perf_counter()
+        deform.Update()
+        evaluation_runs.append(time.perf_counter() - start)
+    if deform.GetNumberOfBindings() != 1:
+        sys.exit(f"expected one binding, got {deform.GetNumberOfBindings()}: the binding cache did not hold")
+    deformed = deform.GetOutput()
+
+    arguments.output_dir.mkdir(parents=True, exist_ok=True)
+    before_png = arguments.output_dir / f"{name}_before.png"
+    after_png = arguments.output_dir / f"{name}_after.png"
+    camera_bounds = union_bounds(mesh, rest_lattice, deformed, lattice)
+    render(before_png, arguments.size, mesh, rest_lattice, camera_bounds)
+    render(after_png, arguments.size, deformed, lattice, camera_bounds)
+
+    n_i, n_j, n_k = lattice.GetDimensions()
+    print(f"{name}: {mesh.GetNumberOfPoints()} vertices, {lattice.GetNumberOfPoints()} control points "
+          f"({n_i}x{n_j}x{n_k}), {voxelize.GetNumberOfActiveVoxels()} active voxels, "
+          f"{build.GetNumberOfActiveControlPoints()} active control points")
+    print(f"deformation: {first_run * 1e3:.2f} ms binding + evaluation, "
+          f"{statistics.median(evaluation_runs) * 1e3:.2f} ms evaluation only (median of {EVALUATION_RUNS})")
+    print(f"wrote {before_png} and {after_png}")
+
+
+if __name__ == "__main__":
+    main()

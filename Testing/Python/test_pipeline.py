@@ -1,0 +1,229 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
+"""The global FFD pipeline driven from Python: vtkFFDVoxelize -> vtkFFDBuildLattice -> (numpy moves the lattice's
+points) -> vtkFFDDeform, on the real elephant mesh, checked against an independent float64 numpy reference of the
+paper's equations 2 and 3 written here.
+
+Run with Debian's /usr/bin/python3, PYTHONPATH=<build>/lib/python3/dist-packages and VOXELFFD_MESH_DIR set to the
+folder of the meshes (ctest does both). Exits non-zero when a test fails.
+"""
+import math
+import os
+import unittest
+
+import numpy as np
+from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+from vtkmodules.vtkCommonCore import vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkPolyData, vtkStructuredGrid
+from vtkmodules.vtkCommonExecutionModel import vtkAlgorithm
+from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+
+import vtkffd
+
+MESH_DIR = os.environ.get(
+    "VOXELFFD_MESH_DIR", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Data", "Meshes"))
+
+# Deformed points agree with the float64 reference within this fraction of the mesh's bounding-box diagonal:
+# both sides compute in double precision from the same input points, so the only differences
+# are rounding in evaluation orders that differ (de Casteljau and displacement form against binomials times
+# powers on absolute positions), a few 1e-16 relative per term.
+RELATIVE_TOLERANCE = 1e-9
+
+
+def read_mesh(name):
+    path = os.path.join(MESH_DIR, name + ".vtp")
+    if not os.path.isfile(path):
+        raise FileNotFoundError(path + " is missing: run Utilities/setup.sh, which fetches the meshes")
+    reader = vtkXMLPolyDataReader()
+    reader.SetFileName(path)
+    reader.Update()
+    return reader.GetOutput()
+
+
+def bbox_diagonal(points):
+    return float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+
+
+def reference_deform(frame, divisions, control_points, x):
+    """Equations 2 and 3 in float64: parameters by triple products, then the Bernstein sum over absolute
+    control points P_ijk (VTK order, i fastest) of a lattice of degree (l, m, n) = divisions."""
+    x0, s, t, u = frame[0:3], frame[3:6], frame[6:9], frame[9:12]
+    d = x - x0
+    tu, su, st = np.cross(t, u), np.cross(s, u), np.cross(s, t)
+    params = [d @ tu / (s @ tu), d @ su / (t @ su), d @ st / (u @ st)]
+    l, m, n = divisions
+
+    def bernstein(degree, v):
+        return np.stack([math.comb(degree, i) * v**i * (1.0 - v) ** (degree - i) for i in range(degree + 1)], axis=1)
+
+    bs, bt, bu = bernstein(l, params[0]), bernstein(m, params[1]), bernstein(n, params[2])
+    p = control_points.reshape(n + 1, m + 1, l + 1, 3)  # [k, j, i]
+    return np.einsum("pi,pj,pk,kjic->pc", bs, bt, bu, p)
+
+
+class ErrorCatcher:
+    """Collects the messages of ErrorEvents (and keeps expected errors out of the log)."""
+
+    def __init__(self):
+        self.CallDataType = "string0"
+        self.messages = []
+
+    def __call__(self, caller, event, message):
+        self.messages.append(message)
+
+
+class TestPipeline(unittest.TestCase):
+    def setUp(self):
+        self.mesh = read_mesh("elephant")
+        self.mesh_points = vtk_to_numpy(self.mesh.GetPoints().GetData()).astype(np.float64)
+        self.diagonal = bbox_diagonal(self.mesh_points)
+
+        self.voxelize = vtkffd.vtkFFDVoxelize()
+        self.voxelize.SetInputData(self.mesh)
+        self.voxelize.SetDivisions(2, 3, 4)
+        self.build = vtkffd.vtkFFDBuildLattice()
+        self.build.SetInputConnection(self.voxelize.GetOutputPort())
+        self.build.SetBasisToBernstein()
+        self.build.Update()
+        # The test owns a copy that it moves; the filters keep their own output.
+        self.lattice = vtkStructuredGrid()
+        self.lattice.DeepCopy(self.build.GetOutput())
+
+        self.deform = vtkffd.vtkFFDDeform()
+        self.deform.SetInputData(self.mesh)
+        self.deform.SetLatticeData(self.lattice)
+        self.deform.SetOutputPointsPrecision(vtkAlgorithm.DOUBLE_PRECISION)
+
+    def frame(self):
+        return vtk_to_numpy(self.lattice.GetFieldData().GetArray("FFDFrame")).astype(np.float64)
+
+    def lattice_points(self):
+        """The lattice's points as a writable numpy view (double precision, as the data contract says)."""
+        return vtk_to_numpy(self.lattice.GetPoints().GetData())
+
+    def move_lattice(self, seed):
+        points = self.lattice_points()
+        rng = np.random.default_rng(seed)
+        points += rng.normal(scale=0.05 * self.diagonal, size=points.shape)
+        self.lattice.GetPoints().Modified()
+
+    def deformed_points(self):
+        self.deform.Update()
+        return vtk_to_numpy(self.deform.GetOutput().GetPoints().GetData())
+
+    def test_import_exposes_classes(self):
+        for name in ("vtkFFDVoxelize", "vtkFFDBuildLattice", "vtkFFDDeform", "vtkFFDLatticeActor"):
+            self.assertTrue(hasattr(vtkffd, name), name)
+
+    def test_lattice_follows_data_contract(self):
+        self.assertEqual(self.lattice.GetDimensions(), (3, 4, 5))
+        self.assertEqual(self.lattice.GetPoints().GetDataType(), 11)  # VTK_DOUBLE
+        divisions = vtk_to_numpy(self.lattice.GetFieldData().GetArray("FFDDivisions"))
+        np.testing.assert_array_equal(divisions, [2, 3, 4])
+        # Equation 1: P_ijk = X0 + i/l S + j/m T + k/n U, VTK order.
+        frame = self.frame()
+        k, j, i = np.meshgrid(np.arange(5) / 4, np.arange(4) / 3, np.arange(3) / 2, indexing="ij")
+        expected = (frame[0:3] + np.outer(i.ravel(), frame[3:6]) + np.outer(j.ravel(), frame[6:9])
+                    + np.outer(k.ravel(), frame[9:12]))
+        rest = vtk_to_numpy(self.lattice.GetPointData().GetArray("RestPosition"))
+        np.testing.assert_allclose(self.lattice_points(), expected, rtol=0, atol=1e-12 * self.diagonal)
+        np.testing.assert_array_equal(rest, self.lattice_points())
+
+    def test_rest_lattice_leaves_mesh_unchanged(self):
+        self.deform.SetOutputPointsPrecision(vtkAlgorithm.DEFAULT_PRECISION)
+        # The deformation is added as displacements P - P_rest, all exactly zero here: the points come back
+        # bit for bit, in the input's precision.
+        output = self.deformed_points()
+        input_points = vtk_to_numpy(self.mesh.GetPoints().GetData())
+        self.assertEqual(output.dtype, input_points.dtype)
+        np.testing.assert_array_equal(output, input_points)
+
+    def test_numpy_moved_lattice_matches_reference(self):
+        self.move_lattice(seed=20240611)
+        expected = reference_deform(self.frame(), (2, 3, 4), self.lattice_points().copy(), self.mesh_points)
+        output = self.deformed_points()
+        error = np.abs(output - expected).max()
+        self.assertLessEqual(error, RELATIVE_TOLERANCE * self.diagonal)
+        # The random moves are large enough that the test can fail: the mesh really moved.
+        self.assertGreater(np.abs(output - self.mesh_points).max(), 0.01 * self.diagonal)
+
+    def test_moving_only_the_lattice_does_not_rebind(self):
+        first = self.deformed_points().copy()
+        self.assertEqual(self.deform.GetNumberOfBindings(), 1)
+        for seed in (1, 2):
+            self.move_lattice(seed)
+            moved = self.deformed_points()
+            self.assertEqual(self.deform.GetNumberOfBindings(), 1)
+            self.assertGreater(np.abs(moved - first).max(), 0.01 * self.diagonal)
+            expected = reference_deform(self.frame(), (2, 3, 4), self.lattice_points().copy(), self.mesh_points)
+            self.assertLessEqual(np.abs(moved - expected).max(), RELATIVE_TOLERANCE * self.diagonal)
+
+    def test_numpy_point_set_and_affine_lattice(self):
+        # A point set built from numpy (numpy_to_vtk) deformed by a lattice moved by an affine map: Bernstein
+        # bases reproduce affine maps (linear precision), so the output is the map applied to the points.
+        rng = np.random.default_rng(7)
+        cloud = rng.uniform(-1.0, 1.0, size=(500, 3)) * [2.0, 1.0, 0.5]
+        vtk_points = vtkPoints()
+        vtk_points.SetData(numpy_to_vtk(cloud, deep=True))
+        point_set = vtkPolyData()
+        point_set.SetPoints(vtk_points)
+
+        voxelize = vtkffd.vtkFFDVoxelize()
+        voxelize.SetInputData(point_set)
+        voxelize.SetDivisions(3, 2, 2)
+        build = vtkffd.vtkFFDBuildLattice()
+        build.SetInputConnection(voxelize.GetOutputPort())
+        build.Update()
+        lattice = vtkStructuredGrid()
+        lattice.DeepCopy(build.GetOutput())
+        matrix = np.eye(3) + rng.uniform(-0.3, 0.3, size=(3, 3))
+        offset = rng.uniform(-1.0, 1.0, size=3)
+        control = vtk_to_numpy(lattice.GetPoints().GetData())
+        control[:] = control @ matrix.T + offset
+        lattice.GetPoints().Modified()
+
+        deform = vtkffd.vtkFFDDeform()
+        deform.SetInputData(point_set)
+        deform.SetLatticeData(lattice)
+        deform.Update()
+        output = vtk_to_numpy(deform.GetOutput().GetPoints().GetData())
+        self.assertEqual(output.dtype, np.float64)
+        np.testing.assert_allclose(output, cloud @ matrix.T + offset, rtol=0,
+                                   atol=RELATIVE_TOLERANCE * bbox_diagonal(cloud))
+
+    def test_lattice_without_rest_position_is_an_error(self):
+        self.lattice.GetPointData().RemoveArray("RestPosition")
+        errors = ErrorCatcher()
+        self.deform.AddObserver("ErrorEvent", errors)
+        # The executive reports the failed request too; catch it so the log shows only unexpected errors.
+        self.deform.GetExecutive().AddObserver("ErrorEvent", ErrorCatcher())
+        self.deform.Update()
+        self.assertTrue(any("RestPosition" in message for message in errors.messages), errors.messages)
+        self.assertEqual(self.deform.GetOutput().GetNumberOfPoints(), 0)
+
+    def test_lattice_actor_sizes_points_from_the_current_lattice(self):
+        actor = vtkffd.vtkFFDLatticeActor()
+        actor.SetInputData(self.lattice)
+        self.assertEqual(actor.GetPointRadius(), 0.0)
+        self.assertEqual(actor.GetPointProperty().GetColor(), (0.9, 0.1, 0.1))
+        self.assertEqual(actor.GetEdgeProperty().GetLineWidth(), 2.0)
+        # Asking for the bounds brings the automatic radius up to date, as rendering does.
+        actor.GetBounds()
+        fraction = vtkffd.vtkFFDLatticeActor.GetAutomaticRadiusFraction()
+        self.assertAlmostEqual(actor.GetRenderedPointRadius(), fraction * self.lattice.GetLength(), delta=1e-12)
+        points = self.lattice_points()
+        points *= 2.0
+        self.lattice.GetPoints().Modified()
+        bounds = actor.GetBounds()
+        self.assertAlmostEqual(actor.GetRenderedPointRadius(), fraction * self.lattice.GetLength(), delta=1e-12)
+        # The spheres stick out of the lattice's bounds by their radius (less a little: the tessellated sphere
+        # has no vertex exactly on its equator).
+        radius = actor.GetRenderedPointRadius()
+        self.assertAlmostEqual(bounds[1], self.lattice.GetBounds()[1] + radius, delta=0.05 * radius)
+        actor.SetPointRadius(0.125)
+        actor.GetBounds()
+        self.assertEqual(actor.GetRenderedPointRadius(), 0.125)
+
+
+if __name__ == "__main__":
+    unittest.main()

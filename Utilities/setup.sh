@@ -1,0 +1,120 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# The README's two Quick start commands:
+#   Utilities/setup.sh demo [demo options]   set up, build, run the main demo (Examples/Python/deform_mesh.py)
+#   Utilities/setup.sh test [ctest options]  set up, build, run every test through ctest
+# Set-up = install the missing Debian 12 packages, fetch the real meshes, configure once, build. Every step is
+# skipped when its result is already there, so a second run only costs a no-op ninja.
+#
+# Environment: VOXELFFD_BUILD_DIR (default <repository>/build).
+set -euo pipefail
+
+usage() {
+  echo "usage:" >&2
+  sed -n '5,6s/^#//p' "$0" >&2 # the two command lines of the header above
+  exit 2
+}
+
+[[ $# -ge 1 ]] || usage
+action=$1
+shift
+[[ $action == demo || $action == test ]] || usage
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build=${VOXELFFD_BUILD_DIR:-$root/build}
+mesh_dir=$root/Testing/Data/Meshes
+# Debian's interpreter: it has VTK's Python (vtkmodules) and numpy, which another python3 on PATH may lack.
+python=/usr/bin/python3
+
+step() { printf '\n==> %s\n' "$*"; }
+
+# Root runs apt directly (CI containers have no sudo); anyone else goes through sudo.
+as_root() {
+  if [[ $(id -u) -eq 0 ]]; then
+    "$@"
+  else
+    sudo "$@"
+  fi
+}
+
+# --- 1. Debian packages ---------------------------------------------------------------------------------------
+packages=(build-essential cmake ninja-build libvtk9-dev python3-vtk9 libopenvdb-dev libboost-iostreams-dev
+  libeigen3-dev libgtest-dev xvfb xauth libgl1-mesa-dri python3-numpy)
+step "Debian packages"
+missing=()
+for package in "${packages[@]}"; do
+  if [[ $(dpkg-query -W -f='${db:Status-Status}' "$package" 2>/dev/null || true) != installed ]]; then
+    missing+=("$package")
+  fi
+done
+if [[ ${#missing[@]} -gt 0 ]]; then
+  echo "installing: ${missing[*]}"
+  as_root apt-get update
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "${missing[@]}"
+else
+  echo "all ${#packages[@]} packages are installed"
+fi
+
+# --- 2. Real meshes -------------------------------------------------------------------------------------------
+# CGAL's sample meshes (OFF) come with Debian's libcgal-demo package; VTK 9.1 reads no OFF, so they are
+# converted to VTK XML PolyData. They are git-ignored: fetched here, never committed.
+meshes=(bear elephant armadillo camel cow)
+step "Meshes in ${mesh_dir#"$root"/}"
+missing=()
+for mesh in "${meshes[@]}"; do
+  [[ -s $mesh_dir/$mesh.vtp ]] || missing+=("$mesh")
+done
+if [[ ${#missing[@]} -gt 0 ]]; then
+  echo "fetching libcgal-demo for: ${missing[*]}"
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT # on failure; removed below on success
+  # apt downloads as the unprivileged _apt user when run as root; let it write here (else apt warns and
+  # downloads unsandboxed).
+  if [[ $(id -u) -eq 0 ]] && id _apt >/dev/null 2>&1; then
+    chown _apt "$work"
+  fi
+  # A fresh system may have no package lists at all (apt-get download then finds nothing).
+  if ! apt-cache show libcgal-demo >/dev/null 2>&1; then
+    as_root apt-get update
+  fi
+  (cd "$work" && apt-get download libcgal-demo)
+  dpkg-deb --fsys-tarfile "$work"/libcgal-demo_*.deb | tar -x -C "$work" ./usr/share/doc/libcgal-dev/data.tar.gz
+  members=()
+  for mesh in "${missing[@]}"; do members+=("data/meshes/$mesh.off"); done
+  tar -xzf "$work/usr/share/doc/libcgal-dev/data.tar.gz" -C "$work" "${members[@]}"
+  mkdir -p "$mesh_dir"
+  for mesh in "${missing[@]}"; do
+    # Convert beside the target and rename, so an interrupted run leaves no half-written mesh behind.
+    "$python" "$root/Utilities/off_to_vtp.py" "$work/data/meshes/$mesh.off" "$mesh_dir/.$mesh.vtp.tmp"
+    mv "$mesh_dir/.$mesh.vtp.tmp" "$mesh_dir/$mesh.vtp"
+    echo "  $mesh.vtp"
+  done
+  rm -rf "$work"
+else
+  echo "all ${#meshes[@]} meshes are there"
+fi
+
+# --- 3. Configure and build -----------------------------------------------------------------------------------
+step "Build in ${build}"
+# Configure only when there is no build system yet (also after a configure that failed half-way).
+if [[ ! -f $build/build.ninja ]]; then
+  cmake -G Ninja -S "$root" -B "$build" -DPython3_EXECUTABLE="$python" -DCMAKE_BUILD_TYPE=Release
+fi
+# Ninja re-runs CMake by itself when a CMakeLists.txt changed.
+cmake --build "$build"
+
+# --- 4. Run ---------------------------------------------------------------------------------------------------
+case $action in
+  demo)
+    step "Demo: Examples/Python/deform_mesh.py"
+    # Rendering needs an X server (Debian's VTK is GLX-only): a virtual one from Xvfb.
+    PYTHONPATH="$build/lib/python3/dist-packages${PYTHONPATH:+:$PYTHONPATH}" \
+      xvfb-run -a "$python" "$root/Examples/Python/deform_mesh.py" --output-dir "$build/demo" "$@"
+    ;;
+  test)
+    step "Tests: ctest"
+    # Tests that render start their own Xvfb (xvfb-run in their ctest command), so ctest runs as is.
+    ctest --test-dir "$build" --output-on-failure "$@"
+    ;;
+esac
