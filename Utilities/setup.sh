@@ -108,13 +108,14 @@ cmake --build "$build"
 case $action in
   demo)
     step "Demo: Examples/Python/deform_mesh.py"
-    # Rendering needs an X server (Debian's VTK is GLX-only): a virtual one from Xvfb.
+    # Rendering needs an X display (Debian's VTK is GLX-only): the caller's, or a virtual one from Xvfb.
     PYTHONPATH="$build/lib/python3/dist-packages${PYTHONPATH:+:$PYTHONPATH}" \
-      xvfb-run -a "$python" "$root/Examples/Python/deform_mesh.py" --output-dir "$build/demo" "$@"
+      "$root/Utilities/with-display.sh" "$python" "$root/Examples/Python/deform_mesh.py" \
+      --output-dir "$build/demo" "$@"
     ;;
   test)
     step "Tests: ctest"
-    # Tests that render start their own Xvfb (xvfb-run in their ctest command), so ctest runs as is.
-    ctest --test-dir "$build" --output-on-failure "$@"
+    # One X display for the whole suite (the caller's, or one virtual server): the tests that render use it.
+    "$root/Utilities/with-display.sh" ctest --test-dir "$build" --output-on-failure "$@"
     ;;
 esac

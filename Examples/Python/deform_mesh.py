@@ -10,7 +10,7 @@ deformation are printed.
 
 Run it with Debian's /usr/bin/python3 (which has VTK's Python), the built package on PYTHONPATH and an X server
 (Xvfb will do), as Utilities/setup.sh does:
-    PYTHONPATH=build/lib/python3/dist-packages xvfb-run -a /usr/bin/python3 Examples/Python/deform_mesh.py
+    PYTHONPATH=build/lib/python3/dist-packages Utilities/with-display.sh /usr/bin/python3 Examples/Python/deform_mesh.py
 """
 import argparse
 import statistics
