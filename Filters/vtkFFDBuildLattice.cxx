@@ -17,7 +17,9 @@
 
 #include "FFDBernstein.h"
 #include "FFDFrame.h"
+#include "FFDGridBasis.h"
 
+#include <algorithm>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -26,48 +28,43 @@ vtkStandardNewMacro(vtkFFDBuildLattice);
 
 namespace
 {
+// The filter's enum and the kernels' enum name the same bases: the `FFDBasis` field array holds either.
+static_assert(int(ffd::GridBasis::Bernstein) == vtkFFDBuildLattice::BERNSTEIN &&
+    int(ffd::GridBasis::Trilinear) == vtkFFDBuildLattice::TRILINEAR &&
+    int(ffd::GridBasis::TriquadraticBezier) == vtkFFDBuildLattice::TRIQUADRATIC_BEZIER &&
+    int(ffd::GridBasis::TricubicBezier) == vtkFFDBuildLattice::TRICUBIC_BEZIER &&
+    int(ffd::GridBasis::CubicBSpline) == vtkFFDBuildLattice::CUBIC_BSPLINE,
+  "vtkFFDBuildLattice::Bases and ffd::GridBasis disagree");
+
 /**
- * What the filter needs to know of a basis over a voxel grid: how many control points lie along each axis,
- * where they rest, and which of them influence a voxel. Each basis fills one in MakeLayout(); the rest of the
- * filter is basis-independent, so the local bases slot in by adding their case there.
+ * The control points per axis of `basis` over `divisions` voxels; false with the reason (and its remedy) in
+ * `why`. The per-basis formulas (points per axis, rest parameters, supports) live in FFDGridBasis.h, shared
+ * with the deformation kernels, so that the lattice and its evaluation cannot disagree.
  */
-struct LatticeLayout
+bool LatticePointsPerAxis(int basis, const int divisions[3], int points[3], std::string& why)
 {
-  int Points[3];    ///< control points per axis
-  int Intervals[3]; ///< control-point spacings across the frame per axis: point i rests at parameter i/Intervals
-
-  /// The control points [first, last] along `axis` that influence voxel `voxel` of that axis.
-  void Support(int axis, int /*voxel*/, int& first, int& last) const
+  if (!ffd::IsGridBasis(basis))
   {
-    // Only the global basis exists so far: its support is the whole axis.
-    first = 0;
-    last = this->Points[axis] - 1;
-  }
-};
-
-/// The layout of `basis` over `divisions` voxels; false with the reason (and its remedy) in `why`.
-bool MakeLayout(int basis, const int divisions[3], LatticeLayout& layout, std::string& why)
-{
-  if (basis != vtkFFDBuildLattice::BERNSTEIN)
-  {
-    why = std::string("basis ") + vtkFFDBuildLattice::GetBasisAsString(basis) +
-      " is not implemented yet; use BERNSTEIN (SetBasisToBernstein()).";
+    std::ostringstream msg;
+    msg << "unknown basis " << basis << ": use one of BERNSTEIN (" << vtkFFDBuildLattice::BERNSTEIN
+        << ") to CUBIC_BSPLINE (" << vtkFFDBuildLattice::CUBIC_BSPLINE << ").";
+    why = msg.str();
     return false;
   }
+  const ffd::GridBasis grid = static_cast<ffd::GridBasis>(basis);
   for (int a = 0; a < 3; ++a)
   {
     // The global lattice's degree along an axis is the number of voxels along it.
-    if (divisions[a] > ffd::MaxBernsteinDegree)
+    if (grid == ffd::GridBasis::Bernstein && divisions[a] > ffd::MaxBernsteinDegree)
     {
       std::ostringstream msg;
       msg << "the BERNSTEIN basis would have degree " << divisions[a] << " along axis " << a
           << ", above the maximum " << ffd::MaxBernsteinDegree << ": give vtkFFDVoxelize at most "
-          << ffd::MaxBernsteinDegree << " divisions per axis.";
+          << ffd::MaxBernsteinDegree << " divisions per axis, or use a local basis (e.g. SetBasisToTrilinear()).";
       why = msg.str();
       return false;
     }
-    layout.Points[a] = divisions[a] + 1;
-    layout.Intervals[a] = divisions[a];
+    points[a] = ffd::ControlPointsAlongAxis(grid, divisions[a]);
   }
   return true;
 }
@@ -115,15 +112,31 @@ int vtkFFDBuildLattice::RequestInformation(
     outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
     return 1;
   }
-  LatticeLayout layout;
+  int points[3];
   std::string why;
-  if (!MakeLayout(this->Basis, divisions, layout, why))
+  if (!LatticePointsPerAxis(this->Basis, divisions, points, why))
   {
     vtkErrorMacro(<< "Cannot build the lattice: " << why);
     return 0;
   }
-  const int latticeExtent[6] = { 0, layout.Points[0] - 1, 0, layout.Points[1] - 1, 0, layout.Points[2] - 1 };
+  const int latticeExtent[6] = { 0, points[0] - 1, 0, points[1] - 1, 0, points[2] - 1 };
   outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), latticeExtent, 6);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkFFDBuildLattice::RequestUpdateExtent(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
+{
+  // The lattice's extent is not the voxel grid's (a quadratic lattice has 2n + 1 points per axis, a B-spline
+  // lattice n + 3), and every control point depends on the whole grid through the culling: ask for all of it
+  // rather than the pipeline's default, which would copy the lattice's extent upstream.
+  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+  {
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
+      inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
+  }
   return 1;
 }
 
@@ -170,20 +183,21 @@ int vtkFFDBuildLattice::RequestData(
                      "connect the output of vtkFFDVoxelize or fix the frame.");
     return 0;
   }
-  LatticeLayout layout;
+  int pointsPerAxis[3];
   std::string why;
-  if (!MakeLayout(this->Basis, divisions, layout, why))
+  if (!LatticePointsPerAxis(this->Basis, divisions, pointsPerAxis, why))
   {
     vtkErrorMacro(<< "Cannot build the lattice: " << why);
     return 0;
   }
+  const ffd::GridBasis basis = static_cast<ffd::GridBasis>(this->Basis);
 
-  // Which control points influence an active voxel: the union of the active voxels' supports. A voxel is
-  // active unless the input's cell ghost array hides it. Once a support covers the whole lattice (always so
-  // for a global basis) no further voxel can add to it.
-  const int nI = layout.Points[0], nJ = layout.Points[1], nK = layout.Points[2];
+  // Which control points influence an active voxel: the union of the active voxels' supports (paper section
+  // III.D). A voxel is active unless the input's cell ghost array hides it. The cost is that of visiting the
+  // active voxels' supports; once a support covers the whole lattice (always so for the global basis) no
+  // further voxel can add to it.
+  const int nI = pointsPerAxis[0], nJ = pointsPerAxis[1], nK = pointsPerAxis[2];
   const vtkIdType numControlPoints = static_cast<vtkIdType>(nI) * nJ * nK;
-  std::vector<unsigned char> active(static_cast<size_t>(numControlPoints), 0);
   vtkUnsignedCharArray* cellGhosts = input->GetCellGhostArray();
   if (cellGhosts && cellGhosts->GetNumberOfValues() != input->GetNumberOfCells())
   {
@@ -192,34 +206,37 @@ int vtkFFDBuildLattice::RequestData(
                   << " voxels: connect the output of vtkFFDVoxelize.");
     return 0;
   }
+  vtkNew<vtkUnsignedCharArray> activeArray;
+  activeArray->SetName(vtkFFDDataContract::ActiveArrayName());
+  activeArray->SetNumberOfValues(numControlPoints);
+  unsigned char* active = activeArray->GetPointer(0);
+  std::fill(active, active + numControlPoints, static_cast<unsigned char>(0));
+  const unsigned char* voxelGhosts = cellGhosts ? cellGhosts->GetPointer(0) : nullptr;
   bool covered = false;
+  vtkIdType voxel = 0;
   for (int k = 0; k < divisions[2] && !covered; ++k)
   {
     for (int j = 0; j < divisions[1] && !covered; ++j)
     {
-      for (int i = 0; i < divisions[0] && !covered; ++i)
+      for (int i = 0; i < divisions[0] && !covered; ++i, ++voxel)
       {
-        const vtkIdType voxel = i + static_cast<vtkIdType>(divisions[0]) * (j + static_cast<vtkIdType>(divisions[1]) * k);
-        if (cellGhosts && (cellGhosts->GetValue(voxel) & vtkDataSetAttributes::HIDDENCELL))
+        if (voxelGhosts && (voxelGhosts[voxel] & vtkDataSetAttributes::HIDDENCELL))
         {
           continue;
         }
-        int first[3], last[3];
-        layout.Support(0, i, first[0], last[0]);
-        layout.Support(1, j, first[1], last[1]);
-        layout.Support(2, k, first[2], last[2]);
-        for (int c = first[2]; c <= last[2]; ++c)
+        int first[3], count[3];
+        ffd::VoxelSupport(basis, divisions[0], i, first[0], count[0]);
+        ffd::VoxelSupport(basis, divisions[1], j, first[1], count[1]);
+        ffd::VoxelSupport(basis, divisions[2], k, first[2], count[2]);
+        for (int c = first[2]; c < first[2] + count[2]; ++c)
         {
-          for (int b = first[1]; b <= last[1]; ++b)
+          for (int b = first[1]; b < first[1] + count[1]; ++b)
           {
-            for (int a = first[0]; a <= last[0]; ++a)
-            {
-              active[a + static_cast<size_t>(nI) * (b + static_cast<size_t>(nJ) * c)] = 1;
-            }
+            unsigned char* row = active + static_cast<size_t>(nI) * (b + static_cast<size_t>(nJ) * c);
+            std::fill(row + first[0], row + first[0] + count[0], static_cast<unsigned char>(1));
           }
         }
-        covered = first[0] == 0 && first[1] == 0 && first[2] == 0 && last[0] == nI - 1 && last[1] == nJ - 1 &&
-          last[2] == nK - 1;
+        covered = count[0] == nI && count[1] == nJ && count[2] == nK;
       }
     }
   }
@@ -229,34 +246,40 @@ int vtkFFDBuildLattice::RequestData(
     return 1;
   }
 
-  // The rest positions, each computed directly from the frame (no accumulated steps).
+  // The rest positions, each computed directly from the frame (no accumulated steps); the B-spline's outer
+  // ring has parameters outside [0, 1].
+  std::vector<double> restParameters[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    for (int i = 0; i < pointsPerAxis[a]; ++i)
+    {
+      restParameters[a].push_back(ffd::RestParameter(basis, divisions[a], i));
+    }
+  }
   const ffd::Frame<double> bound = ffd::Frame<double>::FromArray(frame);
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(numControlPoints);
-  vtkDoubleArray* pointArray = vtkDoubleArray::SafeDownCast(points->GetData());
+  vtkNew<vtkDoubleArray> rest;
+  rest->SetName(vtkFFDDataContract::RestPositionArrayName());
+  rest->SetNumberOfComponents(3);
+  rest->SetNumberOfTuples(numControlPoints);
+  double* pointValues = vtkDoubleArray::SafeDownCast(points->GetData())->GetPointer(0);
+  double* restValues = rest->GetPointer(0);
   vtkSMPTools::For(0, numControlPoints, [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType id = begin; id < end; ++id)
     {
       const vtkIdType i = id % nI, j = (id / nI) % nJ, k = id / (static_cast<vtkIdType>(nI) * nJ);
-      const ffd::Vec3<double> x = bound.ToWorld({ static_cast<double>(i) / layout.Intervals[0],
-        static_cast<double>(j) / layout.Intervals[1], static_cast<double>(k) / layout.Intervals[2] });
-      pointArray->SetTypedTuple(id, &x.x);
+      const ffd::Vec3<double> x =
+        bound.ToWorld({ restParameters[0][i], restParameters[1][j], restParameters[2][k] });
+      for (int c = 0; c < 3; ++c)
+      {
+        pointValues[3 * id + c] = restValues[3 * id + c] = x[c];
+      }
     }
   });
 
-  vtkNew<vtkDoubleArray> rest;
-  rest->DeepCopy(pointArray);
-  rest->SetName(vtkFFDDataContract::RestPositionArrayName());
-  vtkNew<vtkUnsignedCharArray> activeArray;
-  activeArray->SetName(vtkFFDDataContract::ActiveArrayName());
-  activeArray->SetNumberOfValues(numControlPoints);
-  vtkIdType numActive = 0;
-  for (vtkIdType id = 0; id < numControlPoints; ++id)
-  {
-    activeArray->SetValue(id, active[id]);
-    numActive += active[id];
-  }
+  const vtkIdType numActive = std::count(active, active + numControlPoints, static_cast<unsigned char>(1));
 
   output->SetExtent(0, nI - 1, 0, nJ - 1, 0, nK - 1);
   output->SetPoints(points);

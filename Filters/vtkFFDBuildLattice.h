@@ -10,12 +10,27 @@
  * `FFDBasis` (field data), `RestPosition` and `Active` (point data). Control points that influence no active
  * voxel under the basis are culled: `Active` is 0 and the ghost array marks them HIDDENPOINT.
  *
- * Bases:
- * - BERNSTEIN: the global Sederberg-Parry FFD (paper equation 3), degree = divisions per axis, so
- *   (nx+1)(ny+1)(nz+1) control points at X0 + (i/nx) S + (j/ny) T + (k/nz) U. Every control point influences
- *   every voxel: all are active when any voxel is.
- * - TRILINEAR, TRIQUADRATIC_BEZIER, TRICUBIC_BEZIER, CUBIC_BSPLINE: local bases (not implemented yet; asking
- *   for one is an error).
+ * Bases (n voxels along an axis; every basis is a tensor product of one-dimensional bases, see FFDGridBasis.h):
+ *
+ * | basis               | control points per axis | support of voxel v (per axis)  | per voxel | continuity |
+ * |---------------------|-------------------------|--------------------------------|-----------|------------|
+ * | BERNSTEIN           | n + 1 (degree n)        | all n + 1 points               | all       | C-infinity |
+ * | TRILINEAR           | n + 1                   | points v, v + 1                | 2x2x2     | C0         |
+ * | TRIQUADRATIC_BEZIER | 2n + 1                  | points 2v .. 2v + 2            | 3x3x3     | C0         |
+ * | TRICUBIC_BEZIER     | 3n + 1                  | points 3v .. 3v + 3            | 4x4x4     | C0         |
+ * | CUBIC_BSPLINE       | n + 3                   | points v .. v + 3              | 4x4x4     | C2         |
+ *
+ * - BERNSTEIN is the global Sederberg-Parry FFD (paper equation 3): point i rests at parameter i/n; every
+ *   control point influences every voxel, so all are active when any voxel is. Its degree is limited to
+ *   ffd::MaxBernsteinDegree per axis.
+ * - The Bezier sub-regions (paper Listings 1 and 2, equation 4) put degree p = 1, 2, 3 Bezier patches in the
+ *   voxels; neighbouring voxels share their face control points, and point i rests at parameter i/(p n).
+ * - CUBIC_BSPLINE is the uniform cubic B-spline: point i rests at parameter (i - 1)/n, so the lattice has one
+ *   ring of control points beyond the frame on every side.
+ *
+ * The rest lattice is the identity map for every basis. Culling (paper section III.D): a control point is
+ * active when it lies in the support of at least one active voxel; the cost is that of visiting the supports
+ * of the active voxels, so large sparse grids are cheap.
  *
  * Deform the lattice by moving its points (any filter, a script or a widget); its deformation is its points
  * minus `RestPosition`.
@@ -65,6 +80,7 @@ protected:
   ~vtkFFDBuildLattice() override = default;
 
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   int Basis;

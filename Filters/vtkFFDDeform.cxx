@@ -2,6 +2,7 @@
 #include "vtkFFDDeform.h"
 
 #include "vtkFFDBuildLattice.h"
+#include "vtkFFDCudaBackend.h"
 #include "vtkFFDDataContract.h"
 
 #include "vtkAOSDataArrayTemplate.h"
@@ -18,8 +19,7 @@
 #include "vtkSMPTools.h"
 #include "vtkSmartPointer.h"
 
-#include "FFDFrame.h"
-#include "FFDGlobalBernstein.h"
+#include "FFDGridDeformation.h"
 
 #include <algorithm>
 #include <array>
@@ -27,6 +27,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 vtkStandardNewMacro(vtkFFDDeform);
@@ -39,10 +40,17 @@ struct LatticeView
 {
   double Frame[12];
   int Divisions[3];
-  int Basis;
+  ffd::GridBasis Basis;
   int Dims[3];                       // control points per axis
   std::vector<double> Displacements; // 3 per control point: point minus RestPosition
 };
+
+static_assert(int(ffd::GridBasis::Bernstein) == vtkFFDBuildLattice::BERNSTEIN &&
+    int(ffd::GridBasis::Trilinear) == vtkFFDBuildLattice::TRILINEAR &&
+    int(ffd::GridBasis::TriquadraticBezier) == vtkFFDBuildLattice::TRIQUADRATIC_BEZIER &&
+    int(ffd::GridBasis::TricubicBezier) == vtkFFDBuildLattice::TRICUBIC_BEZIER &&
+    int(ffd::GridBasis::CubicBSpline) == vtkFFDBuildLattice::CUBIC_BSPLINE,
+  "the kernels' basis values are the FFDBasis values");
 
 // Reads a lattice per the data contract; returns an empty string or what is wrong with it.
 std::string ReadLattice(vtkPointSet* lattice, LatticeView& view)
@@ -65,23 +73,24 @@ std::string ReadLattice(vtkPointSet* lattice, LatticeView& view)
   {
     return "The lattice has no valid FFDDivisions field array (3 ints >= 1)." + fix;
   }
-  if (!vtkFFDDataContract::GetBasis(lattice, view.Basis))
+  int basis;
+  if (!vtkFFDDataContract::GetBasis(lattice, basis))
   {
     return "The lattice has no FFDBasis field array (1 int)." + fix;
   }
-  if (view.Basis != vtkFFDBuildLattice::BERNSTEIN)
+  if (!ffd::IsGridBasis(basis))
   {
-    return std::string("The lattice's basis ") + vtkFFDBuildLattice::GetBasisAsString(view.Basis) +
-      " is not supported by vtkFFDDeform yet; use BERNSTEIN.";
+    return "The lattice's FFDBasis " + std::to_string(basis) + " is not a known basis." + fix;
   }
+  view.Basis = static_cast<ffd::GridBasis>(basis);
   for (int a = 0; a < 3; ++a)
   {
-    if (view.Divisions[a] > ffd::MaxBernsteinDegree)
+    if (view.Basis == ffd::GridBasis::Bernstein && view.Divisions[a] > ffd::MaxBernsteinDegree)
     {
       return "The lattice's Bernstein degree " + std::to_string(view.Divisions[a]) + " exceeds the maximum " +
         std::to_string(ffd::MaxBernsteinDegree) + ".";
     }
-    view.Dims[a] = view.Divisions[a] + 1;
+    view.Dims[a] = ffd::ControlPointsAlongAxis(view.Basis, view.Divisions[a]);
   }
   const vtkIdType expected = vtkIdType(view.Dims[0]) * view.Dims[1] * view.Dims[2];
   const vtkIdType count = lattice->GetNumberOfPoints();
@@ -89,7 +98,8 @@ std::string ReadLattice(vtkPointSet* lattice, LatticeView& view)
   {
     std::ostringstream msg;
     msg << "The lattice has " << count << " points but its divisions " << view.Divisions[0] << "x"
-        << view.Divisions[1] << "x" << view.Divisions[2] << " need " << expected << ".";
+        << view.Divisions[1] << "x" << view.Divisions[2] << " and basis "
+        << vtkFFDBuildLattice::GetBasisAsString(basis) << " need " << expected << ".";
     return msg.str();
   }
   vtkDataArray* rest = lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
@@ -136,29 +146,30 @@ bool ForInChunks(vtkAlgorithm* self, vtkIdType n, Functor& functor, double progr
 }
 
 //------------------------------------------------------------------------------------------------------------
-// Binding: the parameters (s, t, u) of every point in the frame (equation 2), NaN for points that stay put.
+// Binding: the cell of every point (ffd::BindToGrid), -1 for points that keep their position.
+struct BindSettings
+{
+  ffd::Frame<double> Frame;
+  ffd::GridBasis Basis;
+  int Voxels[3];
+  bool ClampOutside;
+};
+
 template <typename PointArrayT>
 struct BindFunctor
 {
   PointArrayT* Points;
-  ffd::Frame<double> Frame;
-  double* Parameters;
+  const BindSettings& Settings;
+  int* Cells;
 
   void operator()(vtkIdType begin, vtkIdType end)
   {
     const auto points = vtk::DataArrayTupleRange<3>(this->Points, begin, end);
-    double* stuOut = this->Parameters + 3 * begin;
+    int* cell = this->Cells + begin;
     for (const auto x : points)
     {
-      ffd::Vec3<double> stu;
-      if (!this->Frame.Bind({ double(x[0]), double(x[1]), double(x[2]) }, stu))
-      {
-        stu = { std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0 };
-      }
-      stuOut[0] = stu.x;
-      stuOut[1] = stu.y;
-      stuOut[2] = stu.z;
-      stuOut += 3;
+      *cell++ = ffd::BindToGrid(this->Settings.Frame, this->Settings.Basis, this->Settings.Voxels,
+        { double(x[0]), double(x[1]), double(x[2]) }, this->Settings.ClampOutside);
     }
   }
 };
@@ -166,28 +177,26 @@ struct BindFunctor
 struct BindWorker
 {
   template <typename PointArrayT>
-  void operator()(PointArrayT* points, const ffd::Frame<double>& frame, double* parameters, vtkAlgorithm* self,
-    bool& completed)
+  void operator()(
+    PointArrayT* points, const BindSettings& settings, int* cells, vtkAlgorithm* self, bool& completed)
   {
-    BindFunctor<PointArrayT> functor{ points, frame, parameters };
+    BindFunctor<PointArrayT> functor{ points, settings, cells };
     completed = ForInChunks(self, points->GetNumberOfTuples(), functor, 0.0, 0.5);
   }
 };
 
 //------------------------------------------------------------------------------------------------------------
-// Evaluation in the precision Real of the output points.
-template <typename Real, typename PointArrayT>
+// Evaluation in the precision Real of the output points, by a ffd::GridDeformation.
+template <typename Deformer, typename Real, typename PointArrayT>
 struct EvaluateFunctor
 {
   PointArrayT* InPoints;
   Real* OutPoints;
-  const double* Parameters;
-  const Real* Displacements;
-  int Dims[3];
-  ffd::Frame<Real> Frame;
-  vtkDataArray* InNormals;  // nullptr: no normals to transform
+  const int* Cells;
+  Deformer Deformation;
+  vtkDataArray* InNormals; // nullptr: no normals to transform
   vtkDataArray* OutNormals;
-  Real* Determinants;       // nullptr: not asked for
+  Real* Determinants; // nullptr: not asked for
 
   void operator()(vtkIdType begin, vtkIdType end)
   {
@@ -197,22 +206,12 @@ struct EvaluateFunctor
     for (const auto x : inPoints)
     {
       const ffd::Vec3<Real> xr = { Real(x[0]), Real(x[1]), Real(x[2]) };
-      const double* stuIn = this->Parameters + 3 * id;
+      const int cell = this->Cells[id];
       ffd::Vec3<Real> y = xr;
       ffd::Mat3<Real> jacobian = ffd::Mat3<Real>::Identity();
-      if (!std::isnan(stuIn[0]))
+      if (cell >= 0)
       {
-        const ffd::Vec3<Real> stu = ffd::Vec3<Real>::From(stuIn);
-        if (needJacobian)
-        {
-          ffd::Mat3<Real> gradient;
-          y = xr + ffd::EvaluateBernsteinWithGradient(this->Displacements, this->Dims, stu, gradient);
-          jacobian = ffd::DeformationJacobian(gradient, this->Frame);
-        }
-        else
-        {
-          y = xr + ffd::EvaluateBernstein(this->Displacements, this->Dims, stu);
-        }
+        y = needJacobian ? this->Deformation.Deform(xr, cell, jacobian) : this->Deformation.Deform(xr, cell);
       }
       Real* out = this->OutPoints + 3 * id;
       out[0] = y.x;
@@ -234,15 +233,8 @@ struct EvaluateFunctor
   {
     double n[3];
     this->InNormals->GetTuple(id, n);
-    const ffd::Vec3<Real> m = ffd::Cofactor(jacobian) * ffd::Vec3<Real>::From(n);
-    const double length = std::sqrt(double(ffd::Dot(m, m)));
-    if (length > 0.0)
-    {
-      n[0] = m.x / length;
-      n[1] = m.y / length;
-      n[2] = m.z / length;
-    }
-    this->OutNormals->SetTuple(id, n);
+    const ffd::Vec3<Real> m = ffd::TransformNormal(jacobian, ffd::Vec3<Real>::From(n));
+    this->OutNormals->SetTuple3(id, m.x, m.y, m.z);
   }
 };
 
@@ -250,15 +242,51 @@ template <typename Real>
 struct EvaluateWorker
 {
   template <typename PointArrayT>
-  void operator()(PointArrayT* inPoints, const LatticeView& lattice, const double* parameters,
-    vtkDataArray* inNormals, vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outPoints,
+  void operator()(PointArrayT* inPoints, const LatticeView& lattice, const int* cells, vtkDataArray* inNormals,
+    vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outPoints,
     vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self, double progressBegin, bool& completed)
   {
     const std::vector<Real> displacements(lattice.Displacements.begin(), lattice.Displacements.end());
-    EvaluateFunctor<Real, PointArrayT> functor{ inPoints, outPoints->GetPointer(0), parameters,
-      displacements.data(), { lattice.Dims[0], lattice.Dims[1], lattice.Dims[2] },
-      ffd::Frame<Real>::FromArray(lattice.Frame), inNormals, outNormals,
-      determinants ? determinants->GetPointer(0) : nullptr };
+    // One instantiation per basis (see ffd::GridDeformation's StaticBasis). The global basis sums over every
+    // control point of an axis, a local one over at most 4.
+    auto run = [&](auto maxCount, auto basis) {
+      this->Run<decltype(maxCount)::value, decltype(basis)::value>(inPoints, lattice, displacements.data(), cells,
+        inNormals, outNormals, outPoints, determinants, self, progressBegin, completed);
+    };
+    using ffd::GridBasis;
+    using Local = std::integral_constant<int, 4>;
+    switch (lattice.Basis)
+    {
+      case GridBasis::Bernstein:
+        run(std::integral_constant<int, ffd::MaxBernsteinDegree + 1>(),
+          std::integral_constant<int, int(GridBasis::Bernstein)>());
+        break;
+      case GridBasis::Trilinear:
+        run(Local(), std::integral_constant<int, int(GridBasis::Trilinear)>());
+        break;
+      case GridBasis::TriquadraticBezier:
+        run(Local(), std::integral_constant<int, int(GridBasis::TriquadraticBezier)>());
+        break;
+      case GridBasis::TricubicBezier:
+        run(Local(), std::integral_constant<int, int(GridBasis::TricubicBezier)>());
+        break;
+      case GridBasis::CubicBSpline:
+        run(Local(), std::integral_constant<int, int(GridBasis::CubicBSpline)>());
+        break;
+    }
+  }
+
+  template <int MaxCount, int StaticBasis, typename PointArrayT>
+  void Run(PointArrayT* inPoints, const LatticeView& lattice, const Real* displacements, const int* cells,
+    vtkDataArray* inNormals, vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outPoints,
+    vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self, double progressBegin, bool& completed)
+  {
+    const ffd::GridDeformation<MaxCount, Real, StaticBasis> deformation{ lattice.Basis,
+      { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] },
+      { lattice.Dims[0], lattice.Dims[1], lattice.Dims[2] }, displacements,
+      ffd::Frame<Real>::FromArray(lattice.Frame) };
+    EvaluateFunctor<ffd::GridDeformation<MaxCount, Real, StaticBasis>, Real, PointArrayT> functor{ inPoints, outPoints->GetPointer(0), cells,
+      deformation, inNormals, outNormals, determinants ? determinants->GetPointer(0) : nullptr };
     completed = ForInChunks(self, inPoints->GetNumberOfTuples(), functor, progressBegin, 1.0);
   }
 };
@@ -267,45 +295,20 @@ using PointArrays = vtkArrayDispatch::Reals;
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
-// The cached binding and what it was computed for.
+// The CPU binding and what it was computed for, and the CUDA backend's state.
 struct vtkFFDDeform::vtkInternals
 {
-  std::vector<double> Parameters; // (s, t, u) per input point; s is NaN where the point keeps its position
-  const vtkPoints* BoundPoints = nullptr;
-  vtkMTimeType BoundPointsMTime = 0;
-  vtkIdType BoundNumberOfPoints = -1;
-  std::array<double, 12> BoundFrame{};
-  std::array<int, 3> BoundDivisions{};
-  int BoundBasis = -1;
-
-  // Whether the binding is still that of these points in this lattice. Points are compared by identity and
-  // modification time (a new vtkPoints at a recycled address has a newer MTime); the lattice by the values of
-  // its rest frame and shape, so that a rebuilt but identical lattice keeps the binding.
-  bool IsValidFor(vtkPoints* points, const LatticeView& lattice) const
-  {
-    return points == this->BoundPoints && points->GetMTime() == this->BoundPointsMTime &&
-      points->GetNumberOfPoints() == this->BoundNumberOfPoints &&
-      std::equal(this->BoundFrame.begin(), this->BoundFrame.end(), lattice.Frame) &&
-      std::equal(this->BoundDivisions.begin(), this->BoundDivisions.end(), lattice.Divisions) &&
-      this->BoundBasis == lattice.Basis;
-  }
-
-  void Remember(vtkPoints* points, const LatticeView& lattice)
-  {
-    this->BoundPoints = points;
-    this->BoundPointsMTime = points->GetMTime();
-    this->BoundNumberOfPoints = points->GetNumberOfPoints();
-    std::copy(lattice.Frame, lattice.Frame + 12, this->BoundFrame.begin());
-    std::copy(lattice.Divisions, lattice.Divisions + 3, this->BoundDivisions.begin());
-    this->BoundBasis = lattice.Basis;
-  }
-
-  void Forget() { this->BoundPoints = nullptr; }
+  std::vector<int> Cells; // per input point: its cell (ffd::BindToGrid), -1 where it keeps its position
+  vtkFFDBindingKey Bound; // what Cells is for
+  vtkFFDCudaBackend Cuda;
 };
 
 //------------------------------------------------------------------------------------------------------------
 vtkFFDDeform::vtkFFDDeform()
-  : TransformNormals(true)
+  : OutsidePolicy(KEEP_POSITION)
+  , Backend(AUTOMATIC)
+  , LastBackendUsed("None")
+  , TransformNormals(true)
   , ComputeJacobianDeterminant(false)
   , OutputPointsPrecision(vtkAlgorithm::DEFAULT_PRECISION)
   , NumberOfBindings(0)
@@ -359,32 +362,10 @@ int vtkFFDDeform::RequestData(
     return 0;
   }
 
-  // Binding, only when the points or the lattice's rest frame or shape changed.
-  vtkInternals& internals = *this->Internals;
-  if (!internals.IsValidFor(inPoints, view))
-  {
-    internals.Forget();
-    internals.Parameters.resize(3 * numberOfPoints);
-    const ffd::Frame<double> frame = ffd::Frame<double>::FromArray(view.Frame);
-    bool completed = false;
-    BindWorker bind;
-    if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(
-          inPoints->GetData(), bind, frame, internals.Parameters.data(), this, completed))
-    {
-      bind(inPoints->GetData(), frame, internals.Parameters.data(), this, completed);
-    }
-    if (!completed)
-    {
-      return 1; // aborted: the output stays empty
-    }
-    internals.Remember(inPoints, view);
-    ++this->NumberOfBindings;
-  }
-  this->UpdateProgress(0.5);
-
-  // Evaluation, in the precision of the output points.
+  // The outputs, in the precision of the evaluation; either backend fills them.
   const bool useDouble = this->OutputPointsPrecision == vtkAlgorithm::DOUBLE_PRECISION ||
     (this->OutputPointsPrecision == vtkAlgorithm::DEFAULT_PRECISION && inPoints->GetDataType() == VTK_DOUBLE);
+  const int realType = useDouble ? VTK_DOUBLE : VTK_FLOAT;
   vtkDataArray* inNormals = this->TransformNormals ? input->GetPointData()->GetNormals() : nullptr;
   if (inNormals && inNormals->GetNumberOfComponents() != 3)
   {
@@ -399,46 +380,99 @@ int vtkFFDDeform::RequestData(
     outNormals->SetNumberOfComponents(3);
     outNormals->SetNumberOfTuples(numberOfPoints);
   }
-
-  vtkNew<vtkPoints> outPoints;
+  const auto pointsArray = vtk::TakeSmartPointer(vtkDataArray::CreateDataArray(realType));
+  pointsArray->SetNumberOfComponents(3);
+  pointsArray->SetNumberOfTuples(numberOfPoints);
   vtkSmartPointer<vtkDataArray> determinants;
-  bool completed = false;
-  auto evaluate = [&](auto realTag) {
-    using Real = decltype(realTag);
-    vtkNew<vtkAOSDataArrayTemplate<Real>> points;
-    points->SetNumberOfComponents(3);
-    points->SetNumberOfTuples(numberOfPoints);
-    vtkSmartPointer<vtkAOSDataArrayTemplate<Real>> det;
-    if (this->ComputeJacobianDeterminant)
-    {
-      det = vtkSmartPointer<vtkAOSDataArrayTemplate<Real>>::New();
-      det->SetName(JacobianDeterminantArrayName());
-      det->SetNumberOfTuples(numberOfPoints);
-    }
-    EvaluateWorker<Real> worker;
-    if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(inPoints->GetData(), worker, view,
-          internals.Parameters.data(), inNormals, outNormals.Get(), points.Get(), det.Get(), this, 0.5,
-          completed))
-    {
-      worker(inPoints->GetData(), view, internals.Parameters.data(), inNormals, outNormals.Get(), points.Get(),
-        det.Get(), this, 0.5, completed);
-    }
-    outPoints->SetData(points);
-    determinants = det;
-  };
-  if (useDouble)
+  if (this->ComputeJacobianDeterminant)
   {
-    evaluate(double());
+    determinants = vtk::TakeSmartPointer(vtkDataArray::CreateDataArray(realType));
+    determinants->SetName(JacobianDeterminantArrayName());
+    determinants->SetNumberOfTuples(numberOfPoints);
+  }
+
+  const vtkFFDBindingKey key = vtkFFDBindingKey::Of(
+    inPoints, view.Frame, view.Divisions, static_cast<int>(view.Basis), this->OutsidePolicy);
+  vtkInternals& internals = *this->Internals;
+  bool done = false;
+  std::string why;
+  const bool cudaAvailable = this->Backend != CPU && vtkFFDCudaBackend::IsAvailable(why);
+  if (this->Backend == CUDA && !cudaAvailable)
+  {
+    vtkWarningMacro("The CUDA backend cannot run (" << why << "); deforming on the CPU.");
+  }
+  if (cudaAvailable)
+  {
+    bool bound = false;
+    done = internals.Cuda.Deform(key, inPoints, inNormals, view.Displacements.data(),
+      vtkIdType(view.Displacements.size() / 3), pointsArray, outNormals, determinants, bound, why);
+    this->NumberOfBindings += bound ? 1 : 0;
+    if (!done)
+    {
+      vtkWarningMacro("The CUDA backend failed (" << why << "); deforming on the CPU.");
+    }
+  }
+  if (done)
+  {
+    this->LastBackendUsed = "CUDA";
+    this->UpdateProgress(1.0);
   }
   else
   {
-    evaluate(float());
-  }
-  if (!completed)
-  {
-    return 1; // aborted: the output stays empty
+    // CPU binding, only when the points or the lattice's rest frame or shape or the policy changed.
+    if (key != internals.Bound)
+    {
+      internals.Bound = vtkFFDBindingKey();
+      internals.Cells.resize(numberOfPoints);
+      const BindSettings settings{ ffd::Frame<double>::FromArray(view.Frame), view.Basis,
+        { view.Divisions[0], view.Divisions[1], view.Divisions[2] }, this->OutsidePolicy == CLAMP_TO_EDGE };
+      bool completed = false;
+      BindWorker bind;
+      if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(
+            inPoints->GetData(), bind, settings, internals.Cells.data(), this, completed))
+      {
+        bind(inPoints->GetData(), settings, internals.Cells.data(), this, completed);
+      }
+      if (!completed)
+      {
+        return 1; // aborted: the output stays empty
+      }
+      internals.Bound = key;
+      ++this->NumberOfBindings;
+    }
+    this->UpdateProgress(0.5);
+
+    bool completed = false;
+    auto evaluate = [&](auto realTag) {
+      using Real = decltype(realTag);
+      using RealArray = vtkAOSDataArrayTemplate<Real>;
+      EvaluateWorker<Real> worker;
+      auto* points = static_cast<RealArray*>(pointsArray.Get());
+      auto* det = static_cast<RealArray*>(determinants.Get());
+      if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(inPoints->GetData(), worker, view,
+            internals.Cells.data(), inNormals, outNormals.Get(), points, det, this, 0.5, completed))
+      {
+        worker(inPoints->GetData(), view, internals.Cells.data(), inNormals, outNormals.Get(), points, det, this,
+          0.5, completed);
+      }
+    };
+    if (useDouble)
+    {
+      evaluate(double());
+    }
+    else
+    {
+      evaluate(float());
+    }
+    if (!completed)
+    {
+      return 1; // aborted: the output stays empty
+    }
+    this->LastBackendUsed = "CPU";
   }
 
+  vtkNew<vtkPoints> outPoints;
+  outPoints->SetData(pointsArray);
   output->CopyStructure(input);
   output->SetPoints(outPoints);
   output->GetPointData()->PassData(input->GetPointData());
@@ -460,6 +494,11 @@ int vtkFFDDeform::RequestData(
 void vtkFFDDeform::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
+  os << indent << "OutsidePolicy: " << (this->OutsidePolicy == CLAMP_TO_EDGE ? "ClampToEdge" : "KeepPosition")
+     << "\n";
+  os << indent << "Backend: " << (this->Backend == CPU ? "CPU" : (this->Backend == CUDA ? "CUDA" : "Automatic"))
+     << "\n";
+  os << indent << "LastBackendUsed: " << this->LastBackendUsed << "\n";
   os << indent << "TransformNormals: " << (this->TransformNormals ? "On" : "Off") << "\n";
   os << indent << "ComputeJacobianDeterminant: " << (this->ComputeJacobianDeterminant ? "On" : "Off") << "\n";
   os << indent << "OutputPointsPrecision: " << this->OutputPointsPrecision << "\n";

@@ -4,27 +4,38 @@
  * @brief   deforms a point set with a free-form deformation lattice
  *
  * The last stage of the voxel FFD pipeline. Input 0 is any vtkPointSet (the mesh); input 1 is a lattice from
- * vtkFFDBuildLattice, or any vtkStructuredGrid that keeps its data contract (vtkFFDDataContract). The output
- * is a copy of input 0 whose points are moved by the lattice's deformation, its points minus `RestPosition`:
- * X_ffd = X + sum_ijk B_ijk(s, t, u) (P_ijk - P_ijk^rest), which equals the paper's equation 3.
+ * vtkFFDBuildLattice, or any vtkPointSet that keeps its data contract (vtkFFDDataContract). The output is a copy
+ * of input 0 whose points are moved by the lattice's deformation, its points minus `RestPosition`:
+ * X_ffd = X + sum_ijk B_i(s) B_j(t) B_k(u) (P_ijk - P_ijk^rest), which equals the paper's equation 3 for the
+ * global Bernstein basis and its local counterparts for the others (trilinear, triquadratic and tricubic
+ * Bezier sub-regions, uniform cubic B-spline; see vtkFFDBuildLattice).
  *
- * Binding: each input point is bound once to the lattice's frame (its parameters s, t, u, equation 2), and the
- * binding is cached. It is recomputed only when the input's points change (another vtkPoints, a newer
- * modification time or another count) or when the lattice's rest frame, divisions or basis change; moving
- * lattice points only re-runs the evaluation. GetNumberOfBindings() counts the bindings computed so far.
+ * Binding: each input point is bound once to the lattice: the index of the cell it lies in (4 bytes per
+ * point; its local coordinates are recomputed from the point at evaluation, exactly, in the point's
+ * precision). The binding is cached and recomputed only when the input's points change (another vtkPoints, a
+ * newer modification time or another count), when the lattice's rest frame, divisions or basis change, or
+ * when the outside policy changes; moving lattice points only re-runs the evaluation, which for a local basis
+ * touches only the 8, 27 or 64 control points of the point's voxel. GetNumberOfBindings() counts the bindings.
  *
- * Points outside the frame keep their input position, as do non-finite points; points on a face or corner of
- * the frame are inside. Normals (the input's active point normals) are transformed by the cofactor of the
- * Jacobian (det J times its inverse transpose, the same direction where det J > 0) and renormalized.
- * With ComputeJacobianDeterminant on, the output gets a `JacobianDeterminant` point array (1 outside the frame)
- * in which folds show as values <= 0.
+ * Points outside the frame keep their input position (KEEP_POSITION, the default) or take the displacement of
+ * the nearest point of the frame (CLAMP_TO_EDGE, as VTK's Edge border mode and Blender's lattice do);
+ * non-finite points always keep theirs. Points on a face or corner of the frame are inside. Normals (the
+ * input's active point normals) are transformed by the cofactor of the Jacobian (det J times its inverse
+ * transpose, the same direction where det J > 0) and renormalized; cell normals, which a non-affine
+ * deformation invalidates, are dropped. With ComputeJacobianDeterminant on, the output gets a
+ * `JacobianDeterminant` point array (1 where points keep their position) in which folds show as values <= 0.
  *
- * The evaluation runs on the CPU with vtkSMPTools, in the precision of the output points (OutputPointsPrecision,
- * as in vtkWarpVector), using the VTK-free kernels of Filters/Kernels. Progress is reported between chunks of
- * points and the filter stops early when aborted.
+ * Backends: the evaluation runs on the CPU with vtkSMPTools, or on a CUDA device (a build with CUDA), in the
+ * precision of the output points (OutputPointsPrecision, as in vtkWarpVector); both call the same VTK-free
+ * kernels of Filters/Kernels, so they compute the same function. AUTOMATIC (the default) uses CUDA when a device
+ * is present, else the CPU; CUDA asked for where it cannot run, or any CUDA failure (no device, out of memory, a
+ * launch error), falls back to the CPU with a warning, never to a wrong or partial output.
+ * GetLastBackendUsed() tells which ran. On the device the points, normals and binding stay resident across
+ * updates; an update uploads only the lattice and downloads the deformed points into the output array.
+ * Progress is reported between chunks of points on the CPU, and the filter stops early when aborted.
  *
- * A lattice without the contract's arrays, with a flat or non-finite frame, an unsupported basis, or a point
- * count that does not match its divisions is an error; the output is then empty.
+ * A lattice without the contract's arrays, with a flat or non-finite frame, an unknown basis, non-finite
+ * points, or a point count that does not match its divisions and basis is an error; the output is then empty.
  *
  * @sa vtkFFDVoxelize vtkFFDBuildLattice vtkFFDDataContract vtkWarpVector
  */
@@ -56,6 +67,20 @@ public:
   vtkBooleanMacro(TransformNormals, bool);
   ///@}
 
+  enum OutsidePolicies
+  {
+    KEEP_POSITION = 0,
+    CLAMP_TO_EDGE = 1
+  };
+
+  ///@{
+  /// What points outside the lattice's frame do (default KEEP_POSITION).
+  vtkSetClampMacro(OutsidePolicy, int, KEEP_POSITION, CLAMP_TO_EDGE);
+  vtkGetMacro(OutsidePolicy, int);
+  void SetOutsidePolicyToKeepPosition() { this->SetOutsidePolicy(KEEP_POSITION); }
+  void SetOutsidePolicyToClampToEdge() { this->SetOutsidePolicy(CLAMP_TO_EDGE); }
+  ///@}
+
   ///@{
   /// Add the `JacobianDeterminant` point array, det(dX_ffd/dX) (default off).
   vtkSetMacro(ComputeJacobianDeterminant, bool);
@@ -70,7 +95,26 @@ public:
   vtkGetMacro(OutputPointsPrecision, int);
   ///@}
 
-  /// Number of times input points have been bound to a lattice (the binding cache's misses).
+  enum Backends
+  {
+    AUTOMATIC = 0,
+    CPU = 1,
+    CUDA = 2
+  };
+
+  ///@{
+  /// Where the evaluation runs (default AUTOMATIC: CUDA when a device is present, else the CPU).
+  vtkSetClampMacro(Backend, int, AUTOMATIC, CUDA);
+  vtkGetMacro(Backend, int);
+  void SetBackendToAutomatic() { this->SetBackend(AUTOMATIC); }
+  void SetBackendToCPU() { this->SetBackend(CPU); }
+  void SetBackendToCUDA() { this->SetBackend(CUDA); }
+  ///@}
+
+  /// The backend that computed the last output: "CPU" or "CUDA" ("None" before the first execution).
+  const char* GetLastBackendUsed() const { return this->LastBackendUsed; }
+
+  /// Number of times input points have been bound to a lattice (the binding cache's misses), on either backend.
   vtkGetMacro(NumberOfBindings, vtkIdType);
 
 protected:
@@ -80,6 +124,9 @@ protected:
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
+  int OutsidePolicy;
+  int Backend;
+  const char* LastBackendUsed;
   bool TransformNormals;
   bool ComputeJacobianDeterminant;
   int OutputPointsPrecision;

@@ -1,14 +1,19 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
- * DeformMesh: deforms a real mesh with a global Bernstein (Sederberg-Parry) lattice of 3x4x5 control points.
+ * DeformMesh: deforms a real mesh with a global Bernstein (Sederberg-Parry) lattice of 3x4x5 control points,
+ * or another basis.
  *
  * The set-up of the paper's Figure 12, as in Examples/Python/deform_mesh.py: the mesh is voxelized into 2x3x4
  * voxels, giving a Bernstein lattice of degree (2, 3, 4), i.e. 3x4x5 = 60 control points; the top layer of the
  * lattice is pulled up and twisted and the middle layers bulge out; the mesh is deformed; two PNGs are written
- * (the mesh with its rest lattice, the deformed mesh with the moved lattice); a figure-style caption and the
- * time of the deformation are printed.
+ * (the mesh with its rest lattice, the deformed mesh with the moved lattice); a figure-style caption (vertices,
+ * control points, active voxels, active control points, as in the paper's figures) and the time of the
+ * deformation are printed.
  *
- * Usage: DeformMesh [MESH.vtp [OUTPUT_FOLDER]]   (defaults: Testing/Data/Meshes/bear.vtp, build/demo)
+ * Usage: DeformMesh [--basis bernstein|trilinear|quadratic|cubic|bspline] [--divisions NX NY NZ]
+ *                   [MESH.vtp [OUTPUT_FOLDER]]
+ * (defaults: bernstein, 2 3 4, Testing/Data/Meshes/bear.vtp, build/demo); e.g. the paper's Figure 1 is
+ * `--basis trilinear --divisions 5 5 5`.
  * It renders offscreen through GLX: run it under `xvfb-run -a` where there is no display.
  */
 #include "vtkFFDBuildLattice.h"
@@ -38,15 +43,20 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <string>
 #include <vector>
 
 namespace
 {
-constexpr int Divisions[3] = { 2, 3, 4 }; // voxels per axis = Bernstein degree per axis: 3x4x5 control points
+constexpr int DefaultDivisions[3] = { 2, 3, 4 }; // voxels per axis = Bernstein degree per axis: 3x4x5 points
+const std::map<std::string, int> Bases = { { "bernstein", vtkFFDBuildLattice::BERNSTEIN },
+  { "trilinear", vtkFFDBuildLattice::TRILINEAR }, { "quadratic", vtkFFDBuildLattice::TRIQUADRATIC_BEZIER },
+  { "cubic", vtkFFDBuildLattice::TRICUBIC_BEZIER }, { "bspline", vtkFFDBuildLattice::CUBIC_BSPLINE } };
 // CGAL's meshes stand along +Y, the frame's T axis: "up" below is T, and the camera looks along -Z.
 constexpr double TwistDegrees = 40.0; // rotation of the top layer about the vertical axis (zero at the bottom)
 constexpr double Bulge = 0.35;        // outward push of the middle layers, fraction of their distance to the axis
@@ -71,19 +81,22 @@ bool DeformLattice(vtkStructuredGrid* lattice)
   const double* u = frame + 9;
   double axis[3] = { t[0], t[1], t[2] };
   vtkMath::Normalize(axis);
+  // Rows of the inverse of [S T U] give a point's frame parameters; a B-spline lattice's outer layers lie
+  // outside the frame, at t < 0 and t > 1.
+  const double edges[3][3] = { { s[0], t[0], u[0] }, { s[1], t[1], u[1] }, { s[2], t[2], u[2] } };
+  double toParameters[3][3];
+  vtkMath::Invert3x3(edges, toParameters);
 
-  int dims[3];
-  lattice->GetDimensions(dims);
   vtkPoints* points = lattice->GetPoints();
   for (vtkIdType id = 0; id < lattice->GetNumberOfPoints(); ++id)
   {
-    // Control point (i, j, k) is point i + nI*(j + nJ*k): its layer along T is j.
-    const int j = static_cast<int>((id / dims[0]) % dims[1]);
-    const double height = static_cast<double>(j) / (dims[1] - 1);
-    const double angle = vtkMath::RadiansFromDegrees(TwistDegrees) * height;
-    const double scale = 1.0 + Bulge * std::sin(vtkMath::Pi() * height);
     double restPoint[3];
     rest->GetTuple(id, restPoint);
+    // The layer's parameter t along T.
+    const double relative[3] = { restPoint[0] - origin[0], restPoint[1] - origin[1], restPoint[2] - origin[2] };
+    const double height = vtkMath::Dot(toParameters[1], relative);
+    const double angle = vtkMath::RadiansFromDegrees(TwistDegrees) * height;
+    const double scale = 1.0 + Bulge * std::sin(vtkMath::Pi() * height);
 
     double centre[3], along[3], across[3], turned[3], moved[3];
     for (int c = 0; c < 3; ++c)
@@ -160,13 +173,42 @@ double Milliseconds(std::chrono::steady_clock::duration duration)
 
 int main(int argc, char* argv[])
 {
-  if (argc > 3)
+  const std::string usage = std::string("usage: ") + argv[0] +
+    " [--basis bernstein|trilinear|quadratic|cubic|bspline] [--divisions NX NY NZ] [MESH.vtp [OUTPUT_FOLDER]]\n";
+  int basis = vtkFFDBuildLattice::BERNSTEIN;
+  int divisions[3] = { DefaultDivisions[0], DefaultDivisions[1], DefaultDivisions[2] };
+  std::vector<std::string> positional;
+  for (int a = 1; a < argc; ++a)
   {
-    std::cerr << "usage: " << argv[0] << " [MESH.vtp [OUTPUT_FOLDER]]\n";
-    return EXIT_FAILURE;
+    const std::string argument = argv[a];
+    if (argument == "--basis" && a + 1 < argc && Bases.count(argv[a + 1]))
+    {
+      basis = Bases.at(argv[++a]);
+    }
+    else if (argument == "--divisions" && a + 3 < argc)
+    {
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        divisions[axis] = std::atoi(argv[++a]);
+      }
+      if (std::min({ divisions[0], divisions[1], divisions[2] }) < 1)
+      {
+        std::cerr << "--divisions needs at least one voxel per axis\n" << usage;
+        return EXIT_FAILURE;
+      }
+    }
+    else if (argument.rfind("--", 0) == 0 || positional.size() == 2)
+    {
+      std::cerr << usage;
+      return EXIT_FAILURE;
+    }
+    else
+    {
+      positional.push_back(argument);
+    }
   }
-  const std::filesystem::path meshPath = argc > 1 ? argv[1] : DEFORMMESH_DEFAULT_MESH;
-  const std::filesystem::path outputDir = argc > 2 ? argv[2] : DEFORMMESH_DEFAULT_OUTPUT;
+  const std::filesystem::path meshPath = positional.size() > 0 ? positional[0] : DEFORMMESH_DEFAULT_MESH;
+  const std::filesystem::path outputDir = positional.size() > 1 ? positional[1] : DEFORMMESH_DEFAULT_OUTPUT;
   if (!std::filesystem::is_regular_file(meshPath))
   {
     std::cerr << meshPath.string()
@@ -191,12 +233,17 @@ int main(int argc, char* argv[])
 
   vtkNew<vtkFFDVoxelize> voxelize;
   voxelize->SetInputData(mesh);
-  voxelize->SetDivisions(Divisions[0], Divisions[1], Divisions[2]);
+  voxelize->SetDivisions(divisions);
   vtkNew<vtkFFDBuildLattice> build;
   build->SetInputConnection(voxelize->GetOutputPort());
-  build->SetBasisToBernstein();
+  build->SetBasis(basis);
   build->Update();
   vtkStructuredGrid* restLattice = build->GetOutput();
+  if (restLattice->GetNumberOfPoints() == 0)
+  {
+    std::cerr << "the lattice could not be built (see the errors above)\n";
+    return EXIT_FAILURE;
+  }
 
   // Our own copy to move, so that a re-execution of vtkFFDBuildLattice cannot undo the moves.
   vtkNew<vtkStructuredGrid> lattice;

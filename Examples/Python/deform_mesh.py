@@ -1,12 +1,14 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""Deforms a real mesh with a global Bernstein (Sederberg-Parry) lattice of 3x4x5 control points.
+"""Deforms a real mesh with a global Bernstein (Sederberg-Parry) lattice of 3x4x5 control points, or another basis.
 
 The set-up of the paper's Figure 12: the mesh is voxelized into 2x3x4 voxels, which gives a Bernstein lattice of
 degree (2, 3, 4), that is 3x4x5 = 60 control points. The lattice's points are moved through numpy (the top layer
 is pulled up and twisted, the middle layers bulge out), the mesh is deformed, and two PNGs are written: the mesh
-with its rest lattice, and the deformed mesh with the moved lattice. A figure-style caption and the time of the
-deformation are printed.
+with its rest lattice, and the deformed mesh with the moved lattice. A figure-style caption (vertices, control
+points, active voxels, active control points, as in the paper's figures) and the time of the deformation are
+printed. --basis and --divisions choose another lattice: e.g. the paper's Figure 1 is
+`--basis trilinear --divisions 5 5 5`.
 
 Run it with Debian's /usr/bin/python3 (which has VTK's Python), the built package on PYTHONPATH and an X server
 (Xvfb will do), as Utilities/setup.sh does:
@@ -40,6 +42,13 @@ except ImportError as error:
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 DIVISIONS = (2, 3, 4)  # voxels per axis; the Bernstein degree per axis, so 3x4x5 control points
+BASES = {  # --basis name: the vtkFFDBuildLattice setter
+    "bernstein": "SetBasisToBernstein",
+    "trilinear": "SetBasisToTrilinear",
+    "quadratic": "SetBasisToTriquadraticBezier",
+    "cubic": "SetBasisToTricubicBezier",
+    "bspline": "SetBasisToCubicBSpline",
+}
 # CGAL's meshes stand along +Y, the frame's T axis: "up" below is T, and the camera looks along -Z.
 TWIST_DEGREES = 40.0  # rotation of the top layer about the vertical axis (zero at the bottom layer)
 BULGE = 0.35  # outward push of the middle layers, as a fraction of their distance to the axis
@@ -55,7 +64,14 @@ def parse_arguments():
                         help="folder for the PNGs (default: build/demo in the repository)")
     parser.add_argument("--size", type=int, nargs=2, default=(800, 800), metavar=("WIDTH", "HEIGHT"),
                         help="image size in pixels (default: 800 800)")
-    return parser.parse_args()
+    parser.add_argument("--basis", choices=BASES, default="bernstein",
+                        help="the lattice's basis (default: bernstein, the global Sederberg-Parry FFD)")
+    parser.add_argument("--divisions", type=int, nargs=3, default=DIVISIONS, metavar=("NX", "NY", "NZ"),
+                        help="voxels per axis of the frame (default: 2 3 4)")
+    arguments = parser.parse_args()
+    if min(arguments.divisions) < 1:
+        parser.error("--divisions needs at least one voxel per axis")
+    return arguments
 
 
 def read_mesh(name):
@@ -86,7 +102,10 @@ def deform_lattice(lattice):
     # A view of the lattice's own points (VTK order: i fastest, so the numpy shape is k, j, i).
     points = vtk_to_numpy(lattice.GetPoints().GetData()).reshape(n_k, n_j, n_i, 3)
 
-    height = np.linspace(0.0, 1.0, n_j)[None, :, None, None]  # parameter t of each layer along T
+    # Parameter t of each layer along T, from the rest positions: a B-spline lattice's outer layers lie outside
+    # the frame, at t < 0 and t > 1.
+    parameters = np.linalg.solve(np.column_stack((s_axis, t_axis, u_axis)), (rest[0, :, 0] - origin).T)
+    height = parameters[1][None, :, None, None]
     axis = t_axis / np.linalg.norm(t_axis)
     centre = origin + 0.5 * s_axis + 0.5 * u_axis + height * t_axis  # the vertical axis through the frame
     offset = rest - centre
@@ -151,11 +170,13 @@ def main():
 
     voxelize = vtkffd.vtkFFDVoxelize()
     voxelize.SetInputData(mesh)
-    voxelize.SetDivisions(*DIVISIONS)
+    voxelize.SetDivisions(*arguments.divisions)
     build = vtkffd.vtkFFDBuildLattice()
     build.SetInputConnection(voxelize.GetOutputPort())
-    build.SetBasisToBernstein()
+    getattr(build, BASES[arguments.basis])()
     build.Update()
+    if build.GetOutput().GetNumberOfPoints() == 0:
+        sys.exit("the lattice could not be built (see the errors above)")
     rest_lattice = build.GetOutput()
 
     # Our own copy to move, so that a re-execution of vtkFFDBuildLattice cannot undo the moves.

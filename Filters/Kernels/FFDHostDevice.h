@@ -17,4 +17,12 @@
 
 #define FFD_INLINE FFD_HOST_DEVICE inline
 
+// Unrolls the loop that follows in device code, where an array indexed by a run-time loop counter would live in
+// local memory rather than registers; host compilers unroll such short loops by themselves.
+#if defined(__CUDA_ARCH__)
+#define FFD_UNROLL _Pragma("unroll")
+#else
+#define FFD_UNROLL
+#endif
+
 #endif

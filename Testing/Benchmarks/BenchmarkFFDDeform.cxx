@@ -1,29 +1,44 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
- * BenchmarkFFDDeform: points per second of the global (Bernstein) FFD evaluation in vtkFFDDeform, beside the
- * machine's FMA peak measured in the same run. Not a test: it prints a table and asserts nothing about time.
- * Results and how to read them: BENCHMARKS.md at the repository root.
+ * BenchmarkFFDDeform: points per second of the evaluation in vtkFFDDeform, each beside a machine limit
+ * measured in the same run. Not a test: it prints tables and asserts nothing about time. Results and how to
+ * read them: BENCHMARKS.md at the repository root.
+ *
+ * Two sections, on the armadillo subdivided to ~0.5 M and ~5 M points, float32 and float64, 1 and all threads:
+ * - global: the Bernstein evaluation with 5^3 and 10^3 control points, against the FMA peak (compute-bound);
+ * - bases: every basis (the global one over 4^3 voxels, the local ones over 4^3 voxels and over lattices of
+ *   about 10^3 control points), against the copy bandwidth (std::memcpy): the bytes the evaluation must move
+ *   per point (read the point and its 4-byte cell, write the point) per second; and CUBIC_BSPLINE against
+ *   VTK's vtkBSplineTransform + vtkTransformFilter on the same mesh and lattice (with the largest difference
+ *   between the two outputs, which must be rounding).
  *
  * What is timed: vtkFFDDeform::Update() after the lattice's points moved, the binding being cached (the
  * program checks that it was not recomputed). That is the evaluation as a user sees it: reading the lattice,
  * allocating the output points and X + sum B_i B_j B_k D_ijk at every point. Normals and the Jacobian are off.
  *
- * Usage: BenchmarkFFDDeform [--quick] [--mesh path.vtp]
- *   --quick  small meshes and short runs, a smoke check of the program (seconds)
- *   --mesh   the mesh to subdivide (VTK XML PolyData); default: the armadillo of the test data
+ * Usage: BenchmarkFFDDeform [--quick] [--section global|bases|all] [--mesh path.vtp]
+ *   --quick    small meshes and short runs, a smoke check of the program (seconds)
+ *   --section  run one section only (default: all)
+ *   --mesh     the mesh to subdivide (VTK XML PolyData); default: the armadillo of the test data
  */
 
 #include "vtkFFDBuildLattice.h"
+#include "vtkFFDDataContract.h"
 #include "vtkFFDDeform.h"
 #include "vtkFFDVoxelize.h"
 
+#include "vtkBSplineTransform.h"
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
 #include "vtkLinearSubdivisionFilter.h"
 #include "vtkNew.h"
+#include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSMPTools.h"
 #include "vtkSmartPointer.h"
 #include "vtkStructuredGrid.h"
+#include "vtkTransformFilter.h"
 #include "vtkTriangleFilter.h"
 #include "vtkXMLPolyDataReader.h"
 
@@ -157,7 +172,7 @@ double MeasurePeak(const FmaKernel& kernel, bool useDouble, int threads, long it
 //------------------------------------------------------------------------------------------------------------
 /**
  * Operations per point of the global evaluation of degree (l, m, n), counted from the kernel
- * (FFDGlobalBernstein.h): 3 FMAs per control point (sum over i), 3 per (j, k) and 3 per k (the outer sums),
+ * (FFDGridBasis.h, SumTensorProduct and BernsteinBasis): 3 FMAs per control point (sum over i), 3 per (j, k) and 3 per k (the outer sums),
  * 3 adds for X + D, and per axis of degree d the de Casteljau triangle's d(d+1)/2 steps of one FMA and one
  * multiply. Each counts as one operation, one issue of an FMA unit's lane.
  */
@@ -253,6 +268,87 @@ void PrintRow(const Row& r)
   std::fflush(stdout);
 }
 
+/// A lattice of a basis over a mesh, as a copy whose points the benchmark moves (as a widget or a script
+/// would), and its rest positions.
+struct BenchmarkLattice
+{
+  vtkNew<vtkStructuredGrid> Grid;
+  std::vector<double> Rest;
+};
+
+void BuildLattice(vtkPolyData* mesh, int basis, int divisions, BenchmarkLattice& lattice)
+{
+  vtkNew<vtkFFDVoxelize> voxelize;
+  voxelize->SetInputData(mesh);
+  voxelize->SetDivisions(divisions, divisions, divisions);
+  vtkNew<vtkFFDBuildLattice> build;
+  build->SetInputConnection(voxelize->GetOutputPort());
+  build->SetBasis(basis);
+  build->Update();
+  lattice.Grid->DeepCopy(build->GetOutput());
+  lattice.Rest.resize(3 * lattice.Grid->GetNumberOfPoints());
+  for (vtkIdType p = 0; p < lattice.Grid->GetNumberOfPoints(); ++p)
+  {
+    lattice.Grid->GetPoint(p, &lattice.Rest[3 * p]);
+  }
+}
+
+/// Sets up `deform` on `mesh` and `lattice` (normals and Jacobian off) and runs it once, which binds; returns
+/// the seconds that took, or a negative value when the filter failed.
+double BindOnce(vtkFFDDeform* deform, vtkPolyData* mesh, BenchmarkLattice& lattice, std::mt19937& rng)
+{
+  deform->SetInputData(mesh);
+  deform->SetLatticeData(lattice.Grid);
+  deform->TransformNormalsOff();
+  deform->ComputeJacobianDeterminantOff();
+  MoveLattice(lattice.Grid, lattice.Rest, rng);
+  const Clock::time_point begin = Clock::now();
+  deform->Update();
+  const double seconds = Seconds(begin);
+  if (deform->GetOutput()->GetNumberOfPoints() != mesh->GetNumberOfPoints())
+  {
+    std::fprintf(stderr, "vtkFFDDeform failed on %lld points\n", static_cast<long long>(mesh->GetNumberOfPoints()));
+    return -1.0;
+  }
+  return seconds;
+}
+
+/// Runs `step` (which returns the seconds of its timed part) at least `minRepeats` times and until
+/// `minSeconds` have been spent; best and median of the timed parts.
+template <typename Step>
+Timing Repeat(Step&& step, int minRepeats, double minSeconds)
+{
+  std::vector<double> times;
+  const Clock::time_point begin = Clock::now();
+  while (int(times.size()) < minRepeats || Seconds(begin) < minSeconds)
+  {
+    times.push_back(step());
+  }
+  std::sort(times.begin(), times.end());
+  return { times.front(), times[times.size() / 2] };
+}
+
+/// Times vtkFFDDeform::Update() after moving the lattice's points (the binding cached), on `threads` threads.
+Timing TimeEvaluation(vtkFFDDeform* deform, BenchmarkLattice& lattice, std::mt19937& rng, int threads,
+  int minRepeats, double minSeconds)
+{
+  vtkSMPTools::Initialize(threads);
+  const vtkIdType bindings = deform->GetNumberOfBindings();
+  const Timing timing = Repeat(
+    [&]() {
+      MoveLattice(lattice.Grid, lattice.Rest, rng);
+      const Clock::time_point begin = Clock::now();
+      deform->Update();
+      return Seconds(begin);
+    },
+    minRepeats, minSeconds);
+  if (deform->GetNumberOfBindings() != bindings)
+  {
+    std::fprintf(stderr, "warning: the binding was recomputed; these timings include it\n");
+  }
+  return timing;
+}
+
 /**
  * Builds voxelize -> lattice -> deform over `mesh` with `divisions` per axis, binds once, then for each thread
  * count times Update() after moving the lattice: repeated at least `minRepeats` times and until `minSeconds`
@@ -261,100 +357,31 @@ void PrintRow(const Row& r)
 void BenchmarkMesh(vtkPolyData* mesh, bool useDouble, int divisions, const std::vector<int>& threadCounts,
   int minRepeats, double minSeconds, const std::vector<double>& peaks, std::vector<Row>& rows)
 {
-  vtkNew<vtkFFDVoxelize> voxelize;
-  voxelize->SetInputData(mesh);
-  voxelize->SetDivisions(divisions, divisions, divisions);
-  vtkNew<vtkFFDBuildLattice> build;
-  build->SetInputConnection(voxelize->GetOutputPort());
-  build->SetBasisToBernstein();
-  build->Update();
-
-  // A copy of the lattice whose points the benchmark moves, as a widget or a script would.
-  vtkNew<vtkStructuredGrid> lattice;
-  lattice->DeepCopy(build->GetOutput());
-  std::vector<double> rest(3 * lattice->GetNumberOfPoints());
-  for (vtkIdType p = 0; p < lattice->GetNumberOfPoints(); ++p)
-  {
-    lattice->GetPoint(p, &rest[3 * p]);
-  }
-
+  BenchmarkLattice lattice;
+  BuildLattice(mesh, vtkFFDBuildLattice::BERNSTEIN, divisions, lattice);
   vtkNew<vtkFFDDeform> deform;
-  deform->SetInputData(mesh);
-  deform->SetLatticeData(lattice);
-  deform->TransformNormalsOff();
-  deform->ComputeJacobianDeterminantOff();
   std::mt19937 rng(8);
-  MoveLattice(lattice, rest, rng);
-  const Clock::time_point bindBegin = Clock::now();
-  deform->Update();
-  const double bindSeconds = Seconds(bindBegin);
-  if (deform->GetOutput()->GetNumberOfPoints() != mesh->GetNumberOfPoints())
+  const double bindSeconds = BindOnce(deform, mesh, lattice, rng);
+  if (bindSeconds < 0.0)
   {
-    std::fprintf(stderr, "vtkFFDDeform failed on %lld points\n", static_cast<long long>(mesh->GetNumberOfPoints()));
     return;
   }
-
-  const vtkIdType bindings = deform->GetNumberOfBindings();
   for (size_t t = 0; t < threadCounts.size(); ++t)
   {
-    vtkSMPTools::Initialize(threadCounts[t]);
-    std::vector<double> times;
-    const Clock::time_point begin = Clock::now();
-    while (int(times.size()) < minRepeats || Seconds(begin) < minSeconds)
-    {
-      MoveLattice(lattice, rest, rng);
-      const Clock::time_point updateBegin = Clock::now();
-      deform->Update();
-      times.push_back(Seconds(updateBegin));
-    }
-    if (deform->GetNumberOfBindings() != bindings)
-    {
-      std::fprintf(stderr, "warning: the binding was recomputed; these timings include it\n");
-    }
-    std::sort(times.begin(), times.end());
-    const Timing timing = { times.front(), times[times.size() / 2] };
+    const Timing timing = TimeEvaluation(deform, lattice, rng, threadCounts[t], minRepeats, minSeconds);
     rows.push_back({ (divisions + 1) * (divisions + 1) * (divisions + 1), mesh->GetNumberOfPoints(),
       useDouble ? "float64" : "float32", vtkSMPTools::GetEstimatedNumberOfThreads(), bindSeconds, timing,
       OperationsPerPoint(divisions, divisions, divisions), peaks[2 * t + (useDouble ? 1 : 0)] });
     PrintRow(rows.back());
   }
 }
-} // namespace
 
-int main(int argc, char* argv[])
+//------------------------------------------------------------------------------------------------------------
+// The global section: the FMA peak, then the Bernstein evaluation for 5^3 and 10^3 control points. Returns
+// false when a pipeline failed.
+bool RunGlobalSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, const std::vector<int>& threadCounts,
+  bool quick)
 {
-  bool quick = false;
-  std::string meshPath = std::string(VOXELFFD_MESH_DIR) + "/armadillo.vtp";
-  for (int a = 1; a < argc; ++a)
-  {
-    const std::string arg = argv[a];
-    if (arg == "--quick")
-    {
-      quick = true;
-    }
-    else if (arg == "--mesh" && a + 1 < argc)
-    {
-      meshPath = argv[++a];
-    }
-    else
-    {
-      std::fprintf(stderr, "usage: %s [--quick] [--mesh path.vtp]\n", argv[0]);
-      return arg == "--help" || arg == "-h" ? 0 : 1;
-    }
-  }
-
-  // Thread counts: one, and every thread the SMP backend would use by default.
-  vtkSMPTools::Initialize(0);
-  const int allThreads = vtkSMPTools::GetEstimatedNumberOfThreads();
-  std::vector<int> threadCounts = { 1 };
-  if (allThreads > 1)
-  {
-    threadCounts.push_back(allThreads);
-  }
-  std::printf("CPU: %s, %u hardware threads\n", CpuModel().c_str(), std::thread::hardware_concurrency());
-  std::printf("vtkSMPTools backend: %s, thread counts: 1", vtkSMPTools::GetBackend());
-  std::printf(allThreads > 1 ? " and %d\n" : "\n", allThreads);
-
   // FMA peak, per thread count and precision (index 2 * thread + double).
   const long iterations = quick ? 2000000 : 50000000;
   const FmaKernel* best = BestFmaKernel();
@@ -382,6 +409,340 @@ int main(int argc, char* argv[])
     }
   }
 
+  std::printf("\nGlobal Bernstein evaluation (vtkFFDDeform::Update() after moving the lattice, binding cached).\n"
+              "ops/point: 3 FMAs per control point + outer sums + basis (%.0f for 5^3, %.0f for 10^3);\n"
+              "%% of peak: (points/s * ops/point) / the FMA peak above for the same precision and threads.\n"
+              "bind+1st: the first Update(), binding included, on all threads; best, median: evaluation only.\n\n",
+    OperationsPerPoint(4, 4, 4), OperationsPerPoint(9, 9, 9));
+  std::printf("| ctrl | points    | type    | th | bind+1st | best (s) | median   | Mpoints/s | Gops/s   | %% peak   |\n");
+  std::printf("|-----:|----------:|---------|---:|---------:|---------:|---------:|----------:|---------:|---------:|\n");
+  std::vector<Row> rows;
+  const int minRepeats = quick ? 2 : 3;
+  const double minSeconds = quick ? 0.0 : 1.0;
+  for (const auto& mesh : meshes)
+  {
+    for (bool useDouble : { false, true })
+    {
+      vtkSmartPointer<vtkPolyData> input = WithPrecision(mesh, useDouble);
+      for (int divisions : { 4, 9 })
+      {
+        BenchmarkMesh(input, useDouble, divisions, threadCounts, minRepeats, minSeconds, peaks, rows);
+      }
+    }
+  }
+  return rows.size() == 2 * 2 * 2 * threadCounts.size();
+}
+
+//------------------------------------------------------------------------------------------------------------
+// The bases section: every basis against the machine's copy bandwidth, and CUBIC_BSPLINE against VTK's
+// vtkBSplineTransform.
+
+/**
+ * Copy bandwidth: bytes read plus bytes written per second when `threads` threads each std::memcpy their
+ * share of a `bytes` buffer into another at once, best of 5. Both buffers are written before timing, so that
+ * page faults are not timed.
+ */
+double MeasureCopyBandwidth(size_t bytes, int threads)
+{
+  std::vector<char> source(bytes, 1), target(bytes, 0);
+  double best = 0.0;
+  for (int trial = 0; trial < 5; ++trial)
+  {
+    std::vector<std::thread> pool;
+    const Clock::time_point begin = Clock::now();
+    for (int t = 0; t < threads; ++t)
+    {
+      pool.emplace_back([&, t]() {
+        const size_t first = bytes * t / threads, last = bytes * (t + 1) / threads;
+        std::memcpy(target.data() + first, source.data() + first, last - first);
+      });
+    }
+    for (std::thread& th : pool)
+    {
+      th.join();
+    }
+    best = std::max(best, 2.0 * double(bytes) / Seconds(begin));
+  }
+  static volatile char sink = 0;
+  sink = sink + target[bytes / 2]; // the copies are used, so none is optimised away
+  return best;
+}
+
+/// Bytes a local evaluation must move per point: read the input point and its 4-byte cell, write the output.
+int BytesPerPoint(bool useDouble)
+{
+  const int point = 3 * (useDouble ? int(sizeof(double)) : int(sizeof(float)));
+  return point + int(sizeof(int)) + point;
+}
+
+/**
+ * Writes the lattice's displacements (points minus rest positions) into VTK's B-spline coefficients, which
+ * are the same numbers: the CUBIC_BSPLINE lattice's control point (i, j, k) is coefficient (i, j, k).
+ */
+void SetCoefficients(vtkImageData* coefficients, const BenchmarkLattice& lattice)
+{
+  vtkDataArray* values = coefficients->GetPointData()->GetScalars();
+  for (vtkIdType p = 0; p < lattice.Grid->GetNumberOfPoints(); ++p)
+  {
+    double x[3];
+    lattice.Grid->GetPoint(p, x);
+    values->SetTuple3(p, x[0] - lattice.Rest[3 * p], x[1] - lattice.Rest[3 * p + 1], x[2] - lattice.Rest[3 * p + 2]);
+  }
+  values->Modified();
+  coefficients->Modified();
+}
+
+/// VTK's B-spline deformation of a mesh: vtkTransformFilter with a vtkBSplineTransform.
+struct VtkBSpline
+{
+  vtkNew<vtkImageData> Coefficients;
+  vtkNew<vtkBSplineTransform> Transform;
+  vtkNew<vtkTransformFilter> Filter;
+
+  /**
+   * The B-spline grid of a CUBIC_BSPLINE lattice over an axis-aligned frame: origin at the rest position of
+   * control point (0, 0, 0) (one spacing outside the frame), spacing = frame edge / divisions, border mode
+   * Edge. False when the frame is not axis-aligned (vtkImageData has no orientation in VTK 9.1).
+   */
+  bool SetUp(vtkPolyData* mesh, const BenchmarkLattice& lattice, int divisions)
+  {
+    double frame[12];
+    if (!vtkFFDDataContract::GetFrame(lattice.Grid, frame))
+    {
+      return false;
+    }
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        if (c != axis && frame[3 + 3 * axis + c] != 0.0)
+        {
+          return false;
+        }
+      }
+    }
+    int dims[3];
+    lattice.Grid->GetDimensions(dims);
+    this->Coefficients->SetDimensions(dims);
+    this->Coefficients->SetOrigin(lattice.Rest.data());
+    this->Coefficients->SetSpacing(frame[3] / divisions, frame[7] / divisions, frame[11] / divisions);
+    this->Coefficients->AllocateScalars(VTK_DOUBLE, 3);
+    SetCoefficients(this->Coefficients, lattice);
+    this->Transform->SetCoefficientData(this->Coefficients);
+    this->Transform->SetBorderModeToEdge();
+    this->Transform->SetDisplacementScale(1.0);
+    this->Filter->SetInputData(mesh);
+    this->Filter->SetTransform(this->Transform);
+    return true;
+  }
+
+  /// Follows the lattice's current displacements and runs the filter; returns the seconds of Update().
+  double Run(const BenchmarkLattice& lattice)
+  {
+    SetCoefficients(this->Coefficients, lattice);
+    this->Transform->Modified();
+    const Clock::time_point begin = Clock::now();
+    this->Filter->Update();
+    return Seconds(begin);
+  }
+};
+
+/// Largest distance between the points of two point sets of the same size.
+double MaxDistance(vtkPointSet* a, vtkPointSet* b)
+{
+  double largest = 0.0;
+  for (vtkIdType p = 0; p < a->GetNumberOfPoints(); ++p)
+  {
+    double x[3], y[3];
+    a->GetPoint(p, x);
+    b->GetPoint(p, y);
+    largest = std::max(largest,
+      std::sqrt((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) + (x[2] - y[2]) * (x[2] - y[2])));
+  }
+  return largest;
+}
+
+/// One lattice set-up of the bases table.
+struct BasisCase
+{
+  int Basis;
+  int Divisions;
+};
+
+/// A VTK row: vtkBSplineTransform against vtkFFDDeform's CUBIC_BSPLINE on the same lattice.
+struct VtkRow
+{
+  vtkIdType Points;
+  const char* Precision;
+  int Threads;
+  Timing Vtk;
+  Timing Ours;
+  double RelativeDifference; // largest point distance / the mesh's bounding-box diagonal
+};
+
+/**
+ * For each mesh, precision, basis case and thread count: vtkFFDDeform::Update() timed as in the global
+ * section, its points per second turned into bytes per second (BytesPerPoint) and compared with the copy
+ * bandwidth of the same thread count. For CUBIC_BSPLINE over `vtkDivisions`, VTK's vtkBSplineTransform +
+ * vtkTransformFilter on the same mesh and lattice, timed the same way. Returns false when a pipeline failed.
+ */
+bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, const std::vector<int>& threadCounts,
+  bool quick)
+{
+  // 256 MB per buffer: far beyond the caches (32 MB of L3 on this class of CPU), as the 5 M-point meshes are.
+  const size_t copyBytes = size_t(quick ? 32 : 256) << 20;
+  std::vector<double> bandwidth;
+  std::printf("\nCopy bandwidth (std::memcpy of a %zu MB buffer into another, split over the threads; bytes "
+              "read + written per second, best of 5):\n",
+    copyBytes >> 20);
+  for (int threads : threadCounts)
+  {
+    bandwidth.push_back(MeasureCopyBandwidth(copyBytes, threads));
+    std::printf("  %2d thread(s): %6.2f GB/s\n", threads, bandwidth.back() * 1e-9);
+  }
+
+  // Every basis over 4 x 4 x 4 voxels (the global one's cost grows with its degree, so it stays at 4), and the
+  // local ones again over lattices of about 10^3 control points: their cost per point should not change.
+  const int vtkDivisions = 7;
+  const std::vector<BasisCase> cases = { { vtkFFDBuildLattice::BERNSTEIN, 4 },
+    { vtkFFDBuildLattice::TRILINEAR, 4 }, { vtkFFDBuildLattice::TRILINEAR, 9 },
+    { vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, 4 }, { vtkFFDBuildLattice::TRICUBIC_BEZIER, 4 },
+    { vtkFFDBuildLattice::TRICUBIC_BEZIER, 3 }, { vtkFFDBuildLattice::CUBIC_BSPLINE, 4 },
+    { vtkFFDBuildLattice::CUBIC_BSPLINE, vtkDivisions } };
+  std::printf("\nEvaluation per basis (vtkFFDDeform::Update() after moving the lattice, binding cached).\n"
+              "bytes/point: what the evaluation must move: read the point and its 4-byte cell, write the point "
+              "(%d float32, %d float64);\nGB/s: Mpoints/s * bytes/point; %% copy: of the copy bandwidth above "
+              "for the same thread count.\nbind+1st: the first Update(), binding included, on all threads; "
+              "best, median: evaluation only.\n\n",
+    BytesPerPoint(false), BytesPerPoint(true));
+  std::printf("| basis               | div | ctrl | points    | type    | th | bind+1st | best (s) | median   | "
+              "Mpoints/s | GB/s   | %% copy  |\n");
+  std::printf("|---------------------|----:|-----:|----------:|---------|---:|---------:|---------:|---------:|"
+              "----------:|-------:|--------:|\n");
+  const int minRepeats = quick ? 2 : 3;
+  const double minSeconds = quick ? 0.0 : 0.5;
+  std::vector<VtkRow> vtkRows;
+  bool ok = true;
+  for (const auto& mesh : meshes)
+  {
+    for (bool useDouble : { false, true })
+    {
+      vtkSmartPointer<vtkPolyData> input = WithPrecision(mesh, useDouble);
+      for (const BasisCase& c : cases)
+      {
+        BenchmarkLattice lattice;
+        BuildLattice(input, c.Basis, c.Divisions, lattice);
+        vtkNew<vtkFFDDeform> deform;
+        std::mt19937 rng(8);
+        const double bindSeconds = BindOnce(deform, input, lattice, rng);
+        if (bindSeconds < 0.0)
+        {
+          ok = false;
+          continue;
+        }
+        VtkBSpline vtk;
+        const bool compare = c.Basis == vtkFFDBuildLattice::CUBIC_BSPLINE && c.Divisions == vtkDivisions;
+        if (compare && !vtk.SetUp(input, lattice, c.Divisions))
+        {
+          std::fprintf(stderr, "The frame is not axis-aligned: VTK's B-spline grid cannot follow it\n");
+          ok = false;
+        }
+        for (size_t t = 0; t < threadCounts.size(); ++t)
+        {
+          const Timing timing = TimeEvaluation(deform, lattice, rng, threadCounts[t], minRepeats, minSeconds);
+          const double pointsPerSecond = input->GetNumberOfPoints() / timing.Best;
+          const double bytesPerSecond = pointsPerSecond * BytesPerPoint(useDouble);
+          std::printf("| %-19s | %3d | %4lld | %9lld | %-7s | %2d | %8.3f | %8.4f | %8.4f | %9.2f | %6.2f | "
+                      "%5.1f %% |\n",
+            vtkFFDBuildLattice::GetBasisAsString(c.Basis), c.Divisions,
+            static_cast<long long>(lattice.Grid->GetNumberOfPoints()),
+            static_cast<long long>(input->GetNumberOfPoints()), useDouble ? "float64" : "float32",
+            vtkSMPTools::GetEstimatedNumberOfThreads(), bindSeconds, timing.Best, timing.Median,
+            pointsPerSecond * 1e-6, bytesPerSecond * 1e-9, 100.0 * bytesPerSecond / bandwidth[t]);
+          std::fflush(stdout);
+          if (compare && ok)
+          {
+            // VTK on the same thread count (vtkSMPTools is still initialized to it), then both on one lattice
+            // state, to check that they compute the same deformation.
+            const Timing vtkTiming = Repeat(
+              [&]() {
+                MoveLattice(lattice.Grid, lattice.Rest, rng);
+                return vtk.Run(lattice);
+              },
+              minRepeats, minSeconds);
+            MoveLattice(lattice.Grid, lattice.Rest, rng);
+            deform->Update();
+            vtk.Run(lattice);
+            vtkRows.push_back({ input->GetNumberOfPoints(), useDouble ? "float64" : "float32",
+              vtkSMPTools::GetEstimatedNumberOfThreads(), vtkTiming, timing,
+              MaxDistance(deform->GetOutput(), vtk.Filter->GetOutput()) / input->GetLength() });
+          }
+        }
+      }
+    }
+  }
+
+  std::printf("\nVTK's vtkBSplineTransform + vtkTransformFilter against CUBIC_BSPLINE over %d^3 voxels "
+              "(%d^3 control points), the same mesh and lattice\n(coefficients = the lattice's displacements, "
+              "origin = rest position of control point (0, 0, 0), spacing = frame edge / %d, border mode Edge).\n"
+              "difference: largest distance between the two outputs / the mesh's bounding-box diagonal.\n\n",
+    vtkDivisions, vtkDivisions + 3, vtkDivisions);
+  std::printf("| points    | type    | th | VTK best (s) | VTK median | VTK Mpoints/s | ours best (s) | "
+              "ours Mpoints/s | speed-up | difference |\n");
+  std::printf("|----------:|---------|---:|-------------:|-----------:|--------------:|--------------:|"
+              "---------------:|---------:|-----------:|\n");
+  for (const VtkRow& r : vtkRows)
+  {
+    std::printf("| %9lld | %-7s | %2d | %12.4f | %10.4f | %13.2f | %13.4f | %14.2f | %7.1fx | %10.1e |\n",
+      static_cast<long long>(r.Points), r.Precision, r.Threads, r.Vtk.Best, r.Vtk.Median,
+      r.Points / r.Vtk.Best * 1e-6, r.Ours.Best, r.Points / r.Ours.Best * 1e-6, r.Vtk.Best / r.Ours.Best,
+      r.RelativeDifference);
+  }
+  return ok && vtkRows.size() == 2 * 2 * threadCounts.size();
+}
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  bool quick = false;
+  std::string section = "all";
+  std::string meshPath = std::string(VOXELFFD_MESH_DIR) + "/armadillo.vtp";
+  for (int a = 1; a < argc; ++a)
+  {
+    const std::string arg = argv[a];
+    if (arg == "--quick")
+    {
+      quick = true;
+    }
+    else if (arg == "--mesh" && a + 1 < argc)
+    {
+      meshPath = argv[++a];
+    }
+    else if (arg == "--section" && a + 1 < argc &&
+      (std::string(argv[a + 1]) == "global" || std::string(argv[a + 1]) == "bases" ||
+        std::string(argv[a + 1]) == "all"))
+    {
+      section = argv[++a];
+    }
+    else
+    {
+      std::fprintf(stderr, "usage: %s [--quick] [--section global|bases|all] [--mesh path.vtp]\n", argv[0]);
+      return arg == "--help" || arg == "-h" ? 0 : 1;
+    }
+  }
+
+  // Thread counts: one, and every thread the SMP backend would use by default.
+  vtkSMPTools::Initialize(0);
+  const int allThreads = vtkSMPTools::GetEstimatedNumberOfThreads();
+  std::vector<int> threadCounts = { 1 };
+  if (allThreads > 1)
+  {
+    threadCounts.push_back(allThreads);
+  }
+  std::printf("CPU: %s, %u hardware threads\n", CpuModel().c_str(), std::thread::hardware_concurrency());
+  std::printf("vtkSMPTools backend: %s, thread counts: 1", vtkSMPTools::GetBackend());
+  std::printf(allThreads > 1 ? " and %d\n" : "\n", allThreads);
+
   vtkNew<vtkXMLPolyDataReader> reader;
   if (!std::ifstream(meshPath).good())
   {
@@ -408,27 +769,15 @@ int main(int argc, char* argv[])
     static_cast<long long>(meshes[0]->GetNumberOfPoints()), static_cast<long long>(meshes[1]->GetNumberOfPoints()),
     Seconds(subdivideBegin));
 
-  std::printf("\nGlobal Bernstein evaluation (vtkFFDDeform::Update() after moving the lattice, binding cached).\n"
-              "ops/point: 3 FMAs per control point + outer sums + basis (%.0f for 5^3, %.0f for 10^3);\n"
-              "%% of peak: (points/s * ops/point) / the FMA peak above for the same precision and threads.\n"
-              "bind+1st: the first Update(), binding included, on all threads; best, median: evaluation only.\n\n",
-    OperationsPerPoint(4, 4, 4), OperationsPerPoint(9, 9, 9));
-  std::printf("| ctrl | points    | type    | th | bind+1st | best (s) | median   | Mpoints/s | Gops/s   | %% peak   |\n");
-  std::printf("|-----:|----------:|---------|---:|---------:|---------:|---------:|----------:|---------:|---------:|\n");
-  std::vector<Row> rows;
-  const int minRepeats = quick ? 2 : 3;
-  const double minSeconds = quick ? 0.0 : 1.0;
-  for (const auto& mesh : meshes)
+  bool ok = true;
+  if (section != "bases")
   {
-    for (bool useDouble : { false, true })
-    {
-      vtkSmartPointer<vtkPolyData> input = WithPrecision(mesh, useDouble);
-      for (int divisions : { 4, 9 })
-      {
-        BenchmarkMesh(input, useDouble, divisions, threadCounts, minRepeats, minSeconds, peaks, rows);
-      }
-    }
+    ok = RunGlobalSection(meshes, threadCounts, quick) && ok;
+  }
+  if (section != "global")
+  {
+    ok = RunBasesSection(meshes, threadCounts, quick) && ok;
   }
   vtkSMPTools::Initialize(0);
-  return rows.size() == 2 * 2 * 2 * threadCounts.size() ? 0 : 1;
+  return ok ? 0 : 1;
 }

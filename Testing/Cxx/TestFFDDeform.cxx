@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Tests of vtkFFDDeform against the independent float64 reference of equations 1-3 (FFDReference.h), on real
 // meshes and on hand-built lattices; the binding cache; normals and Jacobian determinants; bad input.
-#include "FFDReference.h"
 #include "FFDTestErrorObserver.h"
+#include "FFDTestLattices.h"
 #include "FFDTestMeshes.h"
 
 #include "vtkFFDBuildLattice.h"
@@ -35,64 +35,13 @@
 
 namespace
 {
-using ffdref::Vec;
+using namespace ffdtest;
 
-// A global Bernstein lattice of degree (l, m, n) built by hand from equation 1 and the data contract, so that
-// these tests do not depend on vtkFFDBuildLattice.
+// A global Bernstein lattice of degree (l, m, n), built by hand (FFDTestLattices.h).
 vtkSmartPointer<vtkStructuredGrid> MakeLattice(const ffdref::Frame& f, int l, int m, int n)
 {
-  auto lattice = vtkSmartPointer<vtkStructuredGrid>::New();
-  lattice->SetDimensions(l + 1, m + 1, n + 1);
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  vtkNew<vtkDoubleArray> rest;
-  rest->SetName("RestPosition");
-  rest->SetNumberOfComponents(3);
-  for (const Vec& p : ffdref::RestLattice(f, l, m, n))
-  {
-    points->InsertNextPoint(p.data());
-    rest->InsertNextTuple(p.data());
-  }
-  lattice->SetPoints(points);
-  lattice->GetPointData()->AddArray(rest);
-  const double frame[12] = { f.X0[0], f.X0[1], f.X0[2], f.S[0], f.S[1], f.S[2], f.T[0], f.T[1], f.T[2], f.U[0],
-    f.U[1], f.U[2] };
-  const int divisions[3] = { l, m, n };
-  vtkFFDDataContract::SetFrame(lattice, frame);
-  vtkFFDDataContract::SetDivisions(lattice, divisions);
-  vtkFFDDataContract::SetBasis(lattice, vtkFFDBuildLattice::BERNSTEIN);
-  return lattice;
-}
-
-ffdref::Frame FrameOf(vtkDataObject* data)
-{
-  double f[12];
-  EXPECT_TRUE(vtkFFDDataContract::GetFrame(data, f));
-  return { { f[0], f[1], f[2] }, { f[3], f[4], f[5] }, { f[6], f[7], f[8] }, { f[9], f[10], f[11] } };
-}
-
-double Length(const Vec& v)
-{
-  return std::sqrt(ffdref::Dot(v, v));
-}
-
-double Diagonal(const ffdref::Frame& f)
-{
-  return Length({ f.S[0] + f.T[0] + f.U[0], f.S[1] + f.T[1] + f.U[1], f.S[2] + f.T[2] + f.U[2] });
-}
-
-// Moves every lattice point by a random vector of up to `amplitude` per component.
-void Perturb(vtkPointSet* lattice, std::mt19937& rng, double amplitude)
-{
-  std::uniform_real_distribution<double> d(-amplitude, amplitude);
-  vtkPoints* points = lattice->GetPoints();
-  for (vtkIdType p = 0; p < points->GetNumberOfPoints(); ++p)
-  {
-    double x[3];
-    points->GetPoint(p, x);
-    points->SetPoint(p, x[0] + d(rng), x[1] + d(rng), x[2] + d(rng));
-  }
-  points->Modified();
+  const int degrees[3] = { l, m, n };
+  return ffdtest::MakeLattice(f, vtkFFDBuildLattice::BERNSTEIN, degrees);
 }
 
 // The lattice's control points (absolute positions) in VTK order.
@@ -141,28 +90,6 @@ double MaxRelativeError(vtkPointSet* input, vtkPointSet* output, vtkPointSet* la
   return worst / Diagonal(f);
 }
 
-struct Pipeline
-{
-  vtkNew<vtkFFDVoxelize> Voxelize;
-  vtkNew<vtkFFDBuildLattice> Build;
-  vtkNew<vtkFFDDeform> Deform;
-  vtkSmartPointer<vtkStructuredGrid> Lattice = vtkSmartPointer<vtkStructuredGrid>::New();
-
-  // Voxelizes `mesh`, builds the Bernstein lattice and copies it into Lattice, which drives Deform.
-  explicit Pipeline(vtkPointSet* mesh, int nx, int ny, int nz)
-  {
-    this->Voxelize->SetInputData(mesh);
-    this->Voxelize->SetDivisions(nx, ny, nz);
-    this->Build->SetInputConnection(this->Voxelize->GetOutputPort());
-    this->Build->SetBasisToBernstein();
-    this->Build->Update();
-    this->Lattice->DeepCopy(this->Build->GetOutput());
-    this->Deform->SetInputData(mesh);
-    this->Deform->SetLatticeData(this->Lattice);
-  }
-
-  vtkPointSet* Output() { return vtkPointSet::SafeDownCast(this->Deform->GetOutputDataObject(0)); }
-};
 } // namespace
 
 // Real meshes through the whole pipeline, random lattices: within 1e-12 of the float64 reference, relative to
@@ -175,7 +102,7 @@ TEST(vtkFFDDeform, MatchesReferenceOnRealMeshes)
     for (const std::array<int, 3>& div : { std::array<int, 3>{ 2, 3, 4 }, std::array<int, 3>{ 5, 5, 5 } })
     {
       vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh(name);
-      Pipeline pipeline(mesh, div[0], div[1], div[2]);
+      Pipeline pipeline(mesh, vtkFFDBuildLattice::BERNSTEIN, div[0], div[1], div[2]);
       Perturb(pipeline.Lattice, rng, 0.2 * Diagonal(FrameOf(pipeline.Lattice)));
       pipeline.Deform->Update();
       vtkPointSet* output = pipeline.Output();
@@ -200,7 +127,7 @@ TEST(vtkFFDDeform, FloatPointsStayFloatWithinSinglePrecision)
   floatMesh->SetPoints(floatPoints);
   ASSERT_EQ(floatMesh->GetPoints()->GetDataType(), VTK_FLOAT);
 
-  Pipeline pipeline(floatMesh, 4, 4, 4);
+  Pipeline pipeline(floatMesh, vtkFFDBuildLattice::BERNSTEIN, 4, 4, 4);
   Perturb(pipeline.Lattice, rng, 0.2 * Diagonal(FrameOf(pipeline.Lattice)));
   pipeline.Deform->Update();
   EXPECT_EQ(pipeline.Output()->GetPoints()->GetDataType(), VTK_FLOAT);
@@ -217,7 +144,7 @@ TEST(vtkFFDDeform, FloatPointsStayFloatWithinSinglePrecision)
 TEST(vtkFFDDeform, AffineLatticeMotionIsReproduced)
 {
   vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
-  Pipeline pipeline(mesh, 3, 2, 4);
+  Pipeline pipeline(mesh, vtkFFDBuildLattice::BERNSTEIN, 3, 2, 4);
   vtkNew<vtkTransform> affine;
   affine->Translate(0.3, -0.2, 0.1);
   affine->RotateWXYZ(35, 1, 2, 3);
@@ -244,7 +171,7 @@ TEST(vtkFFDDeform, AffineLatticeMotionIsReproduced)
 TEST(vtkFFDDeform, RestLatticeIsTheIdentity)
 {
   vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
-  Pipeline pipeline(mesh, 4, 3, 2);
+  Pipeline pipeline(mesh, vtkFFDBuildLattice::BERNSTEIN, 4, 3, 2);
   pipeline.Deform->Update();
   for (vtkIdType i = 0; i < mesh->GetNumberOfPoints(); ++i)
   {
@@ -320,12 +247,6 @@ std::array<std::array<double, 3>, 3> ReferenceJacobian(
   }
   return j;
 }
-
-double Det(const std::array<std::array<double, 3>, 3>& a)
-{
-  return ffdref::Dot({ a[0][0], a[0][1], a[0][2] },
-    ffdref::Cross({ a[1][0], a[1][1], a[1][2] }, { a[2][0], a[2][1], a[2][2] }));
-}
 } // namespace
 
 // Normals follow the inverse transpose of the Jacobian and det(J) is reported: both against central differences
@@ -340,7 +261,7 @@ TEST(vtkFFDDeform, NormalsAndJacobianDeterminantMatchFiniteDifferences)
   normals->Update();
   vtkPolyData* withNormals = normals->GetOutput();
 
-  Pipeline pipeline(withNormals, 3, 3, 3);
+  Pipeline pipeline(withNormals, vtkFFDBuildLattice::BERNSTEIN, 3, 3, 3);
   Perturb(pipeline.Lattice, rng, 0.1 * Diagonal(FrameOf(pipeline.Lattice)));
   pipeline.Deform->ComputeJacobianDeterminantOn();
   pipeline.Deform->Update();
@@ -448,7 +369,7 @@ TEST(vtkFFDDeform, NonFiniteInputPointsPassThroughAndOthersAreUnaffected)
 {
   std::mt19937 rng(13);
   vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
-  Pipeline pipeline(mesh, 3, 3, 3);
+  Pipeline pipeline(mesh, vtkFFDBuildLattice::BERNSTEIN, 3, 3, 3);
   Perturb(pipeline.Lattice, rng, 0.1);
   pipeline.Deform->Update();
   vtkNew<vtkPoints> clean;
@@ -527,9 +448,10 @@ TEST(vtkFFDDeform, BadLatticesAreRefusedWithAClearError)
     { "zero divisions", [&](vtkStructuredGrid* l) { vtkFFDDataContract::SetDivisions(l, zero); },
       "FFDDivisions" },
     { "no basis", [](vtkStructuredGrid* l) { l->GetFieldData()->RemoveArray("FFDBasis"); }, "FFDBasis" },
-    { "unsupported basis",
-      [](vtkStructuredGrid* l) { vtkFFDDataContract::SetBasis(l, vtkFFDBuildLattice::TRILINEAR); },
-      "not supported" },
+    { "unknown basis", [](vtkStructuredGrid* l) { vtkFFDDataContract::SetBasis(l, 7); }, "not a known basis" },
+    { "point count of another basis",
+      [](vtkStructuredGrid* l) { vtkFFDDataContract::SetBasis(l, vtkFFDBuildLattice::CUBIC_BSPLINE); },
+      "need 125" },
     { "wrong point count",
       [](vtkStructuredGrid* l) {
         const int more[3] = { 2, 2, 3 };
@@ -572,7 +494,7 @@ TEST(vtkFFDDeform, BadLatticesAreRefusedWithAClearError)
 TEST(vtkFFDDeform, ReportsProgress)
 {
   vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("bear");
-  Pipeline pipeline(mesh, 2, 2, 2);
+  Pipeline pipeline(mesh, vtkFFDBuildLattice::BERNSTEIN, 2, 2, 2);
   std::vector<double> progress;
   vtkNew<vtkCallbackCommand> onProgress;
   onProgress->SetClientData(&progress);
@@ -584,4 +506,59 @@ TEST(vtkFFDDeform, ReportsProgress)
   ASSERT_GE(progress.size(), 2u);
   EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
   EXPECT_EQ(progress.back(), 1.0);
+}
+
+// Backends: AUTOMATIC picks CUDA only where a device is present; CUDA asked for where it cannot run falls back to
+// the CPU with a warning and the same output; GetLastBackendUsed() names what ran. Where a device is present
+// (never on the CPU-only machines these tests run on in CI) the CUDA result must match the CPU's within 1e-5 of
+// the diagonal (float32 evaluation).
+TEST(vtkFFDDeform, BackendChoiceAndCpuFallback)
+{
+  std::mt19937 rng(17);
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
+  Pipeline pipeline(mesh, vtkFFDBuildLattice::BERNSTEIN, 3, 3, 3);
+  Perturb(pipeline.Lattice, rng, 0.1);
+  EXPECT_STREQ(pipeline.Deform->GetLastBackendUsed(), "None");
+
+  pipeline.Deform->SetBackendToCPU();
+  pipeline.Deform->Update();
+  EXPECT_STREQ(pipeline.Deform->GetLastBackendUsed(), "CPU");
+  vtkNew<vtkPoints> cpu;
+  cpu->SetDataTypeToDouble();
+  cpu->DeepCopy(pipeline.Output()->GetPoints());
+
+  for (int backend : { vtkFFDDeform::AUTOMATIC, vtkFFDDeform::CUDA })
+  {
+    pipeline.Deform->SetBackend(backend);
+    vtkNew<FFDTestErrorObserver> observer;
+    observer->Watch(pipeline.Deform);
+    pipeline.Deform->Update();
+    EXPECT_TRUE(observer->Errors.empty()) << observer->Errors;
+    const std::string used = pipeline.Deform->GetLastBackendUsed();
+    double worst = 0.0;
+    for (vtkIdType i = 0; i < mesh->GetNumberOfPoints(); ++i)
+    {
+      double a[3], b[3];
+      cpu->GetPoint(i, a);
+      pipeline.Output()->GetPoint(i, b);
+      worst = std::max(worst, std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]));
+    }
+    if (used == "CUDA")
+    {
+      EXPECT_LE(worst / Diagonal(FrameOf(pipeline.Lattice)), 1e-5);
+    }
+    else
+    {
+      EXPECT_EQ(used, "CPU");
+      EXPECT_EQ(worst, 0.0); // the very same CPU computation
+      if (backend == vtkFFDDeform::CUDA)
+      {
+        EXPECT_NE(observer->Warnings.find("CUDA backend cannot run"), std::string::npos) << observer->Warnings;
+      }
+      else
+      {
+        EXPECT_TRUE(observer->Warnings.empty()) << observer->Warnings; // AUTOMATIC falls back silently
+      }
+    }
+  }
 }

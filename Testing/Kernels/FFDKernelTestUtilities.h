@@ -1,19 +1,25 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
  * @file FFDKernelTestUtilities.h
- * @brief Random inputs shared by the kernel tests: frames, points and conversions between the reference's
- * double arrays (ffdref::) and the kernels' types (ffd::). No VTK, plain C++17 (also built by nvcc).
+ * @brief Random inputs shared by the kernel tests: frames, points, grid lattices of every basis, conversions
+ * between the reference's double arrays (ffdref::) and the kernels' types (ffd::), and the tolerances the tests
+ * share. No VTK, plain C++17 (also built by nvcc).
  */
 #ifndef FFDKernelTestUtilities_h
 #define FFDKernelTestUtilities_h
 
+#include "FFDFrame.h"
 #include "FFDReference.h"
 #include "FFDVector.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace ffdtest
@@ -148,6 +154,115 @@ inline double LatticeScale(const std::vector<ffdref::Vec>& points)
     scale = std::max(scale, MaxAbs(p));
   }
   return scale;
+}
+
+/// max_c |a_c - b_c|
+inline double MaxDiff(const ffdref::Vec& a, const ffdref::Vec& b)
+{
+  return MaxAbs(ffdref::Sub(a, b));
+}
+
+/// Evaluation tolerance relative to the lattice scale: 1e-12 in double, 1e-6 in float (the issues' targets).
+/// Every basis is a convex combination of the control points with weights from a stable recurrence or a cubic
+/// of a number in [0, 1], so its rounding error is a few eps(Real) times the scale.
+template <typename Real>
+constexpr double EvaluationTolerance()
+{
+  return sizeof(Real) >= sizeof(double) ? 1e-12 : 1e-6;
+}
+
+/// Gradient tolerance relative to max(lattice scale, largest derivative): 1e-6 in double (central
+/// differences with h = 1e-6 of a polynomial: truncation h^2 |f'''| / 6 and rounding eps/h, both far below),
+/// 1e-4 in float (the kernel's derivative sums n (B_{k-1} - B_k) P_k lose ~n^2 eps_float ~ 1e-5 at the
+/// global basis's highest degree).
+template <typename Real>
+constexpr double GradientTolerance()
+{
+  return sizeof(Real) >= sizeof(double) ? 1e-6 : 1e-4;
+}
+
+/// Tracks the worst error / tolerance ratio of a test and records it in the XML output (--gtest_output=xml),
+/// so the margins can be read without a debugger.
+class WorstRatio
+{
+public:
+  explicit WorstRatio(const char* key)
+    : Key(key)
+  {
+  }
+  ~WorstRatio() { ::testing::Test::RecordProperty(this->Key, std::to_string(this->Worst)); }
+  void Add(double error, double tol) { this->Worst = std::max(this->Worst, error / tol); }
+
+private:
+  const char* Key;
+  double Worst = 0.0;
+};
+
+/// The kernels' frame (dual basis from ffd::Frame::FromArray) of a reference frame.
+template <typename Real>
+ffd::Frame<Real> KernelFrame(const ffdref::Frame& f)
+{
+  double a[12];
+  FrameToArray(f, a);
+  return ffd::Frame<Real>::FromArray(a);
+}
+
+/// Every grid basis, in the order of the data contract.
+constexpr ffdref::Basis AllBases[] = { ffdref::Basis::Bernstein, ffdref::Basis::Trilinear,
+  ffdref::Basis::TriquadraticBezier, ffdref::Basis::TricubicBezier, ffdref::Basis::CubicBSpline };
+
+inline std::string BasisName(ffdref::Basis b)
+{
+  const char* names[] = { "Bernstein", "Trilinear", "TriquadraticBezier", "TricubicBezier", "CubicBSpline" };
+  return names[int(b)];
+}
+
+/// A lattice of one grid basis over a frame: its rest positions (from the reference) and its moved points.
+struct GridLattice
+{
+  ffdref::Basis Basis;
+  ffdref::Frame F;
+  std::array<int, 3> Divisions; ///< voxels per axis (the degree per axis for the global basis)
+  std::vector<ffdref::Vec> Rest, Points;
+
+  std::array<int, 3> Dims() const
+  {
+    return { ffdref::PointsAlongAxis(Basis, Divisions[0]), ffdref::PointsAlongAxis(Basis, Divisions[1]),
+      ffdref::PointsAlongAxis(Basis, Divisions[2]) };
+  }
+  /// Points minus rest: what the deformation evaluates.
+  std::vector<ffdref::Vec> Displacements() const
+  {
+    std::vector<ffdref::Vec> d;
+    for (size_t i = 0; i < Points.size(); ++i)
+    {
+      d.push_back(ffdref::Sub(Points[i], Rest[i]));
+    }
+    return d;
+  }
+  std::string Name() const
+  {
+    return BasisName(Basis) + " divisions (" + std::to_string(Divisions[0]) + "," + std::to_string(Divisions[1]) +
+      "," + std::to_string(Divisions[2]) + ")";
+  }
+};
+
+/// A random frame, random divisions in 1..maxDivisions per axis, control points displaced from rest by up to
+/// maxDisplacement in each coordinate (the frames' edges are 0.5..2 long).
+inline GridLattice RandomGridLattice(Rng& rng, ffdref::Basis basis, int maxDivisions, double maxDisplacement = 0.3)
+{
+  GridLattice lat;
+  lat.Basis = basis;
+  lat.F = RandomFrame(rng);
+  std::uniform_int_distribution<int> divisions(1, maxDivisions);
+  lat.Divisions = { divisions(rng), divisions(rng), divisions(rng) };
+  lat.Rest = ffdref::RestLattice(basis, lat.F, lat.Divisions.data());
+  for (const ffdref::Vec& p : lat.Rest)
+  {
+    const ffdref::Vec d = RandomVec(rng, -maxDisplacement, maxDisplacement);
+    lat.Points.push_back({ p[0] + d[0], p[1] + d[1], p[2] + d[2] });
+  }
+  return lat;
 }
 
 } // namespace ffdtest

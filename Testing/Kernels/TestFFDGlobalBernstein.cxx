@@ -1,13 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The global FFD (FFDGlobalBernstein.h, paper equation 3) and its Jacobian against the float64 reference
-// ffdref:: (binomials times powers, absolute control points, equation 2 by Cramer's rule).
+// The global FFD (the Bernstein case of FFDGridBasis.h and FFDGridDeformation.h, paper equation 3) and its
+// Jacobian against the float64 reference ffdref:: (binomials times powers, absolute control points, equation 2
+// by Cramer's rule).
 //
 // Normalisation of errors: an evaluation error is divided by the lattice's scale, max_ijk ||P_ijk||_inf (the
 // half-size of the smallest origin-centred cube holding the lattice). The random frames sit near the origin
 // (X0 in [-1, 1]^3, edges 0.5..2), so this is the lattice's extent to within a small factor, and it is the
 // size of the numbers the evaluation rounds: equation 3 is a convex combination of the P_ijk.
 
-#include "FFDGlobalBernstein.h"
+#include "FFDGridDeformation.h"
 #include "FFDKernelTestUtilities.h"
 
 #include <gtest/gtest.h>
@@ -23,7 +24,40 @@ namespace
 {
 using ffdref::Vec;
 using ffdtest::Eps;
+using ffdtest::EvaluationTolerance;
+using ffdtest::GradientTolerance;
 using ffdtest::MaxAbs;
+using ffdtest::MaxDiff;
+using ffdtest::WorstRatio;
+
+// Equation 3 through the kernels: the global basis is one cell of degree dims - 1 per axis.
+template <typename Real>
+void GlobalWeights(const int dims[3], const ffd::Vec3<Real>& stu, bool withDerivative,
+  ffd::AxisWeights<ffd::MaxBernsteinDegree + 1, Real>* axes)
+{
+  const Real p[3] = { stu.x, stu.y, stu.z };
+  for (int a = 0; a < 3; ++a)
+  {
+    ffd::ComputeAxisWeights(ffd::GridBasis::Bernstein, dims[a] - 1, 0, p[a], withDerivative, axes[a]);
+  }
+}
+
+template <typename Real>
+ffd::Vec3<Real> EvaluateBernstein(const Real* values, const int dims[3], const ffd::Vec3<Real>& stu)
+{
+  ffd::AxisWeights<ffd::MaxBernsteinDegree + 1, Real> axes[3];
+  GlobalWeights(dims, stu, false, axes);
+  return ffd::SumTensorProduct(values, dims, axes);
+}
+
+template <typename Real>
+ffd::Vec3<Real> EvaluateBernsteinWithGradient(
+  const Real* values, const int dims[3], const ffd::Vec3<Real>& stu, ffd::Mat3<Real>& gradient)
+{
+  ffd::AxisWeights<ffd::MaxBernsteinDegree + 1, Real> axes[3];
+  GlobalWeights(dims, stu, true, axes);
+  return ffd::SumTensorProductWithGradient(values, dims, axes, gradient);
+}
 
 template <typename Real>
 class FFDGlobalBernsteinTest : public ::testing::Test
@@ -31,13 +65,6 @@ class FFDGlobalBernsteinTest : public ::testing::Test
 };
 using RealTypes = ::testing::Types<float, double>;
 TYPED_TEST_SUITE(FFDGlobalBernsteinTest, RealTypes);
-
-/// Evaluation tolerance relative to the lattice scale: 1e-12 in double, 1e-6 in float (the targets).
-template <typename Real>
-constexpr double EvaluationTolerance()
-{
-  return sizeof(Real) >= sizeof(double) ? 1e-12 : 1e-6;
-}
 
 /// A lattice of degree (l, m, n) over a frame: its rest positions and its (moved) control points.
 struct Lattice
@@ -93,29 +120,6 @@ std::vector<Vec> Displacements(const Lattice& lat)
   return d;
 }
 
-/// Tracks the worst error / tolerance ratio of a test and records it in the XML output (--gtest_output=xml),
-/// so the margins can be read without a debugger.
-class WorstRatio
-{
-public:
-  explicit WorstRatio(const char* key)
-    : Key(key)
-  {
-  }
-  ~WorstRatio() { ::testing::Test::RecordProperty(this->Key, std::to_string(this->Worst)); }
-  void Add(double error, double tol) { this->Worst = std::max(this->Worst, error / tol); }
-
-private:
-  const char* Key;
-  double Worst = 0.0;
-};
-
-/// max_c |a_c - b_c|
-double MaxDiff(const Vec& a, const Vec& b)
-{
-  return MaxAbs(ffdref::Sub(a, b));
-}
-
 TYPED_TEST(FFDGlobalBernsteinTest, RestLatticeReproducesFrame)
 {
   // Partition of unity and linear precision: with the rest lattice's absolute positions as values,
@@ -130,7 +134,7 @@ TYPED_TEST(FFDGlobalBernsteinTest, RestLatticeReproducesFrame)
     for (int p = 0; p < 50; ++p)
     {
       const ffd::Vec3<Real> stu = ffdtest::ToKernel<Real>(ffdtest::RandomVec(rng, 0.0, 1.0));
-      const Vec got = ffdtest::ToRef(ffd::EvaluateBernstein(values.data(), lat.Dims().data(), stu));
+      const Vec got = ffdtest::ToRef(EvaluateBernstein(values.data(), lat.Dims().data(), stu));
       const Vec want = ffdtest::ToWorld(lat.F, ffdtest::ToRef(stu));
       worst.Add(MaxDiff(got, want), tol);
       ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " point " << p;
@@ -191,7 +195,7 @@ TYPED_TEST(FFDGlobalBernsteinTest, AffineMapIsReproduced)
     for (const Vec& stu : params)
     {
       const ffd::Vec3<Real> s = ffdtest::ToKernel<Real>(stu);
-      const Vec got = ffdtest::ToRef(ffd::EvaluateBernstein(values.data(), lat.Dims().data(), s));
+      const Vec got = ffdtest::ToRef(EvaluateBernstein(values.data(), lat.Dims().data(), s));
       const Vec want = map(ffdtest::ToWorld(lat.F, ffdtest::ToRef(s)));
       worst.Add(MaxDiff(got, want), tol);
       ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " at (" << stu[0] << "," << stu[1] << "," << stu[2]
@@ -207,7 +211,7 @@ TYPED_TEST(FFDGlobalBernsteinTest, AffineMapIsReproduced)
       const ffd::Vec3<Real> x = ffdtest::ToKernel<Real>(ffdtest::ToWorld(lat.F, ffdtest::RandomVec(rng, 0, 1)));
       ffd::Vec3<Real> stu;
       ASSERT_TRUE(frame.Bind(x, stu));
-      const Vec got = ffdtest::ToRef(x + ffd::EvaluateBernstein(dvalues.data(), lat.Dims().data(), stu));
+      const Vec got = ffdtest::ToRef(x + EvaluateBernstein(dvalues.data(), lat.Dims().data(), stu));
       const Vec want = map(ffdtest::ToRef(x));
       const double tolD = EvaluationTolerance<Real>() * (scale + MaxAbs(ffdtest::ToRef(x)));
       worst.Add(MaxDiff(got, want), tolD);
@@ -231,7 +235,7 @@ TYPED_TEST(FFDGlobalBernsteinTest, RandomLatticesMatchReference)
     for (int p = 0; p < 20; ++p)
     {
       const ffd::Vec3<Real> stu = ffdtest::ToKernel<Real>(ffdtest::RandomVec(rng, 0.0, 1.0));
-      const Vec got = ffdtest::ToRef(ffd::EvaluateBernstein(values.data(), lat.Dims().data(), stu));
+      const Vec got = ffdtest::ToRef(EvaluateBernstein(values.data(), lat.Dims().data(), stu));
       const Vec want = ffdref::Evaluate(seen, lat.L, lat.M, lat.N, ffdtest::ToRef(stu));
       worst.Add(MaxDiff(got, want), tol);
       ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " point " << p;
@@ -262,7 +266,7 @@ TYPED_TEST(FFDGlobalBernsteinTest, DisplacementFormMatchesDeform)
       const Vec xd = ffdtest::ToRef(x);
       ffd::Vec3<Real> stu;
       ASSERT_TRUE(frame.Bind(x, stu)) << lat.Name() << " point " << p;
-      const Vec got = ffdtest::ToRef(x + ffd::EvaluateBernstein(dvalues.data(), lat.Dims().data(), stu));
+      const Vec got = ffdtest::ToRef(x + EvaluateBernstein(dvalues.data(), lat.Dims().data(), stu));
       const Vec want = ffdref::Deform(lat.F, lat.Points, lat.L, lat.M, lat.N, xd);
       const double tol = EvaluationTolerance<Real>() * (scale + MaxAbs(xd));
       worst.Add(MaxDiff(got, want), tol);
@@ -334,22 +338,13 @@ TYPED_TEST(FFDGlobalBernsteinTest, DegreeElevationLeavesDeformationUnchanged)
       for (int p = 0; p < 20; ++p)
       {
         const ffd::Vec3<Real> stu = ffdtest::ToKernel<Real>(ffdtest::RandomVec(rng, 0.0, 1.0));
-        const Vec got = ffdtest::ToRef(ffd::EvaluateBernstein(values.data(), e.Dims().data(), stu));
+        const Vec got = ffdtest::ToRef(EvaluateBernstein(values.data(), e.Dims().data(), stu));
         const Vec want = ffdref::Evaluate(lat.Points, lat.L, lat.M, lat.N, ffdtest::ToRef(stu));
         worst.Add(MaxDiff(got, want), tol);
         ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " elevated to " << e.Name() << ", point " << p;
       }
     }
   }
-}
-
-/// Gradient tolerance relative to max(lattice scale, largest derivative): 1e-6 in double (central
-/// differences with h = 1e-6 of a polynomial: truncation h^2 |f'''| / 6 and rounding eps/h, both far below),
-/// 1e-4 in float (the kernel's derivative sums n (B_{k-1} - B_k) P_k lose ~n^2 eps_float ~ 1e-5).
-template <typename Real>
-constexpr double GradientTolerance()
-{
-  return sizeof(Real) >= sizeof(double) ? 1e-6 : 1e-4;
 }
 
 TYPED_TEST(FFDGlobalBernsteinTest, GradientMatchesCentralDifferences)
@@ -370,7 +365,7 @@ TYPED_TEST(FFDGlobalBernsteinTest, GradientMatchesCentralDifferences)
       const ffd::Vec3<Real> stu = ffdtest::ToKernel<Real>(ffdtest::RandomVec(rng, 0.001, 0.999));
       const Vec s = ffdtest::ToRef(stu);
       ffd::Mat3<Real> g;
-      const Vec got = ffdtest::ToRef(ffd::EvaluateBernsteinWithGradient(values.data(), lat.Dims().data(), stu, g));
+      const Vec got = ffdtest::ToRef(EvaluateBernsteinWithGradient(values.data(), lat.Dims().data(), stu, g));
       const Vec want = ffdref::Evaluate(seen, lat.L, lat.M, lat.N, s);
       ASSERT_LE(MaxDiff(got, want), EvaluationTolerance<Real>() * scale) << lat.Name();
       for (int c = 0; c < 3; ++c)
@@ -415,7 +410,7 @@ TYPED_TEST(FFDGlobalBernsteinTest, DeformationJacobianMatchesCentralDifferences)
       ffd::Vec3<Real> stu;
       ASSERT_TRUE(frame.Bind(x, stu));
       ffd::Mat3<Real> g;
-      ffd::EvaluateBernsteinWithGradient(dvalues.data(), lat.Dims().data(), stu, g);
+      EvaluateBernsteinWithGradient(dvalues.data(), lat.Dims().data(), stu, g);
       const ffd::Mat3<Real> j = ffd::DeformationJacobian(g, frame);
       double fd[3][3];
       double jmax = 1.0;

@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""The global FFD pipeline driven from Python: vtkFFDVoxelize -> vtkFFDBuildLattice -> (numpy moves the lattice's
-points) -> vtkFFDDeform, on the real elephant mesh, checked against an independent float64 numpy reference of the
-paper's equations 2 and 3 written here.
+"""The FFD pipeline driven from Python: vtkFFDVoxelize -> vtkFFDBuildLattice -> (numpy moves the lattice's points)
+-> vtkFFDDeform, on the real elephant mesh, checked against independent float64 numpy references written here: the
+paper's equations 2 and 3 for the global basis, the definitions of the trilinear and cubic B-spline bases for the
+local ones (and their locality).
 
 Run with Debian's /usr/bin/python3, PYTHONPATH=<build>/lib/python3/dist-packages and VOXELFFD_MESH_DIR set to the
 folder of the meshes (ctest does both). Exits non-zero when a test fails.
@@ -223,6 +224,110 @@ class TestPipeline(unittest.TestCase):
         actor.SetPointRadius(0.125)
         actor.GetBounds()
         self.assertEqual(actor.GetRenderedPointRadius(), 0.125)
+
+
+def local_axis_weights(basis, voxels, s):
+    """Weights of every control point along an axis of `voxels` voxels at the parameters s (shape (P,), in
+    [0, 1]), as dense (P, points) arrays, from the bases' definitions as functions of the distance to each
+    control point's rest parameter, in voxel units: the trilinear hat max(0, 1 - |d|) centred on i/n, and the
+    uniform cubic B-spline centred on (i - 1)/n, (4 - 6d^2 + 3|d|^3)/6 for |d| < 1, (2 - |d|)^3/6 for
+    1 <= |d| < 2."""
+    x = s[:, None] * voxels
+    if basis == vtkffd.vtkFFDBuildLattice.TRILINEAR:
+        d = np.abs(x - np.arange(voxels + 1)[None, :])
+        return np.maximum(0.0, 1.0 - d)
+    d = np.abs(x - (np.arange(voxels + 3)[None, :] - 1))
+    return np.where(d < 1, (4 - 6 * d**2 + 3 * d**3) / 6, np.where(d < 2, (2 - d) ** 3 / 6, 0.0))
+
+
+class TestLocalBases(unittest.TestCase):
+    """A local basis through the pipeline with the lattice moved by numpy, against a numpy reference written
+    from the definitions, and its locality: moving one control point moves only the points in its support."""
+
+    DIVISIONS = (3, 4, 2)
+    BASES = (vtkffd.vtkFFDBuildLattice.TRILINEAR, vtkffd.vtkFFDBuildLattice.CUBIC_BSPLINE)
+
+    def setUp(self):
+        self.mesh = read_mesh("elephant")
+        self.mesh_points = vtk_to_numpy(self.mesh.GetPoints().GetData()).astype(np.float64)
+
+    def pipeline(self, basis):
+        """Voxelize -> build the lattice of `basis` -> a copy the test moves -> deform."""
+        voxelize = vtkffd.vtkFFDVoxelize()
+        voxelize.SetInputData(self.mesh)
+        voxelize.SetDivisions(*self.DIVISIONS)
+        build = vtkffd.vtkFFDBuildLattice()
+        build.SetInputConnection(voxelize.GetOutputPort())
+        build.SetBasis(basis)
+        build.Update()
+        lattice = vtkStructuredGrid()
+        lattice.DeepCopy(build.GetOutput())
+        deform = vtkffd.vtkFFDDeform()
+        deform.SetInputData(self.mesh)
+        deform.SetLatticeData(lattice)
+        deform.SetOutputPointsPrecision(vtkAlgorithm.DOUBLE_PRECISION)
+        return lattice, deform
+
+    def parameters(self, lattice):
+        """(s, t, u) of the mesh points: equation 2, by triple products."""
+        frame = vtk_to_numpy(lattice.GetFieldData().GetArray("FFDFrame")).astype(np.float64)
+        x0, s, t, u = frame[0:3], frame[3:6], frame[6:9], frame[9:12]
+        d = self.mesh_points - x0
+        tu, su, st = np.cross(t, u), np.cross(s, u), np.cross(s, t)
+        return [d @ tu / (s @ tu), d @ su / (t @ su), d @ st / (u @ st)], float(np.linalg.norm(s + t + u))
+
+    def reference(self, basis, lattice, rest):
+        """X + sum_ijk w_i(s) w_j(t) w_k(u) (P_ijk - P_ijk^rest) for the mesh points, all inside the frame."""
+        params, _ = self.parameters(lattice)
+        ws, wt, wu = (local_axis_weights(basis, n, np.clip(p, 0.0, 1.0)) for n, p in zip(self.DIVISIONS, params))
+        nk, nj, ni = wu.shape[1], wt.shape[1], ws.shape[1]
+        moved = (vtk_to_numpy(lattice.GetPoints().GetData()) - rest).reshape(nk, nj, ni, 3)
+        return self.mesh_points + np.einsum("pi,pj,pk,kjic->pc", ws, wt, wu, moved)
+
+    def test_local_basis_matches_numpy_reference(self):
+        for seed, basis in enumerate(self.BASES):
+            lattice, deform = self.pipeline(basis)
+            rest = vtk_to_numpy(lattice.GetPointData().GetArray("RestPosition")).copy()
+            _, diagonal = self.parameters(lattice)
+            points = vtk_to_numpy(lattice.GetPoints().GetData())
+            points += np.random.default_rng(seed).normal(scale=0.03 * diagonal, size=points.shape)
+            lattice.GetPoints().Modified()
+            deform.Update()
+            output = vtk_to_numpy(deform.GetOutput().GetPoints().GetData())
+            self.assertLessEqual(np.abs(output - self.reference(basis, lattice, rest)).max(),
+                                 RELATIVE_TOLERANCE * diagonal, basis)
+            self.assertGreater(np.abs(output - self.mesh_points).max(), 0.01 * diagonal, basis)
+
+    def test_moving_one_control_point_is_local(self):
+        rng = np.random.default_rng(2024)
+        for basis in self.BASES:
+            lattice, deform = self.pipeline(basis)
+            rest = vtk_to_numpy(lattice.GetPointData().GetArray("RestPosition")).copy()
+            params, diagonal = self.parameters(lattice)
+            # A control point that influences the voxel of a random mesh point: the voxel's first control point
+            # along each axis, plus 0 or 1 (trilinear), 0 to 3 (B-spline).
+            seed_point = rng.integers(len(self.mesh_points))
+            voxel = [min(int(p[seed_point] * n), n - 1) for p, n in zip(params, self.DIVISIONS)]
+            span = 2 if basis == vtkffd.vtkFFDBuildLattice.TRILINEAR else 4
+            i, j, k = (v + int(rng.integers(span)) for v in voxel)
+            ni, nj, _ = lattice.GetDimensions()
+            points = vtk_to_numpy(lattice.GetPoints().GetData())
+            points[i + ni * (j + nj * k)] += np.array([0.1, -0.05, 0.07]) * diagonal
+            lattice.GetPoints().Modified()
+            deform.Update()
+            output = vtk_to_numpy(deform.GetOutput().GetPoints().GetData())
+
+            # The support of control point (i, j, k), from the definitions: parameters within one voxel of its
+            # rest parameter i/n (trilinear), within two voxels of (i - 1)/n (B-spline), on every axis.
+            centre, reach = ((i, j, k), 1.0) if span == 2 else ((i - 1, j - 1, k - 1), 2.0)
+            in_support = np.all([np.abs(p * n - c) < reach for p, n, c in zip(params, self.DIVISIONS, centre)],
+                                axis=0)
+            changed = np.any(output != self.mesh_points, axis=1)
+            self.assertFalse(np.any(changed & ~in_support), basis)
+            self.assertTrue(changed[seed_point], basis)
+            self.assertLess(in_support.sum(), len(self.mesh_points), basis)
+            self.assertLessEqual(np.abs(output - self.reference(basis, lattice, rest)).max(),
+                                 RELATIVE_TOLERANCE * diagonal, basis)
 
 
 if __name__ == "__main__":

@@ -7,10 +7,16 @@
  * products of equation 2, absolute control-point positions P_ijk. It shares no code with Filters/Kernels
  * (which uses the de Casteljau triangle, a dual basis and the displacement form), so agreement between the two
  * is evidence, not an identity.
+ *
+ * The local bases (issue 3) follow the same rule: Bezier sub-regions are binomials times powers of the voxel's
+ * local coordinate, the uniform cubic B-spline is the Cox-de Boor recursion on integer knots (the kernels use
+ * closed-form polynomials), and DeformLocal finds the voxel itself and sums over every control point of the
+ * lattice (the kernels sum over the voxel's support only), in the absolute form sum w P.
  */
 #ifndef FFDReference_h
 #define FFDReference_h
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
@@ -93,6 +99,137 @@ inline Vec Evaluate(const std::vector<Vec>& p, int l, int m, int n, const Vec& s
 inline Vec Deform(const Frame& f, const std::vector<Vec>& p, int l, int m, int n, const Vec& x)
 {
   return Evaluate(p, l, m, n, Parameters(f, x));
+}
+
+/// The grid bases, numbered as the data contract's `FFDBasis` field array.
+enum class Basis : int
+{
+  Bernstein = 0,          ///< global, degree = voxels along the axis
+  Trilinear = 1,          ///< Bezier sub-regions of degree 1 (paper Listing 1)
+  TriquadraticBezier = 2, ///< Bezier sub-regions of degree 2
+  TricubicBezier = 3,     ///< Bezier sub-regions of degree 3 (paper Listing 2, equation 4)
+  CubicBSpline = 4,       ///< uniform cubic B-spline, one ring of control points beyond the frame
+};
+
+/// Degree of a basis's polynomials along an axis of n voxels.
+inline int Degree(Basis b, int n)
+{
+  return b == Basis::Bernstein ? n : (b == Basis::CubicBSpline ? 3 : int(b));
+}
+
+/// Control points along an axis of n voxels: neighbouring Bezier voxels share their face points, the B-spline
+/// has one extra point on each side.
+inline int PointsAlongAxis(Basis b, int n)
+{
+  return b == Basis::CubicBSpline ? n + 3 : Degree(b, n) * (b == Basis::Bernstein ? 1 : n) + 1;
+}
+
+/// Rest parameter of control point i: i/n (global), i/(d n) (Bezier of degree d), (i-1)/n (B-spline).
+inline double RestParameter(Basis b, int n, int i)
+{
+  if (b == Basis::CubicBSpline)
+  {
+    return double(i - 1) / n;
+  }
+  return double(i) / (PointsAlongAxis(b, n) - 1);
+}
+
+/// Cox-de Boor recursion on the integer knots t_j = j: the B-spline of degree p supported on [i, i+p+1].
+inline double UniformBSpline(int i, int p, double x)
+{
+  if (p == 0)
+  {
+    return (x >= i && x < i + 1) ? 1.0 : 0.0;
+  }
+  return (x - i) / p * UniformBSpline(i, p - 1, x) + (i + p + 1 - x) / p * UniformBSpline(i + 1, p - 1, x);
+}
+
+/**
+ * Weights of all PointsAlongAxis() control points along an axis of n voxels at the parameter s in [0, 1].
+ * Bezier: voxel c = floor(s n) (n - 1 at s = 1), local coordinate r = s n - c, weight C(d,i) r^i (1-r)^(d-i)
+ * on control point d c + i. B-spline: in voxel units x = s n the knots are the integers, control point i's
+ * cubic spans the knots i-3 .. i+1 (centred on its rest parameter (i-1)/n), so its weight is N(i-3, 3, x).
+ */
+inline std::vector<double> AxisWeights(Basis b, int n, double s)
+{
+  const int count = PointsAlongAxis(b, n);
+  std::vector<double> w(count, 0.0);
+  if (b == Basis::Bernstein)
+  {
+    for (int i = 0; i < count; ++i)
+    {
+      w[i] = Bernstein(n, i, s);
+    }
+  }
+  else if (b == Basis::CubicBSpline)
+  {
+    for (int i = 0; i < count; ++i)
+    {
+      w[i] = UniformBSpline(i - 3, 3, s * n);
+    }
+  }
+  else
+  {
+    const int d = Degree(b, n);
+    const int c = std::min(int(std::floor(s * n)), n - 1);
+    for (int i = 0; i <= d; ++i)
+    {
+      w[d * c + i] = Bernstein(d, i, s * n - c);
+    }
+  }
+  return w;
+}
+
+/// Rest positions X0 + RestParameter(i) S + RestParameter(j) T + RestParameter(k) U, VTK order.
+inline std::vector<Vec> RestLattice(Basis b, const Frame& f, const int divisions[3])
+{
+  std::vector<Vec> p;
+  for (int k = 0; k < PointsAlongAxis(b, divisions[2]); ++k)
+    for (int j = 0; j < PointsAlongAxis(b, divisions[1]); ++j)
+      for (int i = 0; i < PointsAlongAxis(b, divisions[0]); ++i)
+      {
+        const double a = RestParameter(b, divisions[0], i), e = RestParameter(b, divisions[1], j),
+                     c = RestParameter(b, divisions[2], k);
+        p.push_back({ f.X0[0] + a * f.S[0] + e * f.T[0] + c * f.U[0], f.X0[1] + a * f.S[1] + e * f.T[1] + c * f.U[1],
+          f.X0[2] + a * f.S[2] + e * f.T[2] + c * f.U[2] });
+      }
+  return p;
+}
+
+/// sum_ijk w_i(s) w_j(t) w_k(u) P_ijk over the whole lattice (absolute control points, VTK order), for
+/// parameters in [0, 1].
+inline Vec EvaluateLocal(Basis b, const int divisions[3], const std::vector<Vec>& p, const Vec& stu)
+{
+  const std::vector<double> ws = AxisWeights(b, divisions[0], stu[0]);
+  const std::vector<double> wt = AxisWeights(b, divisions[1], stu[1]);
+  const std::vector<double> wu = AxisWeights(b, divisions[2], stu[2]);
+  const int ni = int(ws.size()), nj = int(wt.size());
+  Vec x = { 0, 0, 0 };
+  for (int k = 0; k < int(wu.size()); ++k)
+    for (int j = 0; j < nj; ++j)
+      for (int i = 0; i < ni; ++i)
+      {
+        const double w = ws[i] * wt[j] * wu[k];
+        const Vec& q = p[i + ni * (j + nj * k)];
+        for (int c = 0; c < 3; ++c)
+        {
+          x[c] += w * q[c];
+        }
+      }
+  return x;
+}
+
+/// The deformed position of a world point inside the frame: equation 2, then EvaluateLocal. Parameters a
+/// rounding error outside [0, 1] (points on a face) are clamped to it.
+inline Vec DeformLocal(
+  Basis b, const Frame& f, const int divisions[3], const std::vector<Vec>& p, const Vec& x)
+{
+  Vec stu = Parameters(f, x);
+  for (double& v : stu)
+  {
+    v = std::min(std::max(v, 0.0), 1.0);
+  }
+  return EvaluateLocal(b, divisions, p, stu);
 }
 } // namespace ffdref
 

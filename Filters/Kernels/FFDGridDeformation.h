@@ -1,0 +1,166 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file FFDGridDeformation.h
+ * @brief Binding and per-point evaluation of a grid lattice's deformation, shared by the CPU and CUDA paths.
+ *
+ * Binding stores one int per point: the flat index ci + cx (cj + cy ck) of the cell the point lies in
+ * (BindingCells() per axis), or -1 for a point that keeps its position. The local coordinates are not stored:
+ * evaluation recomputes them from the point, which it reads anyway for the displacement form, in the point's
+ * own precision, so the binding costs 4 bytes per point and loses no digit of a double-precision point.
+ *
+ * Outside policy: a point outside the frame keeps its position, or, with clamping, takes the displacement of
+ * the nearest point of the frame (VTK's Edge border mode, Blender's lattice): the parameters are clamped to
+ * [0, 1], and the Jacobian loses the columns of the clamped directions.
+ */
+#ifndef FFDGridDeformation_h
+#define FFDGridDeformation_h
+
+#include "FFDGridBasis.h"
+
+#include <cmath>
+
+namespace ffd
+{
+
+namespace detail
+{
+template <typename Real>
+FFD_INLINE bool IsFinite(Real v)
+{
+  Real largest;
+  if constexpr (sizeof(Real) >= sizeof(double))
+  {
+    largest = Real(1.7976931348623157e308);
+  }
+  else
+  {
+    largest = Real(3.40282347e38f);
+  }
+  return v >= -largest && v <= largest; // false for NaN and infinities
+}
+} // namespace detail
+
+/**
+ * The cell a point is bound to, or -1 when it keeps its position: non-finite points, and points outside the
+ * frame (beyond ParametricTolerance()) unless clampOutside. `voxels` are the lattice's divisions.
+ */
+template <typename Real>
+FFD_INLINE int BindToGrid(
+  const Frame<Real>& frame, GridBasis basis, const int voxels[3], const Vec3<Real>& x, bool clampOutside)
+{
+  const Vec3<Real> stu = frame.ToParametric(x);
+  const Real p[3] = { stu.x, stu.y, stu.z };
+  const Real lo = -ParametricTolerance<Real>(), hi = Real(1) + ParametricTolerance<Real>();
+  int cell = 0;
+  for (int a = 2; a >= 0; --a)
+  {
+    if (!detail::IsFinite(p[a]) || (!clampOutside && !(p[a] >= lo && p[a] <= hi)))
+    {
+      return -1;
+    }
+    const int cells = BindingCells(basis, voxels[a]);
+    cell = cell * cells + CellOf(p[a] < Real(0) ? Real(0) : (p[a] > Real(1) ? Real(1) : p[a]), cells);
+  }
+  return cell;
+}
+
+/**
+ * dX_ffd/dX of the displacement form X_ffd = X + D(s(X), t(X), u(X)): I + dD/d(s,t,u) * d(s,t,u)/dX, where
+ * displacementGradient's columns are dD/ds, dD/dt and dD/du.
+ */
+template <typename Real>
+FFD_INLINE Mat3<Real> DeformationJacobian(const Mat3<Real>& displacementGradient, const Frame<Real>& frame)
+{
+  Mat3<Real> j = displacementGradient * frame.ParametricGradient();
+  j.M[0][0] += Real(1);
+  j.M[1][1] += Real(1);
+  j.M[2][2] += Real(1);
+  return j;
+}
+
+/**
+ * A unit normal carried by the deformation: the cofactor of the Jacobian times it (see Cofactor()),
+ * renormalized; unchanged where that product vanishes.
+ */
+template <typename Real>
+FFD_INLINE Vec3<Real> TransformNormal(const Mat3<Real>& jacobian, const Vec3<Real>& normal)
+{
+  const Vec3<Real> m = Cofactor(jacobian) * normal;
+  const Real length = std::sqrt(Dot(m, m));
+  return length > Real(0) ? (Real(1) / length) * m : normal;
+}
+
+/**
+ * A grid lattice's deformation, as plain data that host and device code evaluate alike. MaxCount bounds the
+ * control points per axis that influence a point: 4 covers every local basis (and global ones up to degree 3),
+ * MaxBernsteinDegree + 1 every global one; callers pick it from the basis (vtkFFDDeform, the CUDA backend).
+ * StaticBasis, when not -1, is the basis known at compile time (it must equal Basis): the compiler then drops
+ * the other bases' branches and unrolls the fixed-size sums, which made the local bases 2-3 times faster.
+ */
+template <int MaxCount, typename Real, int StaticBasis = -1>
+struct GridDeformation
+{
+  GridBasis Basis;
+  int Voxels[3];             ///< the lattice's divisions
+  int Dims[3];               ///< control points per axis
+  const Real* Displacements; ///< 3 per control point, VTK order: the lattice's points minus RestPosition
+  ffd::Frame<Real> Frame;
+
+  /// X + D(s, t, u) for a point bound to `cell` (not -1).
+  FFD_INLINE Vec3<Real> Deform(const Vec3<Real>& x, int cell) const
+  {
+    AxisWeights<MaxCount, Real> axes[3];
+    this->Weights(x, cell, false, axes, nullptr);
+    return x + SumTensorProduct(this->Displacements, this->Dims, axes);
+  }
+
+  /// Deform() and the Jacobian dX_ffd/dX there.
+  FFD_INLINE Vec3<Real> Deform(const Vec3<Real>& x, int cell, Mat3<Real>& jacobian) const
+  {
+    AxisWeights<MaxCount, Real> axes[3];
+    bool clamped[3];
+    this->Weights(x, cell, true, axes, clamped);
+    Mat3<Real> gradient;
+    const Vec3<Real> d = SumTensorProductWithGradient(this->Displacements, this->Dims, axes, gradient);
+    for (int a = 0; a < 3; ++a)
+    {
+      if (clamped[a]) // the displacement does not change along a clamped direction
+      {
+        gradient.M[0][a] = gradient.M[1][a] = gradient.M[2][a] = Real(0);
+      }
+    }
+    jacobian = DeformationJacobian(gradient, this->Frame);
+    return x + d;
+  }
+
+private:
+  FFD_INLINE void Weights(const Vec3<Real>& x, int cell, bool withDerivative, AxisWeights<MaxCount, Real>* axes,
+    bool* clamped) const
+  {
+    const Vec3<Real> stu = this->Frame.ToParametric(x);
+    const Real p[3] = { stu.x, stu.y, stu.z };
+    const Real lo = -ParametricTolerance<Real>(), hi = Real(1) + ParametricTolerance<Real>();
+    const GridBasis basis = StaticBasis >= 0 ? static_cast<GridBasis>(StaticBasis) : this->Basis;
+    FFD_UNROLL
+    for (int a = 0; a < 3; ++a)
+    {
+      int c = cell; // the last axis takes what is left: no division
+      if (a < 2)
+      {
+        const int cells = BindingCells(basis, this->Voxels[a]);
+        c = cell % cells;
+        cell /= cells;
+      }
+      if (clamped)
+      {
+        clamped[a] = !(p[a] >= lo && p[a] <= hi);
+      }
+      const Real s = p[a] < Real(0) ? Real(0) : (p[a] > Real(1) ? Real(1) : p[a]);
+      ComputeAxisWeights(basis, this->Voxels[a], c, s, withDerivative, axes[a]);
+    }
+  }
+};
+
+} // namespace ffd
+
+#endif

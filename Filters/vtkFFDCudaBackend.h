@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkFFDCudaBackend
+ * @brief   vtkFFDDeform's glue to the CUDA backend (Filters/CUDA): residency, precision, array layout
+ *
+ * Private to the Filters module (not wrapped). It keeps one ffd::cuda::GridDeformer per vtkFFDDeform, uploads the
+ * input's points and normals only when they change, re-binds only when they or the lattice's rest frame, shape
+ * or the outside policy change (the same key as the CPU binding, vtkFFDBindingKey), and on an update uploads
+ * only the lattice's displacements and downloads straight into the output arrays.
+ *
+ * In a build without CUDA every call answers "not available", so vtkFFDDeform needs no conditional code.
+ */
+#ifndef vtkFFDCudaBackend_h
+#define vtkFFDCudaBackend_h
+
+#include "vtkType.h"
+
+#include <array>
+#include <memory>
+#include <string>
+
+class vtkDataArray;
+class vtkPoints;
+
+/// What a binding was computed for: the input's points (identity, modification time, count), the lattice's rest
+/// frame, divisions and basis, and the outside policy. Points are compared by identity and modification time (a
+/// new vtkPoints at a recycled address has a newer MTime); the lattice by values, so that a rebuilt but
+/// identical lattice keeps the binding.
+struct vtkFFDBindingKey
+{
+  const vtkPoints* Points = nullptr;
+  vtkMTimeType PointsMTime = 0;
+  vtkIdType NumberOfPoints = -1;
+  std::array<double, 12> Frame{};
+  std::array<int, 3> Divisions{};
+  int Basis = -1;
+  int OutsidePolicy = -1;
+
+  static vtkFFDBindingKey Of(
+    vtkPoints* points, const double frame[12], const int divisions[3], int basis, int outsidePolicy);
+  bool operator==(const vtkFFDBindingKey& other) const;
+  bool operator!=(const vtkFFDBindingKey& other) const { return !(*this == other); }
+};
+
+class vtkFFDCudaBackend
+{
+public:
+  vtkFFDCudaBackend();
+  ~vtkFFDCudaBackend();
+  vtkFFDCudaBackend(const vtkFFDCudaBackend&) = delete;
+  vtkFFDCudaBackend& operator=(const vtkFFDCudaBackend&) = delete;
+
+  /// True when this build has the CUDA backend and a device can be used; otherwise false and why not.
+  static bool IsAvailable(std::string& why);
+
+  /**
+   * Deforms on the device: the input's points (and normals, 3 components, may be null) bound per `key` to a grid
+   * lattice (frame, basis, divisions, outside policy), displaced by `displacements` (3 per control point). The
+   * results go to outPoints (a float or double AOS array with the points' count of tuples: the evaluation's
+   * precision), outNormals and outDeterminants (of outPoints' type) when not null. `bound` tells whether the
+   * points were (re)bound. On any failure: false, the reason in `why`, the outputs to be discarded, and no
+   * device state kept.
+   */
+  bool Deform(const vtkFFDBindingKey& key, vtkPoints* points, vtkDataArray* normals, const double* displacements,
+    vtkIdType controlPoints, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
+    bool& bound, std::string& why);
+
+private:
+  struct vtkState;
+  std::unique_ptr<vtkState> State;
+};
+
+#endif

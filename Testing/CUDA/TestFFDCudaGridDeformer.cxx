@@ -1,0 +1,272 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The CUDA backend against the CPU path (the same Filters/Kernels functions run on the host) for every grid
+// basis, on fresh random inputs with fixed seeds; device residency (what is uploaded on an update); failures.
+// Without a CUDA device every test skips.
+#include "FFDCudaGridDeformer.h"
+#include "FFDGridDeformation.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace
+{
+#define FFD_REQUIRE_DEVICE()                                                                                     \
+  do                                                                                                             \
+  {                                                                                                              \
+    std::string why;                                                                                             \
+    if (!ffd::cuda::DeviceAvailable(&why))                                                                       \
+    {                                                                                                            \
+      GTEST_SKIP() << why;                                                                                       \
+    }                                                                                                            \
+  } while (false)
+
+// A random problem: a skewed frame, divisions, points (mostly inside, some outside, a few non-finite) and
+// displacements of up to a fifth of the frame.
+struct Problem
+{
+  double Frame[12];
+  int Divisions[3];
+  int Basis;
+  int Dims[3];
+  std::vector<double> Points;
+  std::vector<float> Normals;
+  std::vector<double> Displacements;
+
+  Problem(int basis, std::int64_t count, std::mt19937& rng)
+    : Basis(basis)
+  {
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    std::uniform_int_distribution<int> divisions(1, basis == int(ffd::GridBasis::Bernstein) ? 6 : 5);
+    const double base[12] = { -1, -2, 0.5, 2, 0, 0, 0, 3, 0, 0, 0, 1.5 };
+    for (int c = 0; c < 12; ++c)
+    {
+      this->Frame[c] = base[c] + 0.2 * unit(rng);
+    }
+    const ffd::Frame<double> frame = ffd::Frame<double>::FromArray(this->Frame);
+    std::int64_t controlPoints = 1;
+    for (int a = 0; a < 3; ++a)
+    {
+      this->Divisions[a] = divisions(rng);
+      this->Dims[a] = ffd::ControlPointsAlongAxis(ffd::GridBasis(basis), this->Divisions[a]);
+      controlPoints *= this->Dims[a];
+    }
+    // Parameters keep 1e-4 away from the frame's faces: within float32 rounding of the band that counts as
+    // inside (1e-5 wide in float32), the two sides could clamp differently and so differ in their Jacobians.
+    std::uniform_real_distribution<double> parameter(-0.1, 1.1);
+    auto draw = [&] {
+      double v;
+      do
+      {
+        v = parameter(rng);
+      } while (std::fabs(v) < 1e-4 || std::fabs(v - 1.0) < 1e-4);
+      return v;
+    };
+    for (std::int64_t i = 0; i < count; ++i)
+    {
+      const ffd::Vec3<double> x = frame.ToWorld({ draw(), draw(), draw() });
+      this->Points.insert(this->Points.end(), { x.x, x.y, x.z });
+      const ffd::Vec3<double> n = { unit(rng), unit(rng), unit(rng) };
+      const double length = std::sqrt(ffd::Dot(n, n)) + 1e-3;
+      this->Normals.insert(this->Normals.end(), { float(n.x / length), float(n.y / length), float(n.z / length) });
+    }
+    this->Points[3 * 7] = std::numeric_limits<double>::quiet_NaN();
+    this->Points[3 * 11 + 1] = std::numeric_limits<double>::infinity();
+    for (std::int64_t v = 0; v < 3 * controlPoints; ++v)
+    {
+      this->Displacements.push_back(0.2 * unit(rng));
+    }
+  }
+
+  std::int64_t Count() const { return std::int64_t(this->Points.size() / 3); }
+  std::int64_t ControlPoints() const { return std::int64_t(this->Dims[0]) * this->Dims[1] * this->Dims[2]; }
+};
+
+// The CPU path: the same kernels on the host, in the precision Real of the GPU run (the binding in double, as
+// on both backends).
+template <int MaxCount, typename Real>
+void CpuDeform(const Problem& p, bool clampOutside, std::vector<double>& points, std::vector<double>& normals,
+  std::vector<double>& determinants, std::vector<double>& jacobianScales)
+{
+  const ffd::Frame<double> binding = ffd::Frame<double>::FromArray(p.Frame);
+  const std::vector<Real> displacements(p.Displacements.begin(), p.Displacements.end());
+  const ffd::GridDeformation<MaxCount, Real> deformation{ ffd::GridBasis(p.Basis),
+    { p.Divisions[0], p.Divisions[1], p.Divisions[2] }, { p.Dims[0], p.Dims[1], p.Dims[2] },
+    displacements.data(), ffd::Frame<Real>::FromArray(p.Frame) };
+  for (std::int64_t i = 0; i < p.Count(); ++i)
+  {
+    const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&p.Points[3 * i]);
+    const int cell = ffd::BindToGrid(binding, ffd::GridBasis(p.Basis), p.Divisions,
+      { double(x.x), double(x.y), double(x.z) }, clampOutside);
+    ffd::Mat3<Real> j = ffd::Mat3<Real>::Identity();
+    const ffd::Vec3<Real> y = cell >= 0 ? deformation.Deform(x, cell, j) : x;
+    const ffd::Vec3<Real> n = ffd::TransformNormal(j, ffd::Vec3<Real>::From(&p.Normals[3 * i]));
+    points.insert(points.end(), { double(y.x), double(y.y), double(y.z) });
+    normals.insert(normals.end(), { double(n.x), double(n.y), double(n.z) });
+    determinants.push_back(double(ffd::Determinant(j)));
+    // The size of det(J)'s terms, |J e0| |J e1| |J e2|: the scale its rounding error is relative to.
+    double scale = 1.0;
+    for (int c = 0; c < 3; ++c)
+    {
+      scale *= std::sqrt(double(j.M[0][c] * j.M[0][c] + j.M[1][c] * j.M[1][c] + j.M[2][c] * j.M[2][c]));
+    }
+    jacobianScales.push_back(scale);
+  }
+}
+
+template <typename Real>
+void CpuDeform(const Problem& p, bool clampOutside, std::vector<double>& points, std::vector<double>& normals,
+  std::vector<double>& determinants, std::vector<double>& jacobianScales)
+{
+  if (p.Basis == int(ffd::GridBasis::Bernstein))
+  {
+    CpuDeform<ffd::MaxBernsteinDegree + 1, Real>(p, clampOutside, points, normals, determinants, jacobianScales);
+  }
+  else
+  {
+    CpuDeform<4, Real>(p, clampOutside, points, normals, determinants, jacobianScales);
+  }
+}
+
+bool Same(double a, double b, double tolerance)
+{
+  return (std::isnan(a) && std::isnan(b)) || (std::isinf(a) && a == b) || std::fabs(a - b) <= tolerance;
+}
+
+template <typename Real>
+class CudaGridDeformerTest : public ::testing::Test
+{
+};
+using RealTypes = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(CudaGridDeformerTest, RealTypes);
+
+// GPU and CPU agree for every basis and outside policy, each in the precision of the points. Tolerance: 1e-5
+// relative to the frame's scale (about 3) in float32, the bound, and 1e-12 in double (the same
+// operations; only the compilers' contraction into FMAs differs). Outputs are poisoned first, so unwritten
+// values are caught.
+TYPED_TEST(CudaGridDeformerTest, MatchesCpuForEveryBasis)
+{
+  FFD_REQUIRE_DEVICE();
+  using Real = TypeParam;
+  const double tolerance = (sizeof(Real) == sizeof(float) ? 1e-5 : 1e-12) * 3.0;
+  std::mt19937 rng(4242);
+  for (int basis = 0; basis <= int(ffd::GridBasis::CubicBSpline); ++basis)
+  {
+    for (bool clamp : { false, true })
+    {
+      const Problem p(basis, 100003, rng); // not a multiple of the block size
+      std::vector<double> cpuPoints, cpuNormals, cpuDeterminants, jacobianScales;
+      CpuDeform<Real>(p, clamp, cpuPoints, cpuNormals, cpuDeterminants, jacobianScales);
+
+      const std::vector<Real> points(p.Points.begin(), p.Points.end());
+      ffd::cuda::GridDeformer gpu;
+      ASSERT_TRUE(gpu.SetPoints(points.data(), p.Count())) << gpu.GetLastError();
+      ASSERT_TRUE(gpu.SetNormals(p.Normals.data())) << gpu.GetLastError();
+      ASSERT_TRUE(gpu.Bind(p.Frame, basis, p.Divisions, clamp)) << gpu.GetLastError();
+      const Real poison = Real(-12345.0);
+      std::vector<Real> outPoints(points.size(), poison), outDeterminants(p.Count(), poison);
+      std::vector<float> outNormals(points.size(), float(poison));
+      ASSERT_TRUE(gpu.Evaluate(p.Displacements.data(), p.ControlPoints(), true, true)) << gpu.GetLastError();
+      ASSERT_TRUE(gpu.Download(outPoints.data(), outNormals.data(), outDeterminants.data())) << gpu.GetLastError();
+
+      // Normals and det(J) carry the rounding of the Jacobian, which the conditioning of J amplifies: det(J)
+      // within 1e-5 in float32 (1e-12 in double) of the size of its terms, |J e0||J e1||J e2|; unit normals
+      // within 1e-5 times the ratio of that size to |det J| (a bound on J's condition number) in float32, and
+      // 1e-6 in double (normals cross the bus as float32).
+      const bool single = sizeof(Real) == sizeof(float);
+      std::int64_t wrong = 0;
+      std::string firstWrong;
+      auto check = [&](const char* what, std::int64_t i, double got, double expected, double tol) {
+        if (!Same(got, expected, tol))
+        {
+          if (wrong++ < 5)
+          {
+            firstWrong += std::string(what) + " of point " + std::to_string(i) + ": " + std::to_string(got) +
+              " vs " + std::to_string(expected) + "; ";
+          }
+        }
+      };
+      for (std::int64_t i = 0; i < p.Count(); ++i)
+      {
+        for (int c = 0; c < 3; ++c)
+        {
+          check("position", i, double(outPoints[3 * i + c]), cpuPoints[3 * i + c], tolerance);
+          const double conditioning = jacobianScales[i] / std::max(std::fabs(cpuDeterminants[i]), 1e-300);
+          check("normal", i, outNormals[3 * i + c], cpuNormals[3 * i + c], single ? 1e-5 * conditioning : 1e-6);
+        }
+        check("det", i, double(outDeterminants[i]), cpuDeterminants[i],
+          (single ? 1e-5 : 1e-12) * std::max(1.0, jacobianScales[i]));
+      }
+      EXPECT_EQ(wrong, 0) << "basis " << basis << (clamp ? " clamped" : " kept") << ": " << firstWrong;
+    }
+  }
+}
+
+// Only the lattice crosses the bus on an update: the points and the binding stay on the device.
+TEST(CudaGridDeformer, UpdatesUploadOnlyTheLattice)
+{
+  FFD_REQUIRE_DEVICE();
+  std::mt19937 rng(7);
+  const Problem p(int(ffd::GridBasis::CubicBSpline), 50000, rng);
+  const std::vector<float> points(p.Points.begin(), p.Points.end());
+  ffd::cuda::GridDeformer gpu;
+  ASSERT_TRUE(gpu.SetPoints(points.data(), p.Count()));
+  ASSERT_TRUE(gpu.Bind(p.Frame, p.Basis, p.Divisions, false));
+  std::vector<float> first(points.size(), -1.0f), second(points.size(), -1.0f);
+  ASSERT_TRUE(gpu.Evaluate(p.Displacements.data(), p.ControlPoints(), false, false));
+  ASSERT_TRUE(gpu.Download(first.data(), nullptr, nullptr));
+  std::vector<double> moved = p.Displacements;
+  moved[3 * (p.ControlPoints() / 2)] += 0.5;
+  ASSERT_TRUE(gpu.Evaluate(moved.data(), p.ControlPoints(), false, false));
+  ASSERT_TRUE(gpu.Download(second.data(), nullptr, nullptr));
+
+  const ffd::cuda::Counters& c = gpu.GetCounters();
+  EXPECT_EQ(c.PointUploads, 1u);
+  EXPECT_EQ(c.Bindings, 1u);
+  EXPECT_EQ(c.LatticeUploads, 2u);
+  EXPECT_EQ(c.LatticeBytes, 2u * std::uint64_t(p.ControlPoints()) * 3 * sizeof(float));
+  EXPECT_EQ(c.BytesDownloaded, 2u * points.size() * sizeof(float));
+  EXPECT_NE(first, second); // the moved control point moved some points
+}
+
+// Failures are reported, leave no device state behind, and a later use starts clean.
+TEST(CudaGridDeformer, FailuresAreReportedAndRecoverable)
+{
+  FFD_REQUIRE_DEVICE();
+  ffd::cuda::GridDeformer gpu;
+  std::vector<float> out(30);
+  EXPECT_FALSE(gpu.Evaluate(nullptr, 0, false, false)); // nothing bound
+  EXPECT_NE(gpu.GetLastError().find("no points bound"), std::string::npos) << gpu.GetLastError();
+
+  // Out of device memory: 2^42 points would need 48 TiB; the allocation fails before anything is read.
+  EXPECT_FALSE(gpu.SetPoints(out.data(), std::int64_t(1) << 42));
+  EXPECT_NE(gpu.GetLastError().find("allocating the points"), std::string::npos) << gpu.GetLastError();
+
+  std::mt19937 rng(9);
+  const Problem p(int(ffd::GridBasis::Trilinear), 10, rng);
+  const std::vector<float> points(p.Points.begin(), p.Points.end());
+  ASSERT_TRUE(gpu.SetPoints(points.data(), p.Count())) << gpu.GetLastError();
+  ASSERT_TRUE(gpu.Bind(p.Frame, p.Basis, p.Divisions, false)) << gpu.GetLastError();
+  EXPECT_FALSE(gpu.Evaluate(p.Displacements.data(), p.ControlPoints() + 1, false, false)); // wrong lattice
+  EXPECT_FALSE(gpu.Download(out.data(), nullptr, nullptr)); // the failure dropped the device state
+}
+
+// Without a device the backend says so instead of crashing (this runs on machines without a GPU).
+TEST(CudaGridDeformer, DeviceQueryNeverCrashes)
+{
+  std::string why;
+  const bool available = ffd::cuda::DeviceAvailable(&why);
+  EXPECT_TRUE(available || !why.empty());
+  if (!available)
+  {
+    ffd::cuda::GridDeformer gpu;
+    std::vector<float> points(30, 0.0f);
+    EXPECT_FALSE(gpu.SetPoints(points.data(), 10));
+    EXPECT_FALSE(gpu.GetLastError().empty());
+  }
+}
+} // namespace
