@@ -28,6 +28,7 @@ FFD_INLINE void BernsteinRaise(int j, Real x, Real* b)
 {
   const Real y = Real(1) - x;
   Real carry = Real(0);
+  FFD_UNROLL
   for (int k = 0; k < j; ++k)
   {
     const Real v = b[k];
@@ -45,6 +46,25 @@ FFD_INLINE void BernsteinBasis(int n, Real x, Real* b)
   b[0] = Real(1);
   for (int j = 1; j <= n; ++j)
   {
+    detail::BernsteinRaise(j, x, b);
+  }
+}
+
+/**
+ * BernsteinBasis() for degrees n < MaxCount, with every loop bounded at compile time so that a GPU keeps the
+ * MaxCount entries of b in registers.
+ */
+template <int MaxCount, typename Real>
+FFD_INLINE void BernsteinBasisBounded(int n, Real x, Real* b)
+{
+  b[0] = Real(1);
+  FFD_UNROLL
+  for (int j = 1; j < MaxCount; ++j)
+  {
+    if (j > n)
+    {
+      break;
+    }
     detail::BernsteinRaise(j, x, b);
   }
 }

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -41,7 +42,9 @@ struct Problem
     : Basis(basis)
   {
     std::uniform_real_distribution<double> unit(-1.0, 1.0);
-    std::uniform_int_distribution<int> divisions(1, basis == int(ffd::GridBasis::Bernstein) ? 6 : 5);
+    // Global degrees up to 15 reach both instantiations of the GPU's own kernel for the global basis (up to 8
+    // and 16 control points per axis) and, past its 48 KB of shared memory, the generic one.
+    std::uniform_int_distribution<int> divisions(1, basis == int(ffd::GridBasis::Bernstein) ? 15 : 5);
     const double base[12] = { -1, -2, 0.5, 2, 0, 0, 0, 3, 0, 0, 0, 1.5 };
     for (int c = 0; c < 12; ++c)
     {
@@ -200,6 +203,15 @@ TYPED_TEST(CudaGridDeformerTest, MatchesCpuForEveryBasis)
         }
         check("det", i, double(outDeterminants[i]), cpuDeterminants[i],
           (single ? 1e-5 : 1e-12) * std::max(1.0, jacobianScales[i]));
+      }
+      // Without normals and determinants the global basis takes its own kernel (BernsteinKernel): the points
+      // alone, evaluated again into a freshly poisoned buffer.
+      std::fill(outPoints.begin(), outPoints.end(), poison);
+      ASSERT_TRUE(gpu.Evaluate(p.Displacements.data(), p.ControlPoints(), false, false)) << gpu.GetLastError();
+      ASSERT_TRUE(gpu.Download(outPoints.data(), nullptr, nullptr)) << gpu.GetLastError();
+      for (std::size_t v = 0; v < outPoints.size(); ++v)
+      {
+        check("position without Jacobian", std::int64_t(v / 3), double(outPoints[v]), cpuPoints[v], tolerance);
       }
       EXPECT_EQ(wrong, 0) << "basis " << basis << (clamp ? " clamped" : " kept") << ": " << firstWrong;
     }
