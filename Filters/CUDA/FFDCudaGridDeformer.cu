@@ -419,19 +419,26 @@ struct GridDeformer::Impl
     float* normalsOut = withNormals ? this->OutNormals.As<float>() : nullptr;
     Real* determinantsOut = withDeterminants ? this->OutDeterminants.As<Real>() : nullptr;
     Check(cudaEventRecord(this->KernelStart, this->Stream), "recording an event");
-    if (this->LaunchBernstein(d, dims, withNormals || withDeterminants))
+    if (!this->LaunchBernstein(d, dims, withNormals || withDeterminants))
     {
-      Check(cudaGetLastError(), "launching the evaluation");
-      Check(cudaEventRecord(this->KernelStop, this->Stream), "recording an event");
-      Check(cudaStreamSynchronize(this->Stream), "evaluating");
-      Check(cudaEventElapsedTime(&this->Counts.LastKernelMilliseconds, this->KernelStart, this->KernelStop),
-        "timing the evaluation");
-      this->Evaluated = true;
-      this->EvaluatedNormals = withNormals;
-      this->EvaluatedDeterminants = withDeterminants;
-      ++this->Counts.Evaluations;
-      return;
+      this->LaunchGeneric(frame, d, dims, normalsOut, determinantsOut);
     }
+    Check(cudaGetLastError(), "launching the evaluation");
+    Check(cudaEventRecord(this->KernelStop, this->Stream), "recording an event");
+    Check(cudaStreamSynchronize(this->Stream), "evaluating");
+    Check(cudaEventElapsedTime(&this->Counts.LastKernelMilliseconds, this->KernelStart, this->KernelStop),
+      "timing the evaluation");
+    this->Evaluated = true;
+    this->EvaluatedNormals = withNormals;
+    this->EvaluatedDeterminants = withDeterminants;
+    ++this->Counts.Evaluations;
+  }
+
+  // Launches DeformKernel, one instantiation per basis (see ffd::GridDeformation's StaticBasis).
+  template <typename Real>
+  void LaunchGeneric(const ffd::Frame<Real>& frame, const Real* d, const int dims[3], float* normalsOut,
+    Real* determinantsOut)
+  {
     // One kernel per basis (see ffd::GridDeformation's StaticBasis). The global basis sums over every control
     // point of an axis, a local one over at most 4.
     auto launch = [&](auto maxCount, auto basis) {
@@ -463,15 +470,6 @@ struct GridDeformer::Impl
         launch(Local(), std::integral_constant<int, int(GridBasis::CubicBSpline)>());
         break;
     }
-    Check(cudaGetLastError(), "launching the evaluation");
-    Check(cudaEventRecord(this->KernelStop, this->Stream), "recording an event");
-    Check(cudaStreamSynchronize(this->Stream), "evaluating");
-    Check(cudaEventElapsedTime(&this->Counts.LastKernelMilliseconds, this->KernelStart, this->KernelStop),
-      "timing the evaluation");
-    this->Evaluated = true;
-    this->EvaluatedNormals = withNormals;
-    this->EvaluatedDeterminants = withDeterminants;
-    ++this->Counts.Evaluations;
   }
 
   // Launches BernsteinKernel when it applies: the global basis in float32, no Jacobian asked for, at most 16
