@@ -22,9 +22,7 @@
 #include "FFDGridDeformation.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <limits>
 #include <sstream>
 #include <string>
 #include <type_traits>
