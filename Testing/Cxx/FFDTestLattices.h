@@ -224,6 +224,27 @@ inline double Det(const Matrix& a)
     { a[0][0], a[0][1], a[0][2] }, ffdref::Cross({ a[1][0], a[1][1], a[1][2] }, { a[2][0], a[2][1], a[2][2] }));
 }
 
+/// The unit normal J^-T n of a Jacobian J: the cofactor matrix (its columns cross products of J's columns)
+/// times n over det J, normalized.
+inline Vec TransformedNormal(const Matrix& j, const Vec& n)
+{
+  const Vec c0 = ffdref::Cross({ j[0][1], j[1][1], j[2][1] }, { j[0][2], j[1][2], j[2][2] });
+  const Vec c1 = ffdref::Cross({ j[0][2], j[1][2], j[2][2] }, { j[0][0], j[1][0], j[2][0] });
+  const Vec c2 = ffdref::Cross({ j[0][0], j[1][0], j[2][0] }, { j[0][1], j[1][1], j[2][1] });
+  const double d = Det(j);
+  Vec expected;
+  for (int r = 0; r < 3; ++r)
+  {
+    expected[r] = (c0[r] * n[0] + c1[r] * n[1] + c2[r] * n[2]) / d;
+  }
+  const double length = Length(expected);
+  for (double& e : expected)
+  {
+    e /= length;
+  }
+  return expected;
+}
+
 // The whole pipeline: vtkFFDVoxelize (axis-aligned frame) -> vtkFFDBuildLattice(basis) -> a deep copy of the
 // lattice, which the test moves -> vtkFFDDeform.
 struct Pipeline

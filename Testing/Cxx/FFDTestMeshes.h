@@ -12,6 +12,7 @@
 #include "vtkXMLPolyDataReader.h"
 
 #include <fstream>
+#include <iostream>
 #include <stdexcept>
 #include <string>
 
@@ -32,6 +33,21 @@ inline vtkSmartPointer<vtkPolyData> ReadTestMesh(const std::string& name)
     throw std::runtime_error(path + " holds no points");
   }
   return mesh;
+}
+
+/// ReadTestMesh() for VTK-style tests, which report failure by their return value: the mesh, or nullptr after
+/// printing why on stderr.
+inline vtkSmartPointer<vtkPolyData> ReadTestMeshOrReport(const std::string& name)
+{
+  try
+  {
+    return ReadTestMesh(name);
+  }
+  catch (const std::exception& e)
+  {
+    std::cerr << e.what() << "\n";
+    return nullptr;
+  }
 }
 
 #endif

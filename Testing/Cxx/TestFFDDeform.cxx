@@ -285,21 +285,8 @@ TEST(vtkFFDDeform, NormalsAndJacobianDeterminantMatchFiniteDifferences)
     withNormals->GetPointData()->GetNormals()->GetTuple(i, n.data());
     outNormals->GetTuple(i, m.data());
     const auto j = ReferenceJacobian(f, p, deg, x, h);
-    // J^-T n = (cofactor matrix / det) n; its columns are cross products of J's columns.
-    const Vec c0 = ffdref::Cross({ j[0][1], j[1][1], j[2][1] }, { j[0][2], j[1][2], j[2][2] });
-    const Vec c1 = ffdref::Cross({ j[0][2], j[1][2], j[2][2] }, { j[0][0], j[1][0], j[2][0] });
-    const Vec c2 = ffdref::Cross({ j[0][0], j[1][0], j[2][0] }, { j[0][1], j[1][1], j[2][1] });
     const double d = Det(j);
-    Vec expected;
-    for (int r = 0; r < 3; ++r)
-    {
-      expected[r] = (c0[r] * n[0] + c1[r] * n[1] + c2[r] * n[2]) / d;
-    }
-    const double len = Length(expected);
-    for (double& e : expected)
-    {
-      e /= len;
-    }
+    const Vec expected = TransformedNormal(j, n);
     worstNormal = std::max(worstNormal, Length(ffdref::Sub(m, expected)));
     worstDet = std::max(worstDet, std::fabs(det->GetTuple1(i) - d) / std::fabs(d));
   }

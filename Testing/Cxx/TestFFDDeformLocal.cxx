@@ -518,21 +518,8 @@ TEST(vtkFFDDeformLocal, NormalsAndJacobianDeterminantMatchFiniteDifferences)
       inNormals->GetTuple(i, nIn.data());
       outNormals->GetTuple(i, nOut.data());
       const Matrix j = ref.Jacobian(x, h);
-      // J^-T n is the cofactor matrix times n over det J; the cofactor's columns are crosses of J's columns.
-      const Vec c0 = ffdref::Cross({ j[0][1], j[1][1], j[2][1] }, { j[0][2], j[1][2], j[2][2] });
-      const Vec c1 = ffdref::Cross({ j[0][2], j[1][2], j[2][2] }, { j[0][0], j[1][0], j[2][0] });
-      const Vec c2 = ffdref::Cross({ j[0][0], j[1][0], j[2][0] }, { j[0][1], j[1][1], j[2][1] });
       const double d = Det(j);
-      Vec expected;
-      for (int r = 0; r < 3; ++r)
-      {
-        expected[r] = (c0[r] * nIn[0] + c1[r] * nIn[1] + c2[r] * nIn[2]) / d;
-      }
-      const double length = Length(expected);
-      for (double& e : expected)
-      {
-        e /= length;
-      }
+      const Vec expected = TransformedNormal(j, nIn);
       worstNormal = std::max(worstNormal, Length(ffdref::Sub(nOut, expected)));
       worstDet = std::max(worstDet, std::fabs(det->GetTuple1(i) - d) / std::max(1.0, std::fabs(d)));
     }

@@ -23,7 +23,6 @@
 #include "vtkTesting.h"
 
 #include <cstdlib>
-#include <exception>
 #include <iostream>
 
 namespace
@@ -77,14 +76,9 @@ void MoveControlPoints(vtkStructuredGrid* lattice, const double frame[12])
 
 int TestFFDBearDeformedImage(int argc, char* argv[])
 {
-  vtkSmartPointer<vtkPolyData> bear;
-  try
+  vtkSmartPointer<vtkPolyData> bear = ReadTestMeshOrReport("bear");
+  if (!bear)
   {
-    bear = ReadTestMesh("bear");
-  }
-  catch (const std::exception& e)
-  {
-    std::cerr << e.what() << "\n";
     return EXIT_FAILURE;
   }
 

@@ -18,19 +18,13 @@
 #include "vtkTesting.h"
 
 #include <cstdlib>
-#include <exception>
 #include <iostream>
 
 int TestFFDGlobalVsLocalImage(int argc, char* argv[])
 {
-  vtkSmartPointer<vtkPolyData> bear;
-  try
+  vtkSmartPointer<vtkPolyData> bear = ReadTestMeshOrReport("bear");
+  if (!bear)
   {
-    bear = ReadTestMesh("bear");
-  }
-  catch (const std::exception& e)
-  {
-    std::cerr << e.what() << "\n";
     return EXIT_FAILURE;
   }
 
