@@ -116,8 +116,20 @@ struct Frame
     return true;
   }
 
+  /// The same frame in another number type: a Lanes type (FFDLanes.h), to evaluate several points at once.
+  template <typename Other>
+  Frame<Other> As() const
+  {
+    return { Convert<Other>(Origin), Convert<Other>(S), Convert<Other>(T), Convert<Other>(U),
+      Convert<Other>(DualS), Convert<Other>(DualT), Convert<Other>(DualU) };
+  }
+
 private:
-  FFD_INLINE static Real Clamp01(Real v) { return v < Real(0) ? Real(0) : (v > Real(1) ? Real(1) : v); }
+  template <typename Other>
+  static Vec3<Other> Convert(const Vec3<Real>& v)
+  {
+    return { Other(v.x), Other(v.y), Other(v.z) };
+  }
 };
 
 } // namespace ffd

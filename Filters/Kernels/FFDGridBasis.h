@@ -138,8 +138,7 @@ FFD_INLINE void ComputeAxisWeights(
   if (basis == GridBasis::CubicBSpline)
   {
     // Uniform cubic B-spline: (1-r)^3/6, (3r^3 - 6r^2 + 4)/6, (-3r^3 + 3r^2 + 3r + 1)/6, r^3/6.
-    Real r = s * n - Real(cell);
-    r = r < Real(0) ? Real(0) : (r > Real(1) ? Real(1) : r);
+    const Real r = Clamp01(s * n - Real(cell));
     const Real q = Real(1) - r, r2 = r * r, r3 = r2 * r, sixth = Real(1) / Real(6);
     a.First = cell;
     a.Count = 4;
@@ -167,8 +166,7 @@ FFD_INLINE void ComputeAxisWeights(
   a.First = 0;
   if (!global)
   {
-    r = s * n - Real(cell);
-    r = r < Real(0) ? Real(0) : (r > Real(1) ? Real(1) : r);
+    r = Clamp01(s * n - Real(cell));
     scale = n;
     a.First = degree * cell;
   }
@@ -243,9 +241,13 @@ FFD_INLINE constexpr int LoopCount(const AxisWeights<MaxCount, Real>& a)
 }
 } // namespace detail
 
-/// sum_ijk W0_i W1_j W2_k V_ijk over the supports in `axes`, for values in VTK order on a grid of `dims`.
-template <int MaxCount, typename Real>
-FFD_INLINE Vec3<Real> SumTensorProduct(const Real* values, const int dims[3], const AxisWeights<MaxCount, Real>* axes)
+/**
+ * sum_ijk W0_i W1_j W2_k V_ijk over the supports in `axes`, for values in VTK order on a grid of `dims`.
+ * Value is the values' type, Real the weights' and the sum's: the same, or a Lanes type (FFDLanes.h) whose
+ * lanes are points of one cell, each value then read once for all of them.
+ */
+template <int MaxCount, typename Real, typename Value>
+FFD_INLINE Vec3<Real> SumTensorProduct(const Value* values, const int dims[3], const AxisWeights<MaxCount, Real>* axes)
 {
   Vec3<Real> sum = { 0, 0, 0 };
   FFD_UNROLL
@@ -263,7 +265,7 @@ FFD_INLINE Vec3<Real> SumTensorProduct(const Real* values, const int dims[3], co
       {
         break;
       }
-      const Real* v = values + 3 * (axes[0].First + dims[0] * ((axes[1].First + j) + dims[1] * (axes[2].First + k)));
+      const Value* v = values + 3 * (axes[0].First + dims[0] * ((axes[1].First + j) + dims[1] * (axes[2].First + k)));
       Vec3<Real> sumI = { 0, 0, 0 };
       FFD_UNROLL
       for (int i = 0; i < detail::LoopCount(axes[0]); ++i)
@@ -272,7 +274,7 @@ FFD_INLINE Vec3<Real> SumTensorProduct(const Real* values, const int dims[3], co
         {
           break;
         }
-        sumI = sumI + axes[0].W[i] * Vec3<Real>{ v[3 * i], v[3 * i + 1], v[3 * i + 2] };
+        sumI = sumI + axes[0].W[i] * Vec3<Real>{ Real(v[3 * i]), Real(v[3 * i + 1]), Real(v[3 * i + 2]) };
       }
       sumJ = sumJ + axes[1].W[j] * sumI;
     }

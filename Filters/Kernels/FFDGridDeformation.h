@@ -96,37 +96,49 @@ FFD_INLINE Vec3<Real> TransformNormal(const Mat3<Real>& jacobian, const Vec3<Rea
  * MaxBernsteinDegree + 1 every global one; callers pick it from the basis (vtkFFDDeform, the CUDA backend).
  * StaticBasis, when not -1, is the basis known at compile time (it must equal Basis): the compiler then drops
  * the other bases' branches and unrolls the fixed-size sums, which made the local bases 2-3 times faster.
+ * Real is the displacements' type; Lane, the arithmetic's, is Real too, or on the host a Lanes type
+ * (FFDLanes.h) that deforms several points of one cell at once through these same functions (WithLanes()).
  */
-template <int MaxCount, typename Real, int StaticBasis = -1>
+template <int MaxCount, typename Real, int StaticBasis = -1, typename Lane = Real>
 struct GridDeformation
 {
   GridBasis Basis;
   int Voxels[3];             ///< the lattice's divisions
   int Dims[3];               ///< control points per axis
   const Real* Displacements; ///< 3 per control point, VTK order: the lattice's points minus RestPosition
-  ffd::Frame<Real> Frame;
+  ffd::Frame<Lane> Frame;
 
-  /// X + D(s, t, u) for a point bound to `cell` (not -1).
-  FFD_INLINE Vec3<Real> Deform(const Vec3<Real>& x, int cell) const
+  /// This deformation evaluated in lanes of type OtherLane (its frame converted once, host only).
+  template <typename OtherLane>
+  GridDeformation<MaxCount, Real, StaticBasis, OtherLane> WithLanes() const
   {
-    AxisWeights<MaxCount, Real> axes[3];
-    this->Weights(x, cell, false, axes, nullptr);
+    return { this->Basis, { this->Voxels[0], this->Voxels[1], this->Voxels[2] },
+      { this->Dims[0], this->Dims[1], this->Dims[2] }, this->Displacements,
+      this->Frame.template As<OtherLane>() };
+  }
+
+  /// X + D(s, t, u) for a point bound to `cell` (not -1); with lanes, every lane is bound to `cell`.
+  FFD_INLINE Vec3<Lane> Deform(const Vec3<Lane>& x, int cell) const
+  {
+    AxisWeights<MaxCount, Lane> axes[3];
+    this->Weights(this->Frame.ToParametric(x), cell, false, axes);
     return x + SumTensorProduct(this->Displacements, this->Dims, axes);
   }
 
-  /// Deform() and the Jacobian dX_ffd/dX there.
-  FFD_INLINE Vec3<Real> Deform(const Vec3<Real>& x, int cell, Mat3<Real>& jacobian) const
+  /// Deform() and the Jacobian dX_ffd/dX there (one lane: Lane = Real).
+  FFD_INLINE Vec3<Lane> Deform(const Vec3<Lane>& x, int cell, Mat3<Lane>& jacobian) const
   {
-    AxisWeights<MaxCount, Real> axes[3];
-    bool clamped[3];
-    this->Weights(x, cell, true, axes, clamped);
-    Mat3<Real> gradient;
-    const Vec3<Real> d = SumTensorProductWithGradient(this->Displacements, this->Dims, axes, gradient);
+    const Vec3<Lane> stu = this->Frame.ToParametric(x);
+    AxisWeights<MaxCount, Lane> axes[3];
+    this->Weights(stu, cell, true, axes);
+    Mat3<Lane> gradient;
+    const Vec3<Lane> d = SumTensorProductWithGradient(this->Displacements, this->Dims, axes, gradient);
+    const Lane lo = -ParametricTolerance<Lane>(), hi = Lane(1) + ParametricTolerance<Lane>();
     for (int a = 0; a < 3; ++a)
     {
-      if (clamped[a]) // the displacement does not change along a clamped direction
+      if (!(stu[a] >= lo && stu[a] <= hi)) // clamped: the displacement does not change along this direction
       {
-        gradient.M[0][a] = gradient.M[1][a] = gradient.M[2][a] = Real(0);
+        gradient.M[0][a] = gradient.M[1][a] = gradient.M[2][a] = Lane(0);
       }
     }
     jacobian = DeformationJacobian(gradient, this->Frame);
@@ -134,12 +146,10 @@ struct GridDeformation
   }
 
 private:
-  FFD_INLINE void Weights(const Vec3<Real>& x, int cell, bool withDerivative, AxisWeights<MaxCount, Real>* axes,
-    bool* clamped) const
+  /// The weights along each axis at parameters stu (clamped to the frame) of a point bound to `cell`.
+  FFD_INLINE void Weights(const Vec3<Lane>& stu, int cell, bool withDerivative, AxisWeights<MaxCount, Lane>* axes) const
   {
-    const Vec3<Real> stu = this->Frame.ToParametric(x);
-    const Real p[3] = { stu.x, stu.y, stu.z };
-    const Real lo = -ParametricTolerance<Real>(), hi = Real(1) + ParametricTolerance<Real>();
+    const Lane p[3] = { stu.x, stu.y, stu.z };
     const GridBasis basis = StaticBasis >= 0 ? static_cast<GridBasis>(StaticBasis) : this->Basis;
     FFD_UNROLL
     for (int a = 0; a < 3; ++a)
@@ -151,12 +161,7 @@ private:
         c = cell % cells;
         cell /= cells;
       }
-      if (clamped)
-      {
-        clamped[a] = !(p[a] >= lo && p[a] <= hi);
-      }
-      const Real s = p[a] < Real(0) ? Real(0) : (p[a] > Real(1) ? Real(1) : p[a]);
-      ComputeAxisWeights(basis, this->Voxels[a], c, s, withDerivative, axes[a]);
+      ComputeAxisWeights(basis, this->Voxels[a], c, Clamp01(p[a]), withDerivative, axes[a]);
     }
   }
 };

@@ -11,6 +11,13 @@
 namespace ffd
 {
 
+/// v clamped to [0, 1]; NaN stays NaN. Number types of several lanes (FFDLanes.h) overload it.
+template <typename Real>
+FFD_INLINE Real Clamp01(Real v)
+{
+  return v < Real(0) ? Real(0) : (v > Real(1) ? Real(1) : v);
+}
+
 template <typename Real>
 struct Vec3
 {

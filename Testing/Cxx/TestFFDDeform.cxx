@@ -226,6 +226,68 @@ TEST(vtkFFDDeform, BindingIsCachedUntilPointsOrRestFrameChange)
   EXPECT_LE(MaxRelativeError(mesh, deform->GetOutput(), reshaped), 1e-12);
 }
 
+TEST(vtkFFDDeform, OutputArraysAreReusedOnlyWhenNobodyElseHoldsThem)
+{
+  // An update writes into the last output's arrays when nothing else holds them (to spare the allocation);
+  // arrays that a caller kept must keep the values of their own update.
+  std::mt19937 rng(11);
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("bear");
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputData(mesh);
+  normals->SplittingOff(); // the same points as the mesh
+  normals->Update();
+  const ffdref::Frame f = FrameOf(Pipeline(mesh, vtkFFDBuildLattice::TRILINEAR, 3, 3, 3).Lattice);
+  const int divisions[3] = { 3, 3, 3 };
+  vtkSmartPointer<vtkStructuredGrid> lattice = ffdtest::MakeLattice(f, vtkFFDBuildLattice::TRILINEAR, divisions);
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(normals->GetOutput());
+  deform->SetLatticeData(lattice);
+  deform->ComputeJacobianDeterminantOn();
+  Perturb(lattice, rng, 0.05);
+  deform->Update();
+
+  vtkSmartPointer<vtkDataArray> keptPoints = deform->GetOutput()->GetPoints()->GetData();
+  vtkSmartPointer<vtkDataArray> keptNormals = deform->GetOutput()->GetPointData()->GetNormals();
+  vtkSmartPointer<vtkDataArray> keptDeterminants =
+    deform->GetOutput()->GetPointData()->GetArray(vtkFFDDeform::JacobianDeterminantArrayName());
+  ASSERT_TRUE(keptPoints && keptNormals && keptDeterminants);
+  std::vector<vtkSmartPointer<vtkDataArray>> copies;
+  for (vtkDataArray* kept : { keptPoints.Get(), keptNormals.Get(), keptDeterminants.Get() })
+  {
+    copies.push_back(vtk::TakeSmartPointer(kept->NewInstance()));
+    copies.back()->DeepCopy(kept);
+  }
+  auto unchanged = [&](vtkDataArray* kept, vtkDataArray* copy) {
+    for (vtkIdType v = 0; v < kept->GetNumberOfValues(); ++v)
+    {
+      if (kept->GetComponent(v / kept->GetNumberOfComponents(), v % kept->GetNumberOfComponents()) !=
+        copy->GetComponent(v / copy->GetNumberOfComponents(), v % copy->GetNumberOfComponents()))
+      {
+        return false;
+      }
+    }
+    return true;
+  };
+
+  Perturb(lattice, rng, 0.05);
+  deform->Update();
+  vtkPointSet* out = deform->GetOutput();
+  EXPECT_NE(out->GetPoints()->GetData(), keptPoints.Get());
+  EXPECT_NE(out->GetPointData()->GetNormals(), keptNormals.Get());
+  EXPECT_TRUE(unchanged(keptPoints, copies[0]));
+  EXPECT_TRUE(unchanged(keptNormals, copies[1]));
+  EXPECT_TRUE(unchanged(keptDeterminants, copies[2]));
+  EXPECT_LE(MaxRelativeError(mesh, out, ReferenceOf(lattice)), 1e-12);
+
+  // Nobody holds this update's arrays: the next one writes into them, and its result is still exact.
+  vtkDataArray* owned = out->GetPoints()->GetData();
+  Perturb(lattice, rng, 0.05);
+  deform->Update();
+  EXPECT_EQ(deform->GetOutput()->GetPoints()->GetData(), owned);
+  EXPECT_LE(MaxRelativeError(mesh, deform->GetOutput(), ReferenceOf(lattice)), 1e-12);
+  EXPECT_EQ(deform->GetNumberOfBindings(), 1);
+}
+
 namespace
 {
 // dX_ffd/dX of the reference by central differences (step h), as J[r][c] = d y_r / d x_c.

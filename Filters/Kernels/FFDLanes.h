@@ -1,0 +1,109 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file FFDLanes.h
+ * @brief A number of W lanes, so that the kernels deform W points at once on the CPU (host only).
+ *
+ * The kernels are templates on their number type. Lanes<T, W> is one more number type: the same functions
+ * instantiated with it deform W points at once, one per lane, where those W points are bound to one cell, so
+ * that every index the kernels compute and every control point they read is the same for all lanes (a control
+ * point is read once and broadcast). The arithmetic is GCC/Clang vector extensions rather than intrinsics: a
+ * function compiled for AVX-512 gets zmm instructions, one for AVX2 ymm, and a plain x86-64 build SSE2
+ * (FFDGridLanes.h picks the widest at run time), from the same source.
+ */
+#ifndef FFDLanes_h
+#define FFDLanes_h
+
+#include <cstdint>
+#include <cstring>
+#include <type_traits>
+#include <utility>
+
+namespace ffd
+{
+
+template <typename T, int W>
+struct Lanes
+{
+  static_assert(std::is_floating_point<T>::value && W >= 2 && (W & (W - 1)) == 0, "W floating-point lanes");
+  using Scalar = T;
+  static constexpr int Width = W;
+  typedef T Vector __attribute__((vector_size(W * sizeof(T))));
+  using Index = std::conditional_t<sizeof(T) == 4, std::int32_t, std::int64_t>;
+  typedef Index IndexVector __attribute__((vector_size(W * sizeof(T))));
+
+  Vector V;
+
+  Lanes() = default;
+  /// Every lane s (also from ints and doubles, as the kernels' Real(1) and Real(cell) need).
+  template <typename S, typename = std::enable_if_t<std::is_arithmetic<S>::value>>
+  Lanes(S s)
+    : V(Vector{} + T(s))
+  {
+  }
+  explicit Lanes(Vector v)
+    : V(v)
+  {
+  }
+
+  friend Lanes operator+(Lanes a, Lanes b) { return Lanes(a.V + b.V); }
+  friend Lanes operator-(Lanes a, Lanes b) { return Lanes(a.V - b.V); }
+  friend Lanes operator*(Lanes a, Lanes b) { return Lanes(a.V * b.V); }
+  friend Lanes operator/(Lanes a, Lanes b) { return Lanes(a.V / b.V); }
+  friend Lanes operator-(Lanes a) { return Lanes(-a.V); }
+  /// a where mask is -1, b where it is 0 (masks: IndexVector lanes of -1 or 0).
+  friend Lanes Select(IndexVector mask, Lanes a, Lanes b) { return Lanes(mask ? a.V : b.V); }
+  friend Lanes Clamp01(Lanes a)
+  {
+    const Vector zero = Vector{}, one = zero + T(1);
+    const Vector low = a.V < zero ? zero : a.V;
+    return Lanes(low > one ? one : low);
+  }
+
+  /// x, y, z of W points stored as x0 y0 z0 x1 y1 z1 ... (3 W values, no alignment needed).
+  static void Deinterleave3(const T* p, Lanes& x, Lanes& y, Lanes& z)
+  {
+    Vector a, b, c;
+    std::memcpy(&a, p, sizeof(Vector));
+    std::memcpy(&b, p + W, sizeof(Vector));
+    std::memcpy(&c, p + 2 * W, sizeof(Vector));
+    x = Gather<0>(a, b, c, std::make_index_sequence<W>());
+    y = Gather<1>(a, b, c, std::make_index_sequence<W>());
+    z = Gather<2>(a, b, c, std::make_index_sequence<W>());
+  }
+
+  /// The inverse of Deinterleave3().
+  static void Interleave3(const Lanes& x, const Lanes& y, const Lanes& z, T* p)
+  {
+    Scatter<0>(x.V, y.V, z.V, p, std::make_index_sequence<W>());
+    Scatter<1>(x.V, y.V, z.V, p + W, std::make_index_sequence<W>());
+    Scatter<2>(x.V, y.V, z.V, p + 2 * W, std::make_index_sequence<W>());
+  }
+
+private:
+  // Lane l of component C is value 3 l + C of a|b|c: taken from a|b by a first shuffle, then kept or replaced
+  // by one of c by a second (two-source shuffles with constant masks: vpermt2ps/pd on AVX-512).
+  template <int C, std::size_t... L>
+  static Lanes Gather(Vector a, Vector b, Vector c, std::index_sequence<L...>)
+  {
+    constexpr Index w = W;
+    const IndexVector fromAB = { Index(3 * L + C < 2 * W ? 3 * L + C : 0)... };
+    const IndexVector withC = { Index(3 * L + C < 2 * W ? Index(L) : w + Index(3 * L + C) - 2 * w)... };
+    return Lanes(__builtin_shuffle(__builtin_shuffle(a, b, fromAB), c, withC));
+  }
+
+  // Value m = K W + j of the interleaved output is component m % 3 of lane m / 3. (Stored here rather than
+  // returned: GCC warns of the ABI of a returned vector in code not compiled for its width.)
+  template <int K, std::size_t... J>
+  static void Scatter(Vector x, Vector y, Vector z, T* p, std::index_sequence<J...>)
+  {
+    constexpr Index w = W;
+    const IndexVector fromXY = { Index(((K * W + J) % 3 == 1 ? w : 0) + ((K * W + J) % 3 == 2 ? 0 : (K * W + J) / 3))... };
+    const IndexVector withZ = { Index((K * W + J) % 3 == 2 ? w + Index((K * W + J) / 3) : Index(J))... };
+    const Vector v = __builtin_shuffle(__builtin_shuffle(x, y, fromXY), z, withZ);
+    std::memcpy(p, &v, sizeof(Vector));
+  }
+};
+
+} // namespace ffd
+
+#endif
