@@ -200,15 +200,6 @@ struct EvaluateFunctor
   void operator()(vtkIdType begin, vtkIdType end)
   {
     const bool needJacobian = this->OutNormals || this->Determinants;
-    if constexpr (std::is_same<PointArrayT, vtkAOSDataArrayTemplate<Real>>::value)
-    {
-      if (!needJacobian) // points only: several points at once, in SIMD lanes (FFDGridLanes.h)
-      {
-        static const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
-        ffd::DeformPoints(level, this->Deformation, this->InPoints->GetPointer(0), this->Cells, this->OutPoints, begin, end);
-        return;
-      }
-    }
     const auto inPoints = vtk::DataArrayTupleRange<3>(this->InPoints, begin, end);
     vtkIdType id = begin;
     for (const auto x : inPoints)
@@ -246,11 +237,41 @@ struct EvaluateFunctor
   }
 };
 
+// Evaluation of the points alone (no normals, no determinants) from points of the output's precision, W at a
+// time in SIMD lanes (FFDGridLanes.h): first the blocks whose points share a cell, in place, then the points of
+// the other blocks, gathered by cell at binding.
+template <typename Deformer, typename Real>
+struct LanesFunctor
+{
+  const Real* InPoints;
+  Real* OutPoints;
+  const int* Cells;
+  vtkIdType NumberOfPoints;
+  const int* Gathered; // ffd::GatherByCell()
+  Deformer Deformation;
+  bool GatheredPass; // false: over blocks, true: over Gathered
+
+  void operator()(vtkIdType begin, vtkIdType end)
+  {
+    static const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
+    if (this->GatheredPass)
+    {
+      ffd::DeformGathered(level, this->Deformation, this->InPoints, this->Cells, this->Gathered, this->OutPoints, begin, end);
+    }
+    else
+    {
+      ffd::DeformSharedBlocks(
+        level, this->Deformation, this->InPoints, this->Cells, this->OutPoints, this->NumberOfPoints, begin, end);
+    }
+  }
+};
+
 template <typename Real>
 struct EvaluateWorker
 {
   template <typename PointArrayT>
-  void operator()(PointArrayT* inPoints, const LatticeView& lattice, const int* cells, vtkDataArray* inNormals,
+  void operator()(PointArrayT* inPoints, const LatticeView& lattice, const int* cells,
+    const std::vector<int>& gathered, vtkDataArray* inNormals,
     vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outPoints,
     vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self, double progressBegin, bool& completed)
   {
@@ -259,7 +280,7 @@ struct EvaluateWorker
     // control point of an axis, a local one over at most 4.
     auto run = [&](auto maxCount, auto basis) {
       this->Run<decltype(maxCount)::value, decltype(basis)::value>(inPoints, lattice, displacements.data(), cells,
-        inNormals, outNormals, outPoints, determinants, self, progressBegin, completed);
+        gathered, inNormals, outNormals, outPoints, determinants, self, progressBegin, completed);
     };
     using ffd::GridBasis;
     using Local = std::integral_constant<int, 4>;
@@ -286,14 +307,31 @@ struct EvaluateWorker
 
   template <int MaxCount, int StaticBasis, typename PointArrayT>
   void Run(PointArrayT* inPoints, const LatticeView& lattice, const Real* displacements, const int* cells,
-    vtkDataArray* inNormals, vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outPoints,
-    vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self, double progressBegin, bool& completed)
+    const std::vector<int>& gathered, vtkDataArray* inNormals, vtkDataArray* outNormals,
+    vtkAOSDataArrayTemplate<Real>* outPoints, vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self,
+    double progressBegin, bool& completed)
   {
-    const ffd::GridDeformation<MaxCount, Real, StaticBasis> deformation{ lattice.Basis,
+    using Deformation = ffd::GridDeformation<MaxCount, Real, StaticBasis>;
+    const Deformation deformation{ lattice.Basis,
       { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] },
       { lattice.Dims[0], lattice.Dims[1], lattice.Dims[2] }, displacements,
       ffd::Frame<Real>::FromArray(lattice.Frame) };
-    EvaluateFunctor<ffd::GridDeformation<MaxCount, Real, StaticBasis>, Real, PointArrayT> functor{ inPoints, outPoints->GetPointer(0), cells,
+    const vtkIdType n = inPoints->GetNumberOfTuples();
+    if constexpr (std::is_same<PointArrayT, vtkAOSDataArrayTemplate<Real>>::value)
+    {
+      if (!outNormals && !determinants)
+      {
+        LanesFunctor<Deformation, Real> lanes{ inPoints->GetPointer(0), outPoints->GetPointer(0), cells, n,
+          gathered.data(), deformation, false };
+        const vtkIdType blocks = (n + ffd::BlockSize - 1) / ffd::BlockSize;
+        const double middle = progressBegin + (1.0 - progressBegin) * double(n - vtkIdType(gathered.size())) / double(n);
+        completed = ForInChunks(self, blocks, lanes, progressBegin, middle);
+        lanes.GatheredPass = true;
+        completed = completed && ForInChunks(self, vtkIdType(gathered.size()), lanes, middle, 1.0);
+        return;
+      }
+    }
+    EvaluateFunctor<Deformation, Real, PointArrayT> functor{ inPoints, outPoints->GetPointer(0), cells,
       deformation, inNormals, outNormals, determinants ? determinants->GetPointer(0) : nullptr };
     completed = ForInChunks(self, inPoints->GetNumberOfTuples(), functor, progressBegin, 1.0);
   }
@@ -326,8 +364,9 @@ vtkSmartPointer<vtkDataArray> OutputArray(
 // The CPU binding and what it was computed for, and the CUDA backend's state.
 struct vtkFFDDeform::vtkInternals
 {
-  std::vector<int> Cells; // per input point: its cell (ffd::BindToGrid), -1 where it keeps its position
-  vtkFFDBindingKey Bound; // what Cells is for
+  std::vector<int> Cells;    // per input point: its cell (ffd::BindToGrid), -1 where it keeps its position
+  std::vector<int> Gathered; // the points of blocks not in one cell, sorted by cell (ffd::GatherByCell)
+  vtkFFDBindingKey Bound;    // what Cells and Gathered are for
   vtkFFDCudaBackend Cuda;
   // The last output's arrays (the executive empties the output before RequestData): the next update writes
   // into those that nothing else holds any more (OutputArray()).
@@ -464,6 +503,12 @@ int vtkFFDDeform::RequestData(
       {
         return 1; // aborted: the output stays empty
       }
+      int cellCount = 1;
+      for (int a = 0; a < 3; ++a)
+      {
+        cellCount *= ffd::BindingCells(view.Basis, view.Divisions[a]);
+      }
+      internals.Gathered = ffd::GatherByCell(internals.Cells.data(), numberOfPoints, cellCount);
       internals.Bound = key;
       ++this->NumberOfBindings;
     }
@@ -477,10 +522,11 @@ int vtkFFDDeform::RequestData(
       auto* points = static_cast<RealArray*>(pointsArray.Get());
       auto* det = static_cast<RealArray*>(determinants.Get());
       if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(inPoints->GetData(), worker, view,
-            internals.Cells.data(), inNormals, outNormals.Get(), points, det, this, 0.5, completed))
+            internals.Cells.data(), internals.Gathered, inNormals, outNormals.Get(), points, det, this, 0.5,
+            completed))
       {
-        worker(inPoints->GetData(), view, internals.Cells.data(), inNormals, outNormals.Get(), points, det, this,
-          0.5, completed);
+        worker(inPoints->GetData(), view, internals.Cells.data(), internals.Gathered, inNormals, outNormals.Get(),
+          points, det, this, 0.5, completed);
       }
     };
     if (useDouble)

@@ -1,19 +1,23 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
  * @file FFDGridLanes.h
- * @brief Deforms a range of points W at a time on the CPU, with the widest SIMD the CPU has (host only).
+ * @brief Deforms points W at a time on the CPU, with the widest SIMD the CPU has (host only).
  *
- * A mesh's consecutive vertices mostly lie in one cell of the lattice (always, for the global basis's single
- * cell). DeformPoints() walks the points in blocks of W: a block whose points are all bound to one cell is
- * deformed at once by GridDeformation::Deform() instantiated on Lanes<Real, W> (FFDLanes.h), each control point
- * read once for the W points; any other block, and the tail, point by point by the same function on Real.
- * Both compute the same function; they may differ in the last bit, where the wide code fuses a multiply and
- * an add that the one-point code, compiled for any x86-64, does not.
+ * GridDeformation::Deform() instantiated on Lanes<Real, W> (FFDLanes.h) deforms W points bound to one cell at
+ * once, each control point read once for all of them. The points are taken in blocks of BlockSize
+ * consecutive points: a mesh whose vertices come in a spatially coherent order has most of its blocks in one
+ * cell (always, for the global basis's single cell), and DeformSharedBlocks() deforms those in place. The
+ * points of the other blocks are listed once, at binding, sorted by cell (GatherByCell()), and
+ * DeformGathered() deforms them W at a time from that list: a mesh in random vertex order costs a gather and a
+ * scatter per point, not one evaluation per distinct cell of a block. Every lane's result depends only on its
+ * own point and cell, so a point is deformed the same whichever pass takes it and however the work is split
+ * among threads. The one-point code (SimdLevel::None) computes the same function; it may differ in the last
+ * bit, where the wide code fuses a multiply and an add.
  *
  * The default build must run on any x86-64, so the wide variants are compiled with GCC's target attribute
- * (AVX-512: 16 floats or 8 doubles a block; AVX2 and FMA: 8 or 4) and chosen at run time by SimdLevelOfCpu();
- * `flatten` inlines every kernel function into them, so no out-of-line copy compiled for one instruction set
- * can be shared with code compiled for another. Compilers without these extensions use the one-point loop.
+ * (AVX-512: 16 floats or 8 doubles a lane group; AVX2 and FMA: 8 or 4) and chosen at run time by
+ * SimdLevelOfCpu(); `flatten` inlines every kernel function into them, so that no out-of-line copy compiled for
+ * one instruction set is shared with code compiled for another. SSE2 (any x86-64) takes 4 floats or 2 doubles.
  */
 #ifndef FFDGridLanes_h
 #define FFDGridLanes_h
@@ -21,12 +25,14 @@
 #include "FFDGridDeformation.h"
 
 #include <cstdint>
+#include <vector>
 
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(__CUDACC__)
 #define FFD_HAVE_LANES 1
 #include "FFDLanes.h"
 #define FFD_TARGET_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl,avx512bw,avx2,fma,bmi2"), flatten))
 #define FFD_TARGET_AVX2 __attribute__((target("avx2,fma,bmi2"), flatten))
+#define FFD_TARGET_SSE2 __attribute__((flatten))
 #else
 #define FFD_HAVE_LANES 0
 #endif
@@ -63,6 +69,62 @@ inline SimdLevel SimdLevelOfCpu()
 #endif
 }
 
+/// Consecutive points that DeformSharedBlocks() takes together: the most lanes of any level (16 floats).
+constexpr int BlockSize = 16;
+
+/// True when the points of block b (of n points) are all bound to one cell (-1 included).
+inline bool BlockSharesCell(const int* cells, std::int64_t n, std::int64_t b)
+{
+  const std::int64_t first = b * BlockSize;
+  if (first + BlockSize > n)
+  {
+    return false; // the last, partial block goes to the gathered points
+  }
+  bool shared = true;
+  for (int l = 1; l < BlockSize; ++l)
+  {
+    shared &= cells[first + l] == cells[first];
+  }
+  return shared;
+}
+
+/**
+ * The points of the blocks whose points are not all in one cell, sorted by cell (a stable counting sort:
+ * cell -1 first, then by cell, each cell's points in input order), for DeformGathered(). `cellCount` is the
+ * number of cells of the binding.
+ */
+inline std::vector<int> GatherByCell(const int* cells, std::int64_t n, int cellCount)
+{
+  std::vector<std::int64_t> offsets(std::size_t(cellCount) + 2, 0);
+  const std::int64_t blocks = (n + BlockSize - 1) / BlockSize;
+  for (std::int64_t b = 0; b < blocks; ++b)
+  {
+    if (!BlockSharesCell(cells, n, b))
+    {
+      for (std::int64_t i = b * BlockSize; i < n && i < (b + 1) * BlockSize; ++i)
+      {
+        ++offsets[std::size_t(cells[i] + 2)];
+      }
+    }
+  }
+  for (std::size_t c = 1; c < offsets.size(); ++c)
+  {
+    offsets[c] += offsets[c - 1];
+  }
+  std::vector<int> gathered(std::size_t(offsets.back()));
+  for (std::int64_t b = 0; b < blocks; ++b)
+  {
+    if (!BlockSharesCell(cells, n, b))
+    {
+      for (std::int64_t i = b * BlockSize; i < n && i < (b + 1) * BlockSize; ++i)
+      {
+        gathered[std::size_t(offsets[std::size_t(cells[i] + 1)]++)] = int(i);
+      }
+    }
+  }
+  return gathered;
+}
+
 namespace detail
 {
 /// Point i deformed alone: cell -1 keeps its position.
@@ -76,145 +138,160 @@ inline void DeformOnePoint(const Deformation& deformation, const Real* in, const
   out[3 * i + 2] = y.z;
 }
 
-template <typename Deformation, typename Real>
-inline void DeformOneByOne(
-  const Deformation& deformation, const Real* in, const int* cells, Real* out, std::int64_t begin, std::int64_t end)
-{
-  for (std::int64_t i = begin; i < end; ++i)
-  {
-    DeformOnePoint(deformation, in, cells, out, i);
-  }
-}
-
 #if FFD_HAVE_LANES
-// Points [begin, begin + count), count <= W, deformed in lanes. Each lane's result depends only on its own point
-// and cell, whatever the other lanes hold: a block is evaluated once for each cell its points are bound to, and
-// every lane takes the evaluation of its own cell (most blocks of a mesh have one; -1 keeps the position).
-// So a point's result does not depend on its neighbours nor on how the range was split among threads.
-template <int W, typename Wide, typename Real>
-inline void DeformBlock(const Wide& wide, const Real* in, const int* cells, Real* out, int count)
+template <int W, typename Deformation, typename Real>
+inline void SharedBlocksInLanes(const Deformation& deformation, const Real* in, const int* cells, Real* out,
+  std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd)
 {
+  static_assert(BlockSize % W == 0, "a block is a whole number of lane groups");
   using Lane = Lanes<Real, W>;
-  using Mask = typename Lane::IndexVector;
-  bool shared = count == W && cells[0] >= 0; // the common case, first: one cell for the whole block
-  for (int l = 1; l < count; ++l)
+  const auto wide = deformation.template WithLanes<Lane>();
+  for (std::int64_t b = blockBegin; b < blockEnd; ++b)
   {
-    shared &= cells[l] == cells[0];
-  }
-  if (shared)
-  {
-    Vec3<Lane> x;
-    Lane::Deinterleave3(in, x.x, x.y, x.z);
-    const Vec3<Lane> y = wide.Deform(x, cells[0]);
-    Lane::Interleave3(y.x, y.y, y.z, out);
-    return;
-  }
-
-  Real padded[3 * W] = {};
-  int cell[W];
-  const Real* source = in;
-  for (int l = 0; l < W; ++l)
-  {
-    cell[l] = l < count ? cells[l] : -1;
-  }
-  if (count < W)
-  {
-    for (int v = 0; v < 3 * count; ++v)
-    {
-      padded[v] = in[v];
-    }
-    source = padded;
-  }
-  Vec3<Lane> x;
-  Lane::Deinterleave3(source, x.x, x.y, x.z);
-
-  Vec3<Lane> y = x;
-  bool done[W] = {};
-  for (int first = 0; first < W; ++first)
-  {
-    if (done[first] || cell[first] < 0)
+    if (!BlockSharesCell(cells, n, b))
     {
       continue;
     }
-    const int c = cell[first];
-    Mask mine;
-    for (int l = 0; l < W; ++l)
+    const std::int64_t first = b * BlockSize;
+    const int cell = cells[first];
+    for (std::int64_t i = first; i < first + BlockSize; i += W)
     {
-      const bool same = cell[l] == c;
-      mine[l] = same ? -1 : 0;
-      done[l] = done[l] || same;
+      if (cell < 0)
+      {
+        for (std::int64_t v = 3 * i; v < 3 * (i + W); ++v)
+        {
+          out[v] = in[v];
+        }
+        continue;
+      }
+      Vec3<Lane> x;
+      Lane::Deinterleave3(in + 3 * i, x.x, x.y, x.z);
+      const Vec3<Lane> y = wide.Deform(x, cell);
+      Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
     }
-    const Vec3<Lane> yc = wide.Deform(x, c);
-    y = { Select(mine, yc.x, y.x), Select(mine, yc.y, y.y), Select(mine, yc.z, y.z) };
-  }
-
-  if (count == W)
-  {
-    Lane::Interleave3(y.x, y.y, y.z, out);
-    return;
-  }
-  Lane::Interleave3(y.x, y.y, y.z, padded);
-  for (int v = 0; v < 3 * count; ++v)
-  {
-    out[v] = padded[v];
   }
 }
 
 template <int W, typename Deformation, typename Real>
-inline void DeformInBlocks(
-  const Deformation& deformation, const Real* in, const int* cells, Real* out, std::int64_t begin, std::int64_t end)
+inline void GatheredInLanes(const Deformation& deformation, const Real* in, const int* cells, const int* gathered,
+  Real* out, std::int64_t begin, std::int64_t end)
 {
-  const auto wide = deformation.template WithLanes<Lanes<Real, W>>();
-  for (std::int64_t i = begin; i < end; i += W)
+  using Lane = Lanes<Real, W>;
+  const auto wide = deformation.template WithLanes<Lane>();
+  Real staged[3 * W] = {};
+  std::int64_t g = begin;
+  while (g < end)
   {
-    const int count = int(end - i < W ? end - i : W);
-    DeformBlock<W>(wide, in + 3 * i, cells + i, out + 3 * i, count);
+    // Up to W listed points of one cell; unused lanes repeat the first point and are not written back.
+    const int cell = cells[gathered[g]];
+    int count = 1;
+    while (count < W && g + count < end && cells[gathered[g + count]] == cell)
+    {
+      ++count;
+    }
+    for (int l = 0; l < W; ++l)
+    {
+      const std::int64_t i = gathered[g + (l < count ? l : 0)];
+      staged[3 * l] = in[3 * i];
+      staged[3 * l + 1] = in[3 * i + 1];
+      staged[3 * l + 2] = in[3 * i + 2];
+    }
+    if (cell >= 0)
+    {
+      Vec3<Lane> x;
+      Lane::Deinterleave3(staged, x.x, x.y, x.z);
+      const Vec3<Lane> y = wide.Deform(x, cell);
+      Lane::Interleave3(y.x, y.y, y.z, staged);
+    }
+    for (int l = 0; l < count; ++l)
+    {
+      const std::int64_t i = gathered[g + l];
+      out[3 * i] = staged[3 * l];
+      out[3 * i + 1] = staged[3 * l + 1];
+      out[3 * i + 2] = staged[3 * l + 2];
+    }
+    g += count;
   }
 }
 
-template <typename Deformation, typename Real>
-FFD_TARGET_AVX512 void DeformInBlocksAVX512(
-  const Deformation& deformation, const Real* in, const int* cells, Real* out, std::int64_t begin, std::int64_t end)
-{
-  DeformInBlocks<64 / sizeof(Real)>(deformation, in, cells, out, begin, end);
-}
-
-template <typename Deformation, typename Real>
-FFD_TARGET_AVX2 void DeformInBlocksAVX2(
-  const Deformation& deformation, const Real* in, const int* cells, Real* out, std::int64_t begin, std::int64_t end)
-{
-  DeformInBlocks<32 / sizeof(Real)>(deformation, in, cells, out, begin, end);
-}
+// The wide variants of both passes, one function per instruction set (see the file's documentation).
+#define FFD_LANE_VARIANTS(Suffix, Target, Bytes)                                                              \
+  template <typename Deformation, typename Real>                                                              \
+  Target void SharedBlocks##Suffix(const Deformation& deformation, const Real* in, const int* cells, Real* out, \
+    std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd)                                           \
+  {                                                                                                           \
+    SharedBlocksInLanes<Bytes / sizeof(Real)>(deformation, in, cells, out, n, blockBegin, blockEnd);         \
+  }                                                                                                           \
+  template <typename Deformation, typename Real>                                                              \
+  Target void Gathered##Suffix(const Deformation& deformation, const Real* in, const int* cells,              \
+    const int* gathered, Real* out, std::int64_t begin, std::int64_t end)                                     \
+  {                                                                                                           \
+    GatheredInLanes<Bytes / sizeof(Real)>(deformation, in, cells, gathered, out, begin, end);                \
+  }
+FFD_LANE_VARIANTS(AVX512, FFD_TARGET_AVX512, 64)
+FFD_LANE_VARIANTS(AVX2, FFD_TARGET_AVX2, 32)
+FFD_LANE_VARIANTS(SSE2, FFD_TARGET_SSE2, 16)
+#undef FFD_LANE_VARIANTS
 #endif
 } // namespace detail
 
 /**
- * out = the deformation of in for points [begin, end): 3 values per point (x y z), cells[i] from BindToGrid()
- * (-1: the point keeps its position). `level` at most SimdLevelOfCpu(); None deforms one point at a time.
+ * First pass: out = the deformation of in for the points of blocks [blockBegin, blockEnd) whose BlockSize
+ * points share a cell (BlockSharesCell()); the others are left to DeformGathered(). 3 values per point
+ * (x y z), n points, cells[i] from BindToGrid() (-1: the point keeps its position). `level` at most
+ * SimdLevelOfCpu().
  */
 template <typename Deformation, typename Real>
-inline void DeformPoints(SimdLevel level, const Deformation& deformation, const Real* in, const int* cells, Real* out,
-  std::int64_t begin, std::int64_t end)
+inline void DeformSharedBlocks(SimdLevel level, const Deformation& deformation, const Real* in, const int* cells,
+  Real* out, std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd)
 {
 #if FFD_HAVE_LANES
   switch (level)
   {
     case SimdLevel::AVX512:
-      detail::DeformInBlocksAVX512(deformation, in, cells, out, begin, end);
-      return;
+      return detail::SharedBlocksAVX512(deformation, in, cells, out, n, blockBegin, blockEnd);
     case SimdLevel::AVX2:
-      detail::DeformInBlocksAVX2(deformation, in, cells, out, begin, end);
-      return;
+      return detail::SharedBlocksAVX2(deformation, in, cells, out, n, blockBegin, blockEnd);
     case SimdLevel::SSE2:
-      detail::DeformInBlocks<16 / sizeof(Real)>(deformation, in, cells, out, begin, end);
-      return;
+      return detail::SharedBlocksSSE2(deformation, in, cells, out, n, blockBegin, blockEnd);
     case SimdLevel::None:
       break;
   }
-#else
-  (void)level;
 #endif
-  detail::DeformOneByOne(deformation, in, cells, out, begin, end);
+  for (std::int64_t b = blockBegin; b < blockEnd; ++b)
+  {
+    if (BlockSharesCell(cells, n, b))
+    {
+      for (std::int64_t i = b * BlockSize; i < (b + 1) * BlockSize; ++i)
+      {
+        detail::DeformOnePoint(deformation, in, cells, out, i);
+      }
+    }
+  }
+}
+
+/// Second pass: the points gathered[begin, end) of GatherByCell()'s list.
+template <typename Deformation, typename Real>
+inline void DeformGathered(SimdLevel level, const Deformation& deformation, const Real* in, const int* cells,
+  const int* gathered, Real* out, std::int64_t begin, std::int64_t end)
+{
+#if FFD_HAVE_LANES
+  switch (level)
+  {
+    case SimdLevel::AVX512:
+      return detail::GatheredAVX512(deformation, in, cells, gathered, out, begin, end);
+    case SimdLevel::AVX2:
+      return detail::GatheredAVX2(deformation, in, cells, gathered, out, begin, end);
+    case SimdLevel::SSE2:
+      return detail::GatheredSSE2(deformation, in, cells, gathered, out, begin, end);
+    case SimdLevel::None:
+      break;
+  }
+#endif
+  for (std::int64_t g = begin; g < end; ++g)
+  {
+    detail::DeformOnePoint(deformation, in, cells, out, gathered[g]);
+  }
 }
 
 } // namespace ffd

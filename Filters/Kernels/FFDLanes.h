@@ -40,19 +40,17 @@ struct Lanes
     : V(Vector{} + T(s))
   {
   }
-  explicit Lanes(Vector v)
+  explicit Lanes(const Vector& v)
     : V(v)
   {
   }
 
-  friend Lanes operator+(Lanes a, Lanes b) { return Lanes(a.V + b.V); }
-  friend Lanes operator-(Lanes a, Lanes b) { return Lanes(a.V - b.V); }
-  friend Lanes operator*(Lanes a, Lanes b) { return Lanes(a.V * b.V); }
-  friend Lanes operator/(Lanes a, Lanes b) { return Lanes(a.V / b.V); }
-  friend Lanes operator-(Lanes a) { return Lanes(-a.V); }
-  /// a where mask is -1, b where it is 0 (masks: IndexVector lanes of -1 or 0).
-  friend Lanes Select(IndexVector mask, Lanes a, Lanes b) { return Lanes(mask ? a.V : b.V); }
-  friend Lanes Clamp01(Lanes a)
+  friend Lanes operator+(const Lanes& a, const Lanes& b) { return Lanes(a.V + b.V); }
+  friend Lanes operator-(const Lanes& a, const Lanes& b) { return Lanes(a.V - b.V); }
+  friend Lanes operator*(const Lanes& a, const Lanes& b) { return Lanes(a.V * b.V); }
+  friend Lanes operator/(const Lanes& a, const Lanes& b) { return Lanes(a.V / b.V); }
+  friend Lanes operator-(const Lanes& a) { return Lanes(-a.V); }
+  friend Lanes Clamp01(const Lanes& a)
   {
     const Vector zero = Vector{}, one = zero + T(1);
     const Vector low = a.V < zero ? zero : a.V;
@@ -83,7 +81,7 @@ private:
   // Lane l of component C is value 3 l + C of a|b|c: taken from a|b by a first shuffle, then kept or replaced
   // by one of c by a second (two-source shuffles with constant masks: vpermt2ps/pd on AVX-512).
   template <int C, std::size_t... L>
-  static Lanes Gather(Vector a, Vector b, Vector c, std::index_sequence<L...>)
+  static Lanes Gather(const Vector& a, const Vector& b, const Vector& c, std::index_sequence<L...>)
   {
     constexpr Index w = W;
     const IndexVector fromAB = { Index(3 * L + C < 2 * W ? 3 * L + C : 0)... };
@@ -94,7 +92,7 @@ private:
   // Value m = K W + j of the interleaved output is component m % 3 of lane m / 3. (Stored here rather than
   // returned: GCC warns of the ABI of a returned vector in code not compiled for its width.)
   template <int K, std::size_t... J>
-  static void Scatter(Vector x, Vector y, Vector z, T* p, std::index_sequence<J...>)
+  static void Scatter(const Vector& x, const Vector& y, const Vector& z, T* p, std::index_sequence<J...>)
   {
     constexpr Index w = W;
     const IndexVector fromXY = { Index(((K * W + J) % 3 == 1 ? w : 0) + ((K * W + J) % 3 == 2 ? 0 : (K * W + J) / 3))... };

@@ -9,6 +9,7 @@
 #define FFDKernelTestUtilities_h
 
 #include "FFDFrame.h"
+#include "FFDGridDeformation.h"
 #include "FFDReference.h"
 #include "FFDVector.h"
 
@@ -263,6 +264,77 @@ inline GridLattice RandomGridLattice(Rng& rng, ffdref::Basis basis, int maxDivis
     lat.Points.push_back({ p[0] + d[0], p[1] + d[1], p[2] + d[2] });
   }
   return lat;
+}
+
+/**
+ * A lattice's deformation as the filters hold it: displacements rounded to Real and an ffd::GridDeformation over
+ * them. MaxCount is 4, what the local bases need, and MaxBernsteinDegree + 1 for the global basis.
+ */
+template <typename Real, int MaxCount>
+class Kernel
+{
+public:
+  explicit Kernel(const GridLattice& lat)
+    : Values(Flatten<Real>(lat.Displacements()))
+  {
+    this->D.Basis = ffd::GridBasis(int(lat.Basis));
+    const std::array<int, 3> dims = lat.Dims();
+    for (int a = 0; a < 3; ++a)
+    {
+      this->D.Voxels[a] = lat.Divisions[a];
+      this->D.Dims[a] = dims[a];
+    }
+    this->D.Displacements = this->Values.data();
+    this->D.Frame = KernelFrame<Real>(lat.F);
+  }
+  Kernel(const Kernel&) = delete; // D points into Values
+  Kernel& operator=(const Kernel&) = delete;
+
+  int Bind(const ffd::Vec3<Real>& x, bool clamp) const
+  {
+    return ffd::BindToGrid(this->D.Frame, this->D.Basis, this->D.Voxels, x, clamp);
+  }
+
+  const std::vector<Real> Values;
+  ffd::GridDeformation<MaxCount, Real> D;
+};
+
+/// Calls f(kernel) with the Kernels of lat that the filters may build: MaxCount 4 for the local bases and for
+/// the global basis of degree <= 3 (one cubic voxel), MaxBernsteinDegree + 1 for the global basis.
+template <typename Real, typename F>
+void WithKernel(const GridLattice& lat, F&& f)
+{
+  if (lat.Basis == ffdref::Basis::Bernstein)
+  {
+    const Kernel<Real, ffd::MaxBernsteinDegree + 1> k(lat);
+    f(k);
+  }
+  if (lat.Basis != ffdref::Basis::Bernstein || std::max({ lat.Divisions[0], lat.Divisions[1], lat.Divisions[2] }) <= 3)
+  {
+    const Kernel<Real, 4> k(lat);
+    f(k);
+  }
+}
+
+/**
+ * Tolerance of a deformed position X + D against the reference: EvaluationTolerance() times (scale + |X|) (the
+ * issues' target; X + D rounds at the size of X), plus the rounding of equation 2 amplified by the
+ * displacement's gradient: computing (s, t, u) in Real errs as a world error of ~8 eps(Real) (|X| + |X0|) would,
+ * which moves D by |J - I| times that. In double the second term is below 1e-13 here; in float it matters on
+ * rough lattices (|J - I| reaches ~20 with displacements of 0.3 over control points 1/18 of an edge apart).
+ */
+template <typename Real>
+double PositionTolerance(double scale, const ffdref::Vec& x, const ffdref::Frame& f, const ffd::Mat3<Real>& j)
+{
+  double gradient = 0.0;
+  for (int r = 0; r < 3; ++r)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      gradient = std::max(gradient, std::fabs(double(j.M[r][c]) - (r == c ? 1.0 : 0.0)));
+    }
+  }
+  return EvaluationTolerance<Real>() * (scale + MaxAbs(x)) + 8.0 * Eps<Real>() * gradient * (MaxAbs(x) + MaxAbs(f.X0));
 }
 
 } // namespace ffdtest

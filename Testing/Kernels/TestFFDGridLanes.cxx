@@ -1,0 +1,274 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Deformation of many points at once in SIMD lanes (FFDGridLanes.h, FFDLanes.h), at every instruction-set level
+// this CPU runs, for every basis: against the float64 reference ffdref::DeformLocal; a point's result the same
+// bit for bit whichever pass deforms it, whatever its neighbours and however the range is split; the list of
+// gathered points.
+
+#include "FFDGridLanes.h"
+#include "FFDKernelTestUtilities.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <string>
+#include <vector>
+
+namespace
+{
+using ffdref::Basis;
+using ffdref::Vec;
+using ffdtest::GridLattice;
+
+/// The levels this CPU runs, one point at a time (None) included.
+std::vector<ffd::SimdLevel> Levels()
+{
+  std::vector<ffd::SimdLevel> levels;
+  for (int l = 0; l <= int(ffd::SimdLevelOfCpu()); ++l)
+  {
+    levels.push_back(ffd::SimdLevel(l));
+  }
+  return levels;
+}
+
+std::string LevelName(ffd::SimdLevel level)
+{
+  const char* names[] = { "None", "SSE2", "AVX2", "AVX512" };
+  return names[int(level)];
+}
+
+/// Points as the filter holds them: 3 Real values each, and their cells from the kernel's binding.
+template <typename Real>
+struct PointSet
+{
+  std::vector<Real> Values;
+  std::vector<int> Cells;
+  std::int64_t Size() const { return std::int64_t(this->Cells.size()); }
+};
+
+/**
+ * A mesh-like point set of lattice `lat`: runs of 1 to 40 points in one random cell (the coherent order of a
+ * mesh: shared blocks and mixed ones), random points of the frame, points outside the frame (cell -1), and a
+ * count that is not a multiple of any lane width.
+ */
+template <typename Real, typename K>
+PointSet<Real> MeshLikePoints(ffdtest::Rng& rng, const GridLattice& lat, const K& k, int count)
+{
+  PointSet<Real> set;
+  auto add = [&](const Vec& stu) {
+    const ffd::Vec3<Real> x = ffdtest::ToKernel<Real>(ffdtest::ToWorld(lat.F, stu));
+    set.Values.insert(set.Values.end(), { x.x, x.y, x.z });
+    set.Cells.push_back(k.Bind(x, false));
+  };
+  while (int(set.Cells.size()) < count)
+  {
+    const double kind = ffdtest::Uniform(rng, 0.0, 1.0);
+    if (kind < 0.6) // a run in one cell
+    {
+      Vec lo;
+      for (int a = 0; a < 3; ++a)
+      {
+        const int cells = lat.Basis == Basis::Bernstein ? 1 : lat.Divisions[a];
+        lo[a] = double(std::uniform_int_distribution<int>(0, cells - 1)(rng)) / cells;
+      }
+      const int run = std::uniform_int_distribution<int>(1, 40)(rng);
+      for (int p = 0; p < run; ++p)
+      {
+        Vec stu;
+        for (int a = 0; a < 3; ++a)
+        {
+          const int cells = lat.Basis == Basis::Bernstein ? 1 : lat.Divisions[a];
+          stu[a] = lo[a] + ffdtest::Uniform(rng, 0.01, 0.99) / cells;
+        }
+        add(stu);
+      }
+    }
+    else if (kind < 0.95)
+    {
+      add(ffdtest::RandomVec(rng, 0.0, 1.0));
+    }
+    else
+    {
+      add(ffdtest::RandomVec(rng, 1.1, 1.5)); // outside: keeps its position
+    }
+  }
+  set.Values.resize(3 * std::size_t(count));
+  set.Cells.resize(std::size_t(count));
+  return set;
+}
+
+/// Both passes over the whole set, the ranges cut at the given points (sorted, within the ranges).
+template <typename D, typename Real>
+std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Real>& set,
+  const std::vector<int>& gathered, const std::vector<std::int64_t>& blockCuts = {},
+  const std::vector<std::int64_t>& gatheredCuts = {})
+{
+  std::vector<Real> out(set.Values.size(), std::numeric_limits<Real>::quiet_NaN()); // poisoned
+  const std::int64_t blocks = (set.Size() + ffd::BlockSize - 1) / ffd::BlockSize;
+  std::int64_t begin = 0;
+  for (std::int64_t cut : blockCuts)
+  {
+    ffd::DeformSharedBlocks(level, d, set.Values.data(), set.Cells.data(), out.data(), set.Size(), begin, cut);
+    begin = cut;
+  }
+  ffd::DeformSharedBlocks(level, d, set.Values.data(), set.Cells.data(), out.data(), set.Size(), begin, blocks);
+  begin = 0;
+  for (std::int64_t cut : gatheredCuts)
+  {
+    ffd::DeformGathered(level, d, set.Values.data(), set.Cells.data(), gathered.data(), out.data(), begin, cut);
+    begin = cut;
+  }
+  ffd::DeformGathered(level, d, set.Values.data(), set.Cells.data(), gathered.data(), out.data(), begin,
+    std::int64_t(gathered.size()));
+  return out;
+}
+
+int CellCount(const GridLattice& lat)
+{
+  return lat.Basis == Basis::Bernstein ? 1 : lat.Divisions[0] * lat.Divisions[1] * lat.Divisions[2];
+}
+
+template <typename Real>
+class FFDGridLanesTest : public ::testing::Test
+{
+};
+using RealTypes = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(FFDGridLanesTest, RealTypes);
+
+TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
+{
+  // Every basis and level, random lattices, 1001 mesh-like points into a NaN-poisoned output: every point is
+  // written, points outside keep their position exactly, the others match ffdref::DeformLocal within
+  // ffdtest::PositionTolerance() (1e-12 in double, 1e-6 in float, relative to the lattice's scale).
+  using Real = TypeParam;
+  ffdtest::Rng rng(601);
+  ffdtest::WorstRatio worst("worst_error_over_tolerance");
+  for (Basis b : ffdtest::AllBases)
+  {
+    for (int trial = 0; trial < 6; ++trial)
+    {
+      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 5);
+      const double scale = ffdtest::LatticeScale(lat.Points);
+      ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
+        const PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 1001);
+        const std::vector<int> gathered = ffd::GatherByCell(set.Cells.data(), set.Size(), CellCount(lat));
+        for (ffd::SimdLevel level : Levels())
+        {
+          const std::vector<Real> out = DeformAll(level, k.D, set, gathered);
+          for (std::int64_t i = 0; i < set.Size(); ++i)
+          {
+            const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&set.Values[3 * i]);
+            const ffd::Vec3<Real> y = ffd::Vec3<Real>::From(&out[3 * i]);
+            const std::string where = lat.Name() + " level " + LevelName(level) + " point " + std::to_string(i);
+            if (set.Cells[i] < 0)
+            {
+              ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
+              continue;
+            }
+            ffd::Mat3<Real> j;
+            k.D.Deform(x, set.Cells[i], j);
+            const Vec xd = ffdtest::ToRef(x);
+            const Vec want = ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, xd);
+            const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
+            worst.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
+            ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
+          }
+        }
+      });
+    }
+  }
+}
+
+TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
+{
+  // At each level, a point's result is the same bit for bit: in its mesh order, split into random sub-ranges
+  // (as threads split it), and in a shuffled order, where most points are gathered rather than deformed in
+  // shared blocks.
+  using Real = TypeParam;
+  ffdtest::Rng rng(602);
+  for (Basis b : ffdtest::AllBases)
+  {
+    const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 5);
+    ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
+      const PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 2003);
+      const std::vector<int> gathered = ffd::GatherByCell(set.Cells.data(), set.Size(), CellCount(lat));
+      std::vector<std::int64_t> order(std::size_t(set.Size()));
+      std::iota(order.begin(), order.end(), 0);
+      std::shuffle(order.begin(), order.end(), rng);
+      PointSet<Real> shuffled;
+      for (std::int64_t i : order)
+      {
+        shuffled.Values.insert(shuffled.Values.end(), &set.Values[3 * i], &set.Values[3 * i] + 3);
+        shuffled.Cells.push_back(set.Cells[i]);
+      }
+      const std::vector<int> shuffledGathered =
+        ffd::GatherByCell(shuffled.Cells.data(), shuffled.Size(), CellCount(lat));
+      ASSERT_GT(shuffledGathered.size(), gathered.size()) << lat.Name();
+
+      auto cuts = [&](std::int64_t n) {
+        std::vector<std::int64_t> c;
+        for (int m = 0; m < 7; ++m)
+        {
+          c.push_back(std::uniform_int_distribution<std::int64_t>(0, n)(rng));
+        }
+        std::sort(c.begin(), c.end());
+        return c;
+      };
+      for (ffd::SimdLevel level : Levels())
+      {
+        const std::vector<Real> whole = DeformAll(level, k.D, set, gathered);
+        const std::vector<Real> split = DeformAll(level, k.D, set, gathered,
+          cuts((set.Size() + ffd::BlockSize - 1) / ffd::BlockSize), cuts(std::int64_t(gathered.size())));
+        const std::vector<Real> reordered = DeformAll(level, k.D, shuffled, shuffledGathered);
+        for (std::size_t p = 0; p < order.size(); ++p)
+        {
+          const std::size_t i = std::size_t(order[p]);
+          for (int c = 0; c < 3; ++c)
+          {
+            ASSERT_EQ(split[3 * i + c], whole[3 * i + c]) << lat.Name() << " " << LevelName(level) << " point " << i;
+            ASSERT_EQ(reordered[3 * p + c], whole[3 * i + c])
+              << lat.Name() << " " << LevelName(level) << " point " << i;
+          }
+        }
+      }
+    });
+  }
+}
+
+TEST(FFDGridLanes, GatherByCellListsTheMixedBlocksByCell)
+{
+  // cells of 3 full blocks and a partial one: block 0 shares cell 5, block 1 mixes 2 and -1, block 2 shares
+  // cell -1 (kept in place by the first pass), the tail mixes. The list: the points of blocks 1 and 3,
+  // stably sorted by cell with -1 first.
+  const int n = 3 * ffd::BlockSize + 5;
+  std::vector<int> cells(n, 5);
+  for (int i = ffd::BlockSize; i < 2 * ffd::BlockSize; ++i)
+  {
+    cells[i] = i % 3 == 0 ? -1 : 2;
+  }
+  std::fill(cells.begin() + 2 * ffd::BlockSize, cells.begin() + 3 * ffd::BlockSize, -1);
+  const int tail[5] = { 7, 2, 7, -1, 0 };
+  std::copy(tail, tail + 5, cells.begin() + 3 * ffd::BlockSize);
+
+  std::vector<int> expected;
+  for (int cell = -1; cell < 8; ++cell)
+  {
+    for (int i = 0; i < n; ++i)
+    {
+      const bool mixedBlock = (i >= ffd::BlockSize && i < 2 * ffd::BlockSize) || i >= 3 * ffd::BlockSize;
+      if (mixedBlock && cells[i] == cell)
+      {
+        expected.push_back(i);
+      }
+    }
+  }
+  EXPECT_EQ(ffd::GatherByCell(cells.data(), n, 8), expected);
+  EXPECT_TRUE(ffd::BlockSharesCell(cells.data(), n, 0));
+  EXPECT_FALSE(ffd::BlockSharesCell(cells.data(), n, 1));
+  EXPECT_TRUE(ffd::BlockSharesCell(cells.data(), n, 2));
+  EXPECT_FALSE(ffd::BlockSharesCell(cells.data(), n, 3));
+}
+
+} // namespace
