@@ -3,59 +3,95 @@
 
 #include "vtkActor.h"
 #include "vtkAlgorithmOutput.h"
+#include "vtkDataArray.h"
 #include "vtkDataSet.h"
-#include "vtkExtractEdges.h"
+#include "vtkFFDCellEdges.h"
+#include "vtkFFDControlPoints.h"
 #include "vtkGlyph3DMapper.h"
+#include "vtkLookupTable.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPolyData.h"
 #include "vtkPolyDataMapper.h"
 #include "vtkProperty.h"
 #include "vtkSphereSource.h"
 
 vtkStandardNewMacro(vtkFFDLatticeActor);
 
+namespace
+{
+/// A glyph part: one sphere per control point of a vtkFFDControlPoints output.
+struct PointPart
+{
+  vtkNew<vtkFFDControlPoints> Points;
+  vtkNew<vtkGlyph3DMapper> Mapper;
+  vtkNew<vtkActor> Actor;
+
+  void Initialize(vtkSphereSource* sphere, int selection, double r, double g, double b)
+  {
+    this->Points->SetSelection(selection);
+    this->Mapper->SetInputConnection(this->Points->GetOutputPort());
+    this->Mapper->SetSourceConnection(sphere->GetOutputPort());
+    // The sphere's own radius sets the glyph size: no scaling or orientation from point arrays.
+    this->Mapper->ScalingOff();
+    this->Mapper->OrientOff();
+    this->Mapper->ScalarVisibilityOff();
+    this->Actor->SetMapper(this->Mapper);
+    this->Actor->GetProperty()->SetColor(r, g, b);
+  }
+};
+
+/// A line part: the edges of the visible cells of a data set.
+struct EdgePart
+{
+  vtkNew<vtkFFDCellEdges> Edges;
+  vtkNew<vtkPolyDataMapper> Mapper;
+  vtkNew<vtkActor> Actor;
+
+  void Initialize(double r, double g, double b, double width)
+  {
+    this->Mapper->SetInputConnection(this->Edges->GetOutputPort());
+    this->Mapper->ScalarVisibilityOff();
+    this->Actor->SetMapper(this->Mapper);
+    this->Actor->GetProperty()->SetColor(r, g, b);
+    this->Actor->GetProperty()->SetLineWidth(width);
+    // Lines get no shading; without this they would darken with their angle to the light.
+    this->Actor->GetProperty()->LightingOff();
+  }
+};
+}
+
 struct vtkFFDLatticeActor::vtkInternals
 {
-  // Control points: one sphere glyph per lattice point.
-  vtkNew<vtkSphereSource> Sphere;
-  vtkNew<vtkGlyph3DMapper> PointMapper;
-  vtkNew<vtkActor> PointActor;
-
-  // Lattice edges: the cells' edges, which for a structured lattice are the grid lines.
-  vtkNew<vtkExtractEdges> Edges;
-  vtkNew<vtkPolyDataMapper> EdgeMapper;
-  vtkNew<vtkActor> EdgeActor;
+  vtkNew<vtkSphereSource> Sphere; // shared by both point parts: culled and active spheres have one size
+  PointPart ActivePoints;
+  PointPart CulledPoints;
+  EdgePart LatticeEdges;
+  EdgePart Voxels;
+  vtkNew<vtkLookupTable> DisplacementColors;
+  bool HasLattice = false;
+  bool HasVoxelGrid = false;
 };
 
 //------------------------------------------------------------------------------
 vtkFFDLatticeActor::vtkFFDLatticeActor()
-  : PointRadius(0.0)
-  , Internals(new vtkInternals)
+  : Internals(new vtkInternals)
 {
   vtkInternals& in = *this->Internals;
-
   in.Sphere->SetThetaResolution(16);
   in.Sphere->SetPhiResolution(12);
-  in.PointMapper->SetSourceConnection(in.Sphere->GetOutputPort());
-  // The sphere's own radius sets the glyph size: no scaling or orientation from the lattice's arrays
-  // (a lattice carries RestPosition vectors that would otherwise orient or scale the glyphs).
-  in.PointMapper->ScalingOff();
-  in.PointMapper->OrientOff();
-  // Colours come from the properties, not from point arrays such as `Active`.
-  in.PointMapper->ScalarVisibilityOff();
-  in.PointActor->SetMapper(in.PointMapper);
-  in.PointActor->GetProperty()->SetColor(0.9, 0.1, 0.1);
+  in.ActivePoints.Initialize(in.Sphere, vtkFFDControlPoints::ACTIVE, 0.9, 0.1, 0.1);
+  in.CulledPoints.Initialize(in.Sphere, vtkFFDControlPoints::CULLED, 0.75, 0.75, 0.75);
+  in.LatticeEdges.Initialize(0.25, 0.25, 0.25, 2.0);
+  in.Voxels.Initialize(0.27, 0.51, 0.71, 1.0);
 
-  // Keep the lattice's points as they are (no merging locator): edge i-j then joins lattice points i and j.
-  in.Edges->UseAllPointsOn();
-  in.EdgeMapper->SetInputConnection(in.Edges->GetOutputPort());
-  in.EdgeMapper->ScalarVisibilityOff();
-  in.EdgeActor->SetMapper(in.EdgeMapper);
-  in.EdgeActor->GetProperty()->SetColor(0.25, 0.25, 0.25);
-  in.EdgeActor->GetProperty()->SetLineWidth(2.0);
-  // Lines get no shading; without this they would darken with their angle to the light.
-  in.EdgeActor->GetProperty()->LightingOff();
-  // The parts join the assembly once there is an input (ShowParts).
+  // Blue (not moved) to red (moved the most), the usual reading of a magnitude.
+  in.DisplacementColors->SetHueRange(0.667, 0.0);
+  in.DisplacementColors->Build();
+  in.ActivePoints.Mapper->SetLookupTable(in.DisplacementColors);
+  in.ActivePoints.Mapper->UseLookupTableScalarRangeOff();
+  // The parts join the assembly once there is an input (ShowLatticeParts, SetVoxelGridData).
 }
 
 //------------------------------------------------------------------------------
@@ -64,49 +100,94 @@ vtkFFDLatticeActor::~vtkFFDLatticeActor() = default;
 //------------------------------------------------------------------------------
 void vtkFFDLatticeActor::SetInputConnection(vtkAlgorithmOutput* output)
 {
-  this->Internals->PointMapper->SetInputConnection(output);
-  this->Internals->Edges->SetInputConnection(output);
-  this->ShowParts(output != nullptr);
+  vtkInternals& in = *this->Internals;
+  in.ActivePoints.Points->SetInputConnection(output);
+  in.CulledPoints.Points->SetInputConnection(output);
+  in.LatticeEdges.Edges->SetInputConnection(output);
+  this->ShowLatticeParts(output != nullptr);
   this->Modified();
 }
 
 //------------------------------------------------------------------------------
 void vtkFFDLatticeActor::SetInputData(vtkDataSet* lattice)
 {
-  this->Internals->PointMapper->SetInputData(lattice);
-  this->Internals->Edges->SetInputData(lattice);
-  this->ShowParts(lattice != nullptr);
+  vtkInternals& in = *this->Internals;
+  in.ActivePoints.Points->SetInputData(lattice);
+  in.CulledPoints.Points->SetInputData(lattice);
+  in.LatticeEdges.Edges->SetInputData(lattice);
+  this->ShowLatticeParts(lattice != nullptr);
   this->Modified();
 }
 
 //------------------------------------------------------------------------------
-void vtkFFDLatticeActor::ShowParts(bool hasInput)
+void vtkFFDLatticeActor::ShowLatticeParts(bool hasInput)
 {
-  // Without an input the parts stay out of the assembly: asking an unconnected vtkExtractEdges for its
-  // output (for bounds, for a render or for PrintSelf) is a pipeline error.
+  // Without an input the parts stay out of the assembly: updating an unconnected filter (for bounds, for a
+  // render or for PrintSelf) is a pipeline error.
   vtkInternals& in = *this->Internals;
-  if (hasInput)
+  in.HasLattice = hasInput;
+  vtkActor* parts[3] = { in.LatticeEdges.Actor, in.CulledPoints.Actor, in.ActivePoints.Actor };
+  for (vtkActor* part : parts)
   {
-    this->AddPart(in.EdgeActor);
-    this->AddPart(in.PointActor);
+    if (hasInput)
+    {
+      this->AddPart(part);
+    }
+    else
+    {
+      this->RemovePart(part);
+    }
   }
-  else
-  {
-    this->RemovePart(in.EdgeActor);
-    this->RemovePart(in.PointActor);
-  }
+}
+
+//------------------------------------------------------------------------------
+void vtkFFDLatticeActor::SetVoxelGridConnection(vtkAlgorithmOutput* output)
+{
+  vtkInternals& in = *this->Internals;
+  in.Voxels.Edges->SetInputConnection(output);
+  in.HasVoxelGrid = output != nullptr;
+  in.HasVoxelGrid ? this->AddPart(in.Voxels.Actor) : this->RemovePart(in.Voxels.Actor);
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+void vtkFFDLatticeActor::SetVoxelGridData(vtkDataSet* voxelGrid)
+{
+  vtkInternals& in = *this->Internals;
+  in.Voxels.Edges->SetInputData(voxelGrid);
+  in.HasVoxelGrid = voxelGrid != nullptr;
+  in.HasVoxelGrid ? this->AddPart(in.Voxels.Actor) : this->RemovePart(in.Voxels.Actor);
+  this->Modified();
 }
 
 //------------------------------------------------------------------------------
 vtkProperty* vtkFFDLatticeActor::GetPointProperty()
 {
-  return this->Internals->PointActor->GetProperty();
+  return this->Internals->ActivePoints.Actor->GetProperty();
+}
+
+//------------------------------------------------------------------------------
+vtkProperty* vtkFFDLatticeActor::GetCulledPointProperty()
+{
+  return this->Internals->CulledPoints.Actor->GetProperty();
 }
 
 //------------------------------------------------------------------------------
 vtkProperty* vtkFFDLatticeActor::GetEdgeProperty()
 {
-  return this->Internals->EdgeActor->GetProperty();
+  return this->Internals->LatticeEdges.Actor->GetProperty();
+}
+
+//------------------------------------------------------------------------------
+vtkProperty* vtkFFDLatticeActor::GetVoxelProperty()
+{
+  return this->Internals->Voxels.Actor->GetProperty();
+}
+
+//------------------------------------------------------------------------------
+vtkLookupTable* vtkFFDLatticeActor::GetDisplacementLookupTable()
+{
+  return this->Internals->DisplacementColors;
 }
 
 //------------------------------------------------------------------------------
@@ -116,41 +197,74 @@ double vtkFFDLatticeActor::GetRenderedPointRadius()
 }
 
 //------------------------------------------------------------------------------
-void vtkFFDLatticeActor::UpdatePointRadius()
+void vtkFFDLatticeActor::UpdateParts()
 {
   vtkInternals& in = *this->Internals;
+  in.LatticeEdges.Actor->SetVisibility(in.HasLattice && this->ShowEdges);
+  if (!in.HasLattice)
+  {
+    return;
+  }
+  // The lattice may have moved since the last render: bring the point parts up to date before measuring.
+  in.ActivePoints.Points->Update();
+  vtkPolyData* active = in.ActivePoints.Points->GetOutput();
+  // A part with no point would report uninitialized bounds; it is hidden instead.
+  in.ActivePoints.Actor->SetVisibility(active->GetNumberOfPoints() > 0);
+  bool showCulled = false;
+  if (this->ShowCulledPoints)
+  {
+    in.CulledPoints.Points->Update();
+    showCulled = in.CulledPoints.Points->GetOutput()->GetNumberOfPoints() > 0;
+  }
+  in.CulledPoints.Actor->SetVisibility(showCulled);
+
   if (this->PointRadius > 0.0)
   {
     in.Sphere->SetRadius(this->PointRadius);
-    return;
   }
-  vtkAlgorithmOutput* input = in.PointMapper->GetInputConnection(0, 0);
-  if (!input)
+  else
   {
-    return;
+    vtkDataSet* lattice = vtkDataSet::SafeDownCast(in.ActivePoints.Points->GetInputDataObject(0, 0));
+    // A lattice of a single point (or none) has no size to scale with: the last radius stays.
+    const double diagonal = (lattice && lattice->GetNumberOfPoints() > 0) ? lattice->GetLength() : 0.0;
+    if (diagonal > 0.0)
+    {
+      in.Sphere->SetRadius(GetAutomaticRadiusFraction() * diagonal);
+    }
   }
-  // The lattice may have moved since the last render: bring the input up to date before measuring it.
-  input->GetProducer()->Update(input->GetIndex());
-  vtkDataSet* lattice = in.PointMapper->GetInput();
-  // A lattice of a single point (or none) has no size to scale with: the last radius stays.
-  const double diagonal = (lattice && lattice->GetNumberOfPoints() > 0) ? lattice->GetLength() : 0.0;
-  if (diagonal > 0.0)
+
+  in.ActivePoints.Mapper->SetScalarVisibility(this->ColorByDisplacement);
+  if (this->ColorByDisplacement)
   {
-    in.Sphere->SetRadius(GetAutomaticRadiusFraction() * diagonal);
+    double range[2] = { this->DisplacementRange[0], this->DisplacementRange[1] };
+    if (range[1] <= range[0])
+    {
+      vtkDataArray* lengths = active->GetPointData()->GetScalars();
+      range[0] = 0.0;
+      range[1] = lengths && lengths->GetNumberOfTuples() > 0 ? lengths->GetRange(0)[1] : 0.0;
+      if (range[1] <= 0.0)
+      {
+        range[1] = 1.0; // nothing moved: every point gets the colour of 0
+      }
+    }
+    in.ActivePoints.Mapper->SetScalarRange(range);
   }
 }
 
 //------------------------------------------------------------------------------
 int vtkFFDLatticeActor::RenderOpaqueGeometry(vtkViewport* viewport)
 {
-  this->UpdatePointRadius();
+  this->UpdateParts();
+  // vtkGlyph3DMapper brings its sphere source up to date in GetBounds(), which the renderer calls on its own
+  // props only: inside a widget representation nobody else would, and a new radius would not show.
+  this->Superclass::GetBounds();
   return this->Superclass::RenderOpaqueGeometry(viewport);
 }
 
 //------------------------------------------------------------------------------
 double* vtkFFDLatticeActor::GetBounds()
 {
-  this->UpdatePointRadius();
+  this->UpdateParts();
   return this->Superclass::GetBounds();
 }
 
@@ -158,11 +272,23 @@ double* vtkFFDLatticeActor::GetBounds()
 void vtkFFDLatticeActor::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "PointRadius: " << this->PointRadius
-     << (this->PointRadius > 0.0 ? "" : " (automatic)") << "\n";
-  os << indent << "RenderedPointRadius: " << this->Internals->Sphere->GetRadius() << "\n";
+  vtkInternals& in = *this->Internals;
+  os << indent << "Lattice: " << (in.HasLattice ? "set" : "(none)") << "\n";
+  os << indent << "VoxelGrid: " << (in.HasVoxelGrid ? "set" : "(none)") << "\n";
+  os << indent << "PointRadius: " << this->PointRadius << (this->PointRadius > 0.0 ? "" : " (automatic)")
+     << "\n";
+  os << indent << "RenderedPointRadius: " << in.Sphere->GetRadius() << "\n";
+  os << indent << "ShowCulledPoints: " << (this->ShowCulledPoints ? "On" : "Off") << "\n";
+  os << indent << "ShowEdges: " << (this->ShowEdges ? "On" : "Off") << "\n";
+  os << indent << "ColorByDisplacement: " << (this->ColorByDisplacement ? "On" : "Off") << "\n";
+  os << indent << "DisplacementRange: " << this->DisplacementRange[0] << " " << this->DisplacementRange[1]
+     << (this->DisplacementRange[1] > this->DisplacementRange[0] ? "" : " (automatic)") << "\n";
   os << indent << "PointProperty:\n";
   this->GetPointProperty()->PrintSelf(os, indent.GetNextIndent());
+  os << indent << "CulledPointProperty:\n";
+  this->GetCulledPointProperty()->PrintSelf(os, indent.GetNextIndent());
   os << indent << "EdgeProperty:\n";
   this->GetEdgeProperty()->PrintSelf(os, indent.GetNextIndent());
+  os << indent << "VoxelProperty:\n";
+  this->GetVoxelProperty()->PrintSelf(os, indent.GetNextIndent());
 }

@@ -1,26 +1,35 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
  * @class   vtkFFDLatticeActor
- * @brief   draws a free-form deformation lattice: control points as spheres, grid lines between neighbours
+ * @brief   draws a free-form deformation lattice: control points, lattice edges and active voxels
  *
- * A vtkAssembly of two parts that show a control lattice (the vtkStructuredGrid from vtkFFDBuildLattice, as
- * it is or deformed by moving its points):
- * - the control points, as sphere glyphs (vtkGlyph3DMapper over a vtkSphereSource), red by default;
- * - the lattice edges, the grid lines between neighbouring control points (vtkExtractEdges), dark grey lines
- *   of width 2 by default.
+ * A vtkAssembly of up to four parts that show a control lattice (the vtkStructuredGrid from
+ * vtkFFDBuildLattice, as it is or deformed by moving its points, or a vtkUnstructuredGrid of tetrahedra with
+ * the same point arrays) and, optionally, the voxel grid it was built over:
+ * - the active control points, as sphere glyphs, red by default (GetPointProperty()), or coloured by how far
+ *   they have been moved from their `RestPosition` (ColorByDisplacement);
+ * - the culled control points (`Active` 0: they influence no active voxel, paper section III.D), as light
+ *   grey spheres of the same size (GetCulledPointProperty(); ShowCulledPoints off hides them);
+ * - the lattice edges, the edges of the lattice's cells (grid lines of a structured lattice, tetrahedron
+ *   edges of an unstructured one), dark grey lines of width 2 (GetEdgeProperty());
+ * - the active voxels as wireframe boxes, when a voxel grid from vtkFFDVoxelize is set (SetVoxelGridData() or
+ *   SetVoxelGridConnection()): its inactive voxels are hidden cells and are not drawn; steel blue lines of
+ *   width 1 by default (GetVoxelProperty()). The boxes stay where the voxel grid is: the rest frame.
  *
- * Both parts read the lattice through their own pipelines, so the actor follows the lattice: moving its
- * points (and marking them modified) or re-executing the upstream filter shows at the next render.
+ * Every part reads its input through its own pipeline (vtkFFDControlPoints, vtkFFDCellEdges), so the actor
+ * follows the lattice: moving its points (and marking them modified) or re-executing the upstream filter shows
+ * at the next render.
  *
  * The sphere radius is PointRadius, or, when PointRadius is 0 (the default), a fixed fraction of the diagonal
  * of the current lattice's bounds, computed whenever the actor is rendered or asked for its bounds, so that
  * the spheres keep their size relative to the lattice as it deforms.
  *
- * The input may be any vtkDataSet whose cells join neighbouring control points (a structured grid of
- * control points gives the grid lines). Colouring by the `Active` array and showing active voxels are not done
- * here yet; the point and edge parts take no colours from the input's scalars.
+ * A lattice without an `Active` array shows every control point as active; one without `RestPosition` has no
+ * displacement to colour by (every point gets the colour of 0). Arrays of the wrong shape are reported by
+ * vtkFFDControlPoints, and the point parts then show nothing.
  *
- * @sa vtkFFDBuildLattice vtkFFDDeform vtkAssembly vtkGlyph3DMapper vtkExtractEdges
+ * @sa vtkFFDBuildLattice vtkFFDVoxelize vtkFFDDeform vtkFFDControlPoints vtkFFDCellEdges
+ * vtkFFDLatticeRepresentation vtkAssembly vtkGlyph3DMapper
  */
 #ifndef vtkFFDLatticeActor_h
 #define vtkFFDLatticeActor_h
@@ -32,6 +41,7 @@
 
 class vtkAlgorithmOutput;
 class vtkDataSet;
+class vtkLookupTable;
 class vtkProperty;
 
 class VTKFFDRENDERING_EXPORT vtkFFDLatticeActor : public vtkAssembly
@@ -42,16 +52,55 @@ public:
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
   ///@{
-  /// The lattice to draw: a pipeline connection (e.g. vtkFFDBuildLattice's output) or a data set.
+  /// The lattice to draw: a pipeline connection (e.g. vtkFFDBuildLattice's output) or a data set (a
+  /// vtkPointSet: structured or unstructured lattice). nullptr removes the lattice's parts.
   void SetInputConnection(vtkAlgorithmOutput* output);
   void SetInputData(vtkDataSet* lattice);
   ///@}
 
   ///@{
-  /// Properties of the control-point spheres (default red) and of the lattice edges (default dark grey,
-  /// line width 2).
+  /// The voxel grid whose active voxels are drawn as boxes (vtkFFDVoxelize's output); nullptr (the default)
+  /// draws no voxels.
+  void SetVoxelGridConnection(vtkAlgorithmOutput* output);
+  void SetVoxelGridData(vtkDataSet* voxelGrid);
+  ///@}
+
+  ///@{
+  /// Properties of the parts: active control points (default red), culled control points (default light
+  /// grey), lattice edges (default dark grey, line width 2), voxel boxes (default steel blue, line width 1).
   vtkProperty* GetPointProperty();
+  vtkProperty* GetCulledPointProperty();
   vtkProperty* GetEdgeProperty();
+  vtkProperty* GetVoxelProperty();
+  ///@}
+
+  ///@{
+  /// Whether the culled control points are drawn (default on).
+  vtkSetMacro(ShowCulledPoints, bool);
+  vtkGetMacro(ShowCulledPoints, bool);
+  vtkBooleanMacro(ShowCulledPoints, bool);
+  ///@}
+
+  ///@{
+  /// Whether the lattice edges are drawn (default on).
+  vtkSetMacro(ShowEdges, bool);
+  vtkGetMacro(ShowEdges, bool);
+  vtkBooleanMacro(ShowEdges, bool);
+  ///@}
+
+  ///@{
+  /**
+   * Colour the active control points by their displacement length |point - RestPosition| through
+   * GetDisplacementLookupTable() (blue for 0 to red) instead of the point property's colour (default off).
+   * The colours span DisplacementRange; when its maximum is not above its minimum (the default, 0 0), they
+   * span 0 to the largest displacement of the current lattice.
+   */
+  vtkSetMacro(ColorByDisplacement, bool);
+  vtkGetMacro(ColorByDisplacement, bool);
+  vtkBooleanMacro(ColorByDisplacement, bool);
+  vtkSetVector2Macro(DisplacementRange, double);
+  vtkGetVector2Macro(DisplacementRange, double);
+  vtkLookupTable* GetDisplacementLookupTable();
   ///@}
 
   ///@{
@@ -66,7 +115,7 @@ public:
   double GetRenderedPointRadius();
 
   ///@{
-  /// Bring the point radius up to date with the input before drawing or reporting bounds.
+  /// Bring the parts up to date with the inputs and the settings before drawing or reporting bounds.
   int RenderOpaqueGeometry(vtkViewport* viewport) override;
   double* GetBounds() VTK_SIZEHINT(6) override;
   using vtkAssembly::GetBounds;
@@ -76,13 +125,18 @@ protected:
   vtkFFDLatticeActor();
   ~vtkFFDLatticeActor() override;
 
-  /// Sets the sphere radius from PointRadius or the current input's bounds.
-  void UpdatePointRadius();
+  /// Sets the sphere radius from PointRadius or the current input's bounds, the parts' visibility and the
+  /// colouring from the settings.
+  void UpdateParts();
 
-  /// Puts the parts in the assembly when there is an input, takes them out when there is none.
-  void ShowParts(bool hasInput);
+  /// Puts the lattice's parts in the assembly when there is an input, takes them out when there is none.
+  void ShowLatticeParts(bool hasInput);
 
-  double PointRadius;
+  double PointRadius = 0.0;
+  bool ShowCulledPoints = true;
+  bool ShowEdges = true;
+  bool ColorByDisplacement = false;
+  double DisplacementRange[2] = { 0.0, 0.0 };
 
 private:
   vtkFFDLatticeActor(const vtkFFDLatticeActor&) = delete;

@@ -34,16 +34,20 @@
 struct FFDTestLattice
 {
   vtkSmartPointer<vtkStructuredGrid> Grid;
+  vtkSmartPointer<vtkStructuredGrid> VoxelGrid; ///< vtkFFDVoxelize's output: inactive voxels hidden
   double Frame[12]; ///< X0, S, T, U
   int Divisions[3];
   int Dims[3]; ///< control points per axis
   vtkIdType ActiveVoxels = 0;
   vtkIdType ActiveControlPoints = 0;
 
+  /// Id of control point (i, j, k).
+  vtkIdType Id(int i, int j, int k) const { return i + this->Dims[0] * (j + vtkIdType(this->Dims[1]) * k); }
+
   /// Moves control point (i, j, k) by (ds, dt, du) in frame units: ds S + dt T + du U.
   void Move(int i, int j, int k, double ds, double dt, double du)
   {
-    const vtkIdType id = i + this->Dims[0] * (j + vtkIdType(this->Dims[1]) * k);
+    const vtkIdType id = this->Id(i, j, k);
     double p[3];
     this->Grid->GetPoint(id, p);
     for (int c = 0; c < 3; ++c)
@@ -70,6 +74,8 @@ inline bool BuildTestLattice(
   lattice.Grid = vtkSmartPointer<vtkStructuredGrid>::New();
   lattice.Grid->DeepCopy(build->GetOutput());
   lattice.Grid->GetDimensions(lattice.Dims);
+  lattice.VoxelGrid = vtkSmartPointer<vtkStructuredGrid>::New();
+  lattice.VoxelGrid->DeepCopy(voxelize->GetOutput());
   std::copy(divisions, divisions + 3, lattice.Divisions);
   lattice.ActiveVoxels = voxelize->GetNumberOfActiveVoxels();
   lattice.ActiveControlPoints = build->GetNumberOfActiveControlPoints();
@@ -129,9 +135,9 @@ inline vtkIdType CountMovedPoints(vtkPolyData* deformed, double tolerance)
  * Adds the deformed mesh, coloured by its `Displacement` from ivory (did not move) to red (moved
  * `maxDisplacement` or more), and the lattice to `renderer`, on a white background. A dense lattice is drawn
  * with small spheres (`pointRadius` in world units, 0 for vtkFFDLatticeActor's automatic size) and thin,
- * light edges, so that the mesh stays visible through it.
+ * light edges, so that the mesh stays visible through it. Returns the lattice's actor, for more settings.
  */
-inline void AddDeformedScene(vtkRenderer* renderer, vtkPolyData* deformed, vtkStructuredGrid* lattice,
+inline vtkFFDLatticeActor* AddDeformedScene(vtkRenderer* renderer, vtkPolyData* deformed, vtkStructuredGrid* lattice,
   double maxDisplacement, double pointRadius = 0.0)
 {
   vtkNew<vtkLookupTable> colours;
@@ -160,6 +166,7 @@ inline void AddDeformedScene(vtkRenderer* renderer, vtkPolyData* deformed, vtkSt
   renderer->AddActor(actor);
   renderer->AddActor(latticeActor);
   renderer->SetBackground(1.0, 1.0, 1.0);
+  return latticeActor; // the renderer holds it
 }
 
 #endif

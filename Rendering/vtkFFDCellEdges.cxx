@@ -1,0 +1,117 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkFFDCellEdges.h"
+
+#include "vtkCell.h"
+#include "vtkCellArray.h"
+#include "vtkDataSet.h"
+#include "vtkDataSetAttributes.h"
+#include "vtkGenericCell.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointSet.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkUnsignedCharArray.h"
+
+#include <algorithm>
+#include <set>
+#include <utility>
+
+vtkStandardNewMacro(vtkFFDCellEdges);
+
+//------------------------------------------------------------------------------
+int vtkFFDCellEdges::FillInputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkDataSet");
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkFFDCellEdges::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkDataSet* input = vtkDataSet::GetData(inputVector[0]);
+  vtkPolyData* output = vtkPolyData::GetData(outputVector);
+  if (!input || !output)
+  {
+    vtkErrorMacro("Expected a vtkDataSet (a lattice or a voxel grid) on input 0.");
+    return 0;
+  }
+  const vtkIdType numberOfPoints = input->GetNumberOfPoints();
+  if (numberOfPoints == 0)
+  {
+    return 1;
+  }
+
+  // The input's own points: shared when it has a vtkPoints (lattices and voxel grids do), copied otherwise.
+  vtkPointSet* pointSet = vtkPointSet::SafeDownCast(input);
+  if (pointSet && pointSet->GetPoints())
+  {
+    output->SetPoints(pointSet->GetPoints());
+  }
+  else
+  {
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->SetNumberOfPoints(numberOfPoints);
+    for (vtkIdType id = 0; id < numberOfPoints; ++id)
+    {
+      points->SetPoint(id, input->GetPoint(id));
+    }
+    output->SetPoints(points);
+  }
+
+  // Unique edges, ordered by their point ids so that the output does not depend on hashing. A set is enough:
+  // lattices and voxel grids have thousands of cells, not millions.
+  std::set<std::pair<vtkIdType, vtkIdType>> edges;
+  auto addEdge = [&edges](vtkIdType a, vtkIdType b) {
+    if (a != b)
+    {
+      edges.emplace(std::min(a, b), std::max(a, b));
+    }
+  };
+  vtkUnsignedCharArray* ghosts = input->GetCellGhostArray();
+  vtkNew<vtkGenericCell> cell;
+  const vtkIdType numberOfCells = input->GetNumberOfCells();
+  for (vtkIdType cellId = 0; cellId < numberOfCells; ++cellId)
+  {
+    if (ghosts && (ghosts->GetValue(cellId) & vtkDataSetAttributes::HIDDENCELL))
+    {
+      continue;
+    }
+    input->GetCell(cellId, cell);
+    if (cell->GetCellDimension() == 1)
+    {
+      // A line or polyline is its own edge list (vtkCell::GetNumberOfEdges() is 0 for them).
+      for (vtkIdType p = 0; p + 1 < cell->GetNumberOfPoints(); ++p)
+      {
+        addEdge(cell->GetPointId(p), cell->GetPointId(p + 1));
+      }
+      continue;
+    }
+    const int numberOfEdges = cell->GetNumberOfEdges();
+    for (int e = 0; e < numberOfEdges; ++e)
+    {
+      vtkCell* edge = cell->GetEdge(e);
+      addEdge(edge->GetPointId(0), edge->GetPointId(1));
+    }
+  }
+
+  vtkNew<vtkCellArray> lines;
+  lines->AllocateExact(static_cast<vtkIdType>(edges.size()), 2 * static_cast<vtkIdType>(edges.size()));
+  for (const auto& edge : edges)
+  {
+    const vtkIdType ids[2] = { edge.first, edge.second };
+    lines->InsertNextCell(2, ids);
+  }
+  output->SetLines(lines);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkFFDCellEdges::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+}
