@@ -1,0 +1,335 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
+"""The Rendering module from Python: vtkFFDLatticeActor's parts (grid and hand-made tetrahedral lattices, voxel
+boxes without the hidden voxels, culled points, displacement colours), vtkFFDCellEdges, vtkFFDControlPoints,
+and vtkFFDLatticeRepresentation / vtkFFDLatticeWidget's API, keys and bad input (no lattice, a lattice without
+the data contract's arrays, malformed arrays). Renders offscreen, so it runs in an X display
+(Utilities/with-display.sh); PYTHONPATH=<build>/lib/python3/dist-packages.
+"""
+import unittest
+
+import numpy as np
+from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+from vtkmodules.vtkCommonCore import vtkCommand, vtkIdList, vtkPoints
+from vtkmodules.vtkCommonDataModel import VTK_TETRA, vtkStructuredGrid, vtkUnstructuredGrid
+from vtkmodules.vtkFiltersSources import vtkSphereSource
+from vtkmodules.vtkInteractionStyle import vtkInteractorStyleTrackballCamera
+from vtkmodules.vtkRenderingCore import (vtkInteractorObserver, vtkRenderer, vtkRenderWindow,
+                                         vtkRenderWindowInteractor)
+import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
+
+import vtkffd
+
+
+class ErrorCatcher:
+    """Collects the messages of ErrorEvents (and keeps expected errors out of the log)."""
+
+    def __init__(self):
+        self.CallDataType = "string0"  # VTK passes the message as call data to observers that declare it
+        self.messages = []
+
+    def __call__(self, caller, event, message):
+        self.messages.append(message)
+
+
+def catch_errors(obj):
+    catcher = ErrorCatcher()
+    obj.AddObserver("ErrorEvent", catcher)
+    return catcher
+
+
+def cube_tetrahedra():
+    """A unit cube split into 5 tetrahedra (8 points, 18 edges: 12 cube edges and 6 face diagonals), with the
+    data contract's point arrays, as a tetrahedral lattice (paper Figure 9) will carry them."""
+    corners = np.array([[i, j, k] for k in (0, 1) for j in (0, 1) for i in (0, 1)], dtype=float)
+    grid = vtkUnstructuredGrid()
+    points = vtkPoints()
+    points.SetData(numpy_to_vtk(corners, deep=True))
+    grid.SetPoints(points)
+    for tet in ((0, 1, 2, 4), (1, 3, 2, 7), (1, 4, 5, 7), (2, 4, 7, 6), (1, 2, 4, 7)):
+        ids = vtkIdList()
+        for p in tet:
+            ids.InsertNextId(p)
+        grid.InsertNextCell(VTK_TETRA, ids)
+    rest = numpy_to_vtk(corners, deep=True)
+    rest.SetName("RestPosition")
+    grid.GetPointData().AddArray(rest)
+    active = numpy_to_vtk(np.array([1, 1, 1, 1, 1, 1, 1, 0], dtype=np.uint8), deep=True)
+    active.SetName("Active")
+    grid.GetPointData().AddArray(active)
+    return grid
+
+
+def sphere_lattice(divisions=(5, 5, 5)):
+    """A 6 x 6 x 6 TRILINEAR lattice around a sphere's surface: the corner voxels and the inner ones hold no
+    point, so some control points are culled."""
+    sphere = vtkSphereSource()
+    sphere.SetThetaResolution(24)
+    sphere.SetPhiResolution(16)
+    voxelize = vtkffd.vtkFFDVoxelize()
+    voxelize.SetInputConnection(sphere.GetOutputPort())
+    voxelize.SetDivisions(*divisions)
+    build = vtkffd.vtkFFDBuildLattice()
+    build.SetInputConnection(voxelize.GetOutputPort())
+    build.SetBasisToTrilinear()
+    build.Update()
+    lattice = vtkStructuredGrid()
+    lattice.DeepCopy(build.GetOutput())
+    return voxelize, build, lattice
+
+
+def parts(actor):
+    """The part actors of a vtkFFDLatticeActor, by their mapper's class and input size."""
+    actor.GetBounds()  # brings the parts up to date, as a render does
+    collection = actor.GetParts()
+    return [collection.GetItemAsObject(i) for i in range(collection.GetNumberOfItems())]
+
+
+def part_inputs(actor):
+    return [p.GetMapper().GetInputDataObject(0, 0) for p in parts(actor) if p.GetVisibility()]
+
+
+class LatticeActorTest(unittest.TestCase):
+    def test_tetrahedral_lattice_points_and_edges(self):
+        grid = cube_tetrahedra()
+        actor = vtkffd.vtkFFDLatticeActor()
+        actor.SetInputData(grid)
+        inputs = part_inputs(actor)
+        lines = [d for d in inputs if d.GetNumberOfLines() > 0]
+        vertices = sorted(d.GetNumberOfVerts() for d in inputs if d.GetNumberOfVerts() > 0)
+        self.assertEqual(len(lines), 1)
+        self.assertEqual(lines[0].GetNumberOfLines(), 18)
+        self.assertEqual(vertices, [1, 7])  # one culled, seven active control points
+        # The edges follow the lattice's points: move one and render again.
+        grid.GetPoints().SetPoint(7, 2.0, 2.0, 2.0)
+        grid.GetPoints().Modified()
+        self.assertEqual(actor.GetBounds()[1] > 1.9, True)
+        lines = [d for d in part_inputs(actor) if d.GetNumberOfLines() > 0][0]
+        self.assertEqual(lines.GetPoint(7), (2.0, 2.0, 2.0))
+
+    def test_voxel_boxes_skip_hidden_voxels(self):
+        voxelize, build, lattice = sphere_lattice()
+        voxelize.Update()
+        grid = voxelize.GetOutput()
+        active = voxelize.GetNumberOfActiveVoxels()
+        self.assertLess(active, 125)  # the sphere leaves the corner and inner voxels empty
+        edges = vtkffd.vtkFFDCellEdges()
+        edges.SetInputData(grid)
+        edges.Update()
+        # Reference: the unique edges of the visible hexahedra, from the structured indices.
+        unique = set()
+        for k in range(5):
+            for j in range(5):
+                for i in range(5):
+                    if not grid.IsCellVisible(i + 5 * (j + 5 * k)):
+                        continue
+                    for a in range(8):
+                        for axis in range(3):
+                            c = [i + (a & 1), j + ((a >> 1) & 1), k + ((a >> 2) & 1)]
+                            if c[axis] == [i, j, k][axis] + 1:
+                                continue
+                            d = list(c)
+                            d[axis] += 1
+                            unique.add((c[0] + 6 * (c[1] + 6 * c[2]), d[0] + 6 * (d[1] + 6 * d[2])))
+        self.assertEqual(edges.GetOutput().GetNumberOfLines(), len(unique))
+        # Every cell visible: the full 5x5x5 grid's 3 * 5 * 6 * 6 edges.
+        unhidden = vtkStructuredGrid()
+        unhidden.SetDimensions(6, 6, 6)
+        unhidden.SetPoints(grid.GetPoints())
+        edges.SetInputData(unhidden)
+        edges.Update()
+        self.assertEqual(edges.GetOutput().GetNumberOfLines(), 3 * 5 * 6 * 6)
+
+        actor = vtkffd.vtkFFDLatticeActor()
+        actor.SetInputData(lattice)
+        actor.SetVoxelGridConnection(voxelize.GetOutputPort())
+        self.assertEqual(len(part_inputs(actor)), 4)  # active, culled points, lattice edges, voxel boxes
+        actor.SetVoxelGridData(None)
+        self.assertEqual(len(part_inputs(actor)), 3)
+
+    def test_control_points_arrays_and_colours(self):
+        _, build, lattice = sphere_lattice()
+        points = vtk_to_numpy(lattice.GetPoints().GetData())
+        moved = int(np.flatnonzero(vtk_to_numpy(lattice.GetPointData().GetArray("Active")))[0])
+        points[moved] += (0.0, 0.3, 0.4)
+        lattice.GetPoints().Modified()
+        control = vtkffd.vtkFFDControlPoints()
+        control.SetInputData(lattice)
+        control.Update()
+        out = control.GetOutput()
+        self.assertEqual(out.GetNumberOfPoints(), build.GetNumberOfActiveControlPoints())
+        ids = vtk_to_numpy(out.GetPointData().GetArray("LatticePointId"))
+        lengths = vtk_to_numpy(out.GetPointData().GetArray("DisplacementLength"))
+        self.assertAlmostEqual(float(lengths[list(ids).index(moved)]), 0.5, delta=1e-12)
+        self.assertEqual(float(np.delete(lengths, list(ids).index(moved)).max()), 0.0)
+        control.SetSelectionToCulled()
+        control.Update()
+        self.assertEqual(control.GetOutput().GetNumberOfPoints(), 216 - build.GetNumberOfActiveControlPoints())
+
+        actor = vtkffd.vtkFFDLatticeActor()
+        actor.SetInputData(lattice)
+        actor.ColorByDisplacementOn()
+        glyphs = [p for p in parts(actor) if p.GetProperty() is actor.GetPointProperty()][0]
+        self.assertTrue(glyphs.GetMapper().GetScalarVisibility())
+        self.assertAlmostEqual(glyphs.GetMapper().GetScalarRange()[1], 0.5, delta=1e-12)
+        actor.SetDisplacementRange(0.0, 2.0)
+        actor.GetBounds()
+        self.assertEqual(glyphs.GetMapper().GetScalarRange(), (0.0, 2.0))
+        actor.ShowCulledPointsOff()
+        self.assertFalse([p for p in parts(actor) if p.GetProperty() is actor.GetCulledPointProperty()][0]
+                         .GetVisibility())
+
+    def test_lattice_without_contract_arrays(self):
+        grid = cube_tetrahedra()
+        grid.GetPointData().RemoveArray("Active")
+        grid.GetPointData().RemoveArray("RestPosition")
+        actor = vtkffd.vtkFFDLatticeActor()
+        actor.SetInputData(grid)
+        vertices = [d.GetNumberOfVerts() for d in part_inputs(actor) if d.GetNumberOfVerts() > 0]
+        self.assertEqual(vertices, [8])  # every point active, displacement 0
+
+    def test_malformed_rest_position_is_an_error(self):
+        grid = cube_tetrahedra()
+        bad = numpy_to_vtk(np.zeros((8, 2)), deep=True)
+        bad.SetName("RestPosition")
+        grid.GetPointData().AddArray(bad)
+        control = vtkffd.vtkFFDControlPoints()
+        control.SetInputData(grid)
+        errors = catch_errors(control)
+        control.Update()
+        self.assertTrue(any("RestPosition" in m for m in errors.messages), errors.messages)
+        self.assertEqual(control.GetOutput().GetNumberOfPoints(), 0)
+
+    def test_no_input_renders_nothing_and_does_not_fail(self):
+        actor = vtkffd.vtkFFDLatticeActor()
+        self.assertIn("Lattice: (none)", str(actor))
+        renderer = vtkRenderer()
+        renderer.AddActor(actor)
+        window = vtkRenderWindow()
+        window.SetOffScreenRendering(1)
+        window.AddRenderer(renderer)
+        window.Render()
+        actor.SetInputData(None)
+        window.Render()
+
+
+class LatticeWidgetTest(unittest.TestCase):
+    def setUp(self):
+        _, self.build, self.lattice = sphere_lattice()
+        self.renderer = vtkRenderer()
+        self.window = vtkRenderWindow()
+        self.window.SetOffScreenRendering(1)
+        self.window.SetSize(400, 400)
+        self.window.AddRenderer(self.renderer)
+        self.interactor = vtkRenderWindowInteractor()
+        self.interactor.SetRenderWindow(self.window)
+        self.interactor.SetInteractorStyle(vtkInteractorStyleTrackballCamera())
+        self.widget = vtkffd.vtkFFDLatticeWidget()
+        self.widget.SetInteractor(self.interactor)
+        self.widget.CreateDefaultRepresentation()
+        self.rep = self.widget.GetLatticeRepresentation()
+
+    def enable(self, lattice):
+        self.rep.SetLattice(lattice)
+        self.widget.On()
+        self.renderer.ResetCamera(-1, 1, -1, 1, -1, 1)
+        self.window.Render()
+
+    def display(self, point_id):
+        d = [0.0, 0.0, 0.0]
+        vtkInteractorObserver.ComputeWorldToDisplay(self.renderer, *self.lattice.GetPoint(point_id), d)
+        return round(d[0]), round(d[1])
+
+    def event(self, event, position, shift=False):
+        self.interactor.SetEventInformation(position[0], position[1], 0, 1 if shift else 0)
+        self.interactor.InvokeEvent(event)
+
+    def key(self, code, sym):
+        self.interactor.SetKeyEventInformation(0, 0, code, 0, sym)
+        self.interactor.InvokeEvent(vtkCommand.KeyPressEvent)
+
+    def test_selection_api_and_culled_points(self):
+        self.enable(self.lattice)
+        active = vtk_to_numpy(self.lattice.GetPointData().GetArray("Active"))
+        culled = int(np.flatnonzero(active == 0)[0])
+        self.assertFalse(self.rep.SelectControlPoint(culled))
+        chosen = int(np.flatnonzero(active)[0])
+        self.assertFalse(self.rep.SelectControlPoint(216))  # out of range
+        self.rep.PickCulledPointsOn()
+        self.assertTrue(self.rep.SelectControlPoint(culled))
+        self.assertTrue(self.rep.SelectControlPoint(chosen))
+        self.assertFalse(self.rep.ToggleControlPoint(culled))
+        ids = vtkIdList()
+        self.rep.GetSelectedControlPoints(ids)
+        self.assertEqual([ids.GetId(i) for i in range(ids.GetNumberOfIds())], [chosen])
+        before = np.array(self.lattice.GetPoint(chosen))
+        self.assertTrue(self.rep.MoveSelectedControlPoints((0.1, 0.2, 0.3)))
+        np.testing.assert_allclose(np.array(self.lattice.GetPoint(chosen)) - before, (0.1, 0.2, 0.3), atol=1e-15)
+        self.assertTrue(self.rep.ResetLatticeToRest())
+        self.assertEqual(self.lattice.GetPoint(chosen), tuple(before))
+
+    def click(self, position, shift=False):
+        self.event(vtkCommand.MouseMoveEvent, position, shift)
+        self.event(vtkCommand.LeftButtonPressEvent, position, shift)
+        self.event(vtkCommand.LeftButtonReleaseEvent, position, shift)
+        return self.rep.GetHoveredControlPoint()
+
+    def test_shift_click_escape_and_reset_key(self):
+        self.enable(self.lattice)
+        active = np.flatnonzero(vtk_to_numpy(self.lattice.GetPointData().GetArray("Active")))
+        first_position = self.display(int(active[0]))
+        # A second active point well apart on screen from the first (more than twice the pick tolerance).
+        second_position = next(self.display(int(i)) for i in active
+                               if np.hypot(*np.subtract(self.display(int(i)), first_position)) > 30)
+        first = self.click(first_position)
+        self.assertGreaterEqual(first, 0)
+        self.assertEqual(self.rep.GetNumberOfSelectedControlPoints(), 1)
+        second = self.click(second_position, shift=True)
+        self.assertNotEqual(second, first)
+        self.assertTrue(self.rep.IsControlPointSelected(first) and self.rep.IsControlPointSelected(second))
+        self.click(second_position, shift=True)  # Shift+click again toggles it off
+        self.assertEqual(self.rep.GetNumberOfSelectedControlPoints(), 1)
+        self.key("\x1b", "Escape")
+        self.assertEqual(self.rep.GetNumberOfSelectedControlPoints(), 0)
+        vtk_to_numpy(self.lattice.GetPoints().GetData())[:] += 0.25
+        self.lattice.GetPoints().Modified()
+        self.key("x", "x")
+        np.testing.assert_array_equal(vtk_to_numpy(self.lattice.GetPoints().GetData()),
+                                      vtk_to_numpy(self.lattice.GetPointData().GetArray("RestPosition")))
+
+    def test_no_lattice(self):
+        self.widget.On()
+        self.window.Render()
+        errors = catch_errors(self.rep)
+        for event in (vtkCommand.MouseMoveEvent, vtkCommand.LeftButtonPressEvent, vtkCommand.MouseMoveEvent,
+                      vtkCommand.LeftButtonReleaseEvent):
+            self.event(event, (200, 200))
+        self.key("x", "x")
+        self.assertFalse(self.rep.ResetLatticeToRest())
+        self.assertTrue(any("No lattice" in m for m in errors.messages), errors.messages)
+        self.assertFalse(self.rep.MoveSelectedControlPoints((1.0, 0.0, 0.0)))
+        self.assertIsNone(self.rep.GetBounds())
+
+    def test_lattice_without_rest_position_drags_but_does_not_reset(self):
+        # A point culled in the built lattice: without an `Active` array every point is pickable.
+        culled = int(np.flatnonzero(vtk_to_numpy(self.lattice.GetPointData().GetArray("Active")) == 0)[0])
+        bare = vtkStructuredGrid()
+        bare.SetDimensions(6, 6, 6)
+        bare.SetPoints(self.lattice.GetPoints())  # no point arrays at all
+        self.lattice = bare
+        self.enable(bare)
+        start = self.display(culled)
+        before = vtk_to_numpy(bare.GetPoints().GetData()).copy()
+        self.event(vtkCommand.MouseMoveEvent, start)
+        self.event(vtkCommand.LeftButtonPressEvent, start)
+        self.event(vtkCommand.MouseMoveEvent, (start[0] + 25, start[1]))
+        self.event(vtkCommand.LeftButtonReleaseEvent, (start[0] + 25, start[1]))
+        moved = np.flatnonzero(np.any(vtk_to_numpy(bare.GetPoints().GetData()) != before, axis=1))
+        self.assertEqual(list(moved), [self.rep.GetHoveredControlPoint()])  # every point pickable, one moved
+        errors = catch_errors(self.rep)
+        self.assertFalse(self.rep.ResetLatticeToRest())
+        self.assertTrue(any("RestPosition" in m for m in errors.messages), errors.messages)
+
+
+if __name__ == "__main__":
+    unittest.main()
