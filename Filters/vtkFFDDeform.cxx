@@ -260,7 +260,7 @@ struct LanesFunctor
     }
     else
     {
-      ffd::DeformSharedBlocks(
+      ffd::DeformBlocksInPlace(
         level, this->Deformation, this->InPoints, this->Cells, this->OutPoints, this->NumberOfPoints, begin, end);
     }
   }

@@ -6,12 +6,12 @@
  * GridDeformation::Deform() instantiated on Lanes<Real, W> (FFDLanes.h) deforms W points bound to one cell at
  * once, each control point read once for all of them. The points are taken in blocks of BlockSize
  * consecutive points: a mesh whose vertices come in a spatially coherent order has most of its blocks in one
- * cell (always, for the global basis's single cell), and DeformSharedBlocks() deforms those in place. The
- * points of the other blocks are listed once, at binding, sorted by cell (GatherByCell()), and
- * DeformGathered() deforms them W at a time from that list: a mesh in random vertex order costs a gather and a
- * scatter per point, not one evaluation per distinct cell of a block. Every lane's result depends only on its
- * own point and cell, so a point is deformed the same whichever pass takes it and however the work is split
- * among threads. The one-point code (SimdLevel::None) computes the same function; it may differ in the last
+ * cell or a few (always one, for the global basis), and DeformBlocksInPlace() deforms those in place, once
+ * per cell, each lane keeping the result of its own cell. The points of the other blocks are listed once, at
+ * binding, sorted by cell (GatherByCell()), and DeformGathered() deforms them W at a time from that list: a
+ * mesh in random vertex order costs a gather and a scatter per point, not one evaluation per cell of a block.
+ * Every lane's result depends only on its own point and cell, so a point is deformed the same whichever pass
+ * takes it and however the work is split among threads. The one-point code (SimdLevel::None) computes the same function; it may differ in the last
  * bit, where the wide code fuses a multiply and an add.
  *
  * The default build must run on any x86-64, so the wide variants are compiled with GCC's target attribute
@@ -69,27 +69,48 @@ inline SimdLevel SimdLevelOfCpu()
 #endif
 }
 
-/// Consecutive points that DeformSharedBlocks() takes together: the most lanes of any level (16 floats).
+/// Consecutive points that DeformBlocksInPlace() takes together: a multiple of every level's lanes (16 floats).
 constexpr int BlockSize = 16;
 
-/// True when the points of block b (of n points) are all bound to one cell (-1 included).
-inline bool BlockSharesCell(const int* cells, std::int64_t n, std::int64_t b)
+/// Blocks whose points lie in at most this many cells (-1 counts as one) are deformed in place, once per
+/// cell, with each lane taking its own cell's result; the points of the others are gathered by cell. In place
+/// reads and writes memory in order; a gather and a scatter per point cost less than more evaluations only
+/// when the block has many cells (measured on meshes of 0.4 and 6.7 M points, BENCHMARKS.md).
+constexpr int MaxCellsInPlace = 4;
+
+/// True when block b (of n points) is deformed in place: it is whole and its points lie in at most
+/// MaxCellsInPlace cells.
+inline bool BlockInPlace(const int* cells, std::int64_t n, std::int64_t b)
 {
   const std::int64_t first = b * BlockSize;
   if (first + BlockSize > n)
   {
     return false; // the last, partial block goes to the gathered points
   }
-  bool shared = true;
-  for (int l = 1; l < BlockSize; ++l)
+  int seen[MaxCellsInPlace];
+  int count = 0;
+  for (int l = 0; l < BlockSize; ++l)
   {
-    shared &= cells[first + l] == cells[first];
+    const int cell = cells[first + l];
+    bool known = false;
+    for (int k = 0; k < count; ++k)
+    {
+      known |= seen[k] == cell;
+    }
+    if (!known)
+    {
+      if (count == MaxCellsInPlace)
+      {
+        return false;
+      }
+      seen[count++] = cell;
+    }
   }
-  return shared;
+  return true;
 }
 
 /**
- * The points of the blocks whose points are not all in one cell, sorted by cell (a stable counting sort:
+ * The points of the blocks not deformed in place (BlockInPlace()), sorted by cell (a stable counting sort:
  * cell -1 first, then by cell, each cell's points in input order), for DeformGathered(). `cellCount` is the
  * number of cells of the binding.
  */
@@ -99,7 +120,7 @@ inline std::vector<int> GatherByCell(const int* cells, std::int64_t n, int cellC
   const std::int64_t blocks = (n + BlockSize - 1) / BlockSize;
   for (std::int64_t b = 0; b < blocks; ++b)
   {
-    if (!BlockSharesCell(cells, n, b))
+    if (!BlockInPlace(cells, n, b))
     {
       for (std::int64_t i = b * BlockSize; i < n && i < (b + 1) * BlockSize; ++i)
       {
@@ -114,7 +135,7 @@ inline std::vector<int> GatherByCell(const int* cells, std::int64_t n, int cellC
   std::vector<int> gathered(std::size_t(offsets.back()));
   for (std::int64_t b = 0; b < blocks; ++b)
   {
-    if (!BlockSharesCell(cells, n, b))
+    if (!BlockInPlace(cells, n, b))
     {
       for (std::int64_t i = b * BlockSize; i < n && i < (b + 1) * BlockSize; ++i)
       {
@@ -140,33 +161,53 @@ inline void DeformOnePoint(const Deformation& deformation, const Real* in, const
 
 #if FFD_HAVE_LANES
 template <int W, typename Deformation, typename Real>
-inline void SharedBlocksInLanes(const Deformation& deformation, const Real* in, const int* cells, Real* out,
+inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in, const int* cells, Real* out,
   std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd)
 {
   static_assert(BlockSize % W == 0, "a block is a whole number of lane groups");
   using Lane = Lanes<Real, W>;
+  using Mask = typename Lane::IndexVector;
   const auto wide = deformation.template WithLanes<Lane>();
   for (std::int64_t b = blockBegin; b < blockEnd; ++b)
   {
-    if (!BlockSharesCell(cells, n, b))
+    if (!BlockInPlace(cells, n, b))
     {
       continue;
     }
-    const std::int64_t first = b * BlockSize;
-    const int cell = cells[first];
-    for (std::int64_t i = first; i < first + BlockSize; i += W)
+    for (std::int64_t i = b * BlockSize; i < (b + 1) * BlockSize; i += W)
     {
-      if (cell < 0)
-      {
-        for (std::int64_t v = 3 * i; v < 3 * (i + W); ++v)
-        {
-          out[v] = in[v];
-        }
-        continue;
-      }
       Vec3<Lane> x;
       Lane::Deinterleave3(in + 3 * i, x.x, x.y, x.z);
-      const Vec3<Lane> y = wide.Deform(x, cell);
+      bool one = cells[i] >= 0; // the common case first: the W points in one cell
+      for (int l = 1; l < W; ++l)
+      {
+        one &= cells[i + l] == cells[i];
+      }
+      if (one)
+      {
+        const Vec3<Lane> y = wide.Deform(x, int(cells[i]));
+        Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
+        continue;
+      }
+      Vec3<Lane> y = x; // lanes of cell -1 keep their position
+      bool done[W] = {};
+      for (int first = 0; first < W; ++first)
+      {
+        const int cell = cells[i + first];
+        if (done[first] || cell < 0)
+        {
+          continue;
+        }
+        Mask mine;
+        for (int l = 0; l < W; ++l)
+        {
+          const bool same = cells[i + l] == cell;
+          mine[l] = same ? -1 : 0;
+          done[l] = done[l] || same;
+        }
+        const Vec3<Lane> yc = wide.Deform(x, cell);
+        y = { Select(mine, yc.x, y.x), Select(mine, yc.y, y.y), Select(mine, yc.z, y.z) };
+      }
       Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
     }
   }
@@ -217,10 +258,10 @@ inline void GatheredInLanes(const Deformation& deformation, const Real* in, cons
 // The wide variants of both passes, one function per instruction set (see the file's documentation).
 #define FFD_LANE_VARIANTS(Suffix, Target, Bytes)                                                              \
   template <typename Deformation, typename Real>                                                              \
-  Target void SharedBlocks##Suffix(const Deformation& deformation, const Real* in, const int* cells, Real* out, \
+  Target void BlocksInPlace##Suffix(const Deformation& deformation, const Real* in, const int* cells, Real* out, \
     std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd)                                           \
   {                                                                                                           \
-    SharedBlocksInLanes<Bytes / sizeof(Real)>(deformation, in, cells, out, n, blockBegin, blockEnd);         \
+    BlocksInPlaceInLanes<Bytes / sizeof(Real)>(deformation, in, cells, out, n, blockBegin, blockEnd);         \
   }                                                                                                           \
   template <typename Deformation, typename Real>                                                              \
   Target void Gathered##Suffix(const Deformation& deformation, const Real* in, const int* cells,              \
@@ -236,31 +277,31 @@ FFD_LANE_VARIANTS(SSE2, FFD_TARGET_SSE2, 16)
 } // namespace detail
 
 /**
- * First pass: out = the deformation of in for the points of blocks [blockBegin, blockEnd) whose BlockSize
- * points share a cell (BlockSharesCell()); the others are left to DeformGathered(). 3 values per point
+ * First pass: out = the deformation of in for the points of blocks [blockBegin, blockEnd) that are deformed in
+ * place (BlockInPlace()); the others are left to DeformGathered(). 3 values per point
  * (x y z), n points, cells[i] from BindToGrid() (-1: the point keeps its position). `level` at most
  * SimdLevelOfCpu().
  */
 template <typename Deformation, typename Real>
-inline void DeformSharedBlocks(SimdLevel level, const Deformation& deformation, const Real* in, const int* cells,
+inline void DeformBlocksInPlace(SimdLevel level, const Deformation& deformation, const Real* in, const int* cells,
   Real* out, std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd)
 {
 #if FFD_HAVE_LANES
   switch (level)
   {
     case SimdLevel::AVX512:
-      return detail::SharedBlocksAVX512(deformation, in, cells, out, n, blockBegin, blockEnd);
+      return detail::BlocksInPlaceAVX512(deformation, in, cells, out, n, blockBegin, blockEnd);
     case SimdLevel::AVX2:
-      return detail::SharedBlocksAVX2(deformation, in, cells, out, n, blockBegin, blockEnd);
+      return detail::BlocksInPlaceAVX2(deformation, in, cells, out, n, blockBegin, blockEnd);
     case SimdLevel::SSE2:
-      return detail::SharedBlocksSSE2(deformation, in, cells, out, n, blockBegin, blockEnd);
+      return detail::BlocksInPlaceSSE2(deformation, in, cells, out, n, blockBegin, blockEnd);
     case SimdLevel::None:
       break;
   }
 #endif
   for (std::int64_t b = blockBegin; b < blockEnd; ++b)
   {
-    if (BlockSharesCell(cells, n, b))
+    if (BlockInPlace(cells, n, b))
     {
       for (std::int64_t i = b * BlockSize; i < (b + 1) * BlockSize; ++i)
       {

@@ -50,6 +50,8 @@ struct Lanes
   friend Lanes operator*(const Lanes& a, const Lanes& b) { return Lanes(a.V * b.V); }
   friend Lanes operator/(const Lanes& a, const Lanes& b) { return Lanes(a.V / b.V); }
   friend Lanes operator-(const Lanes& a) { return Lanes(-a.V); }
+  /// a in the lanes where mask is -1, b where it is 0.
+  friend Lanes Select(const IndexVector& mask, const Lanes& a, const Lanes& b) { return Lanes(mask ? a.V : b.V); }
   friend Lanes Clamp01(const Lanes& a)
   {
     const Vector zero = Vector{}, one = zero + T(1);
