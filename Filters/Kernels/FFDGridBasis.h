@@ -242,7 +242,24 @@ FFD_INLINE constexpr int LoopCount(const AxisWeights<MaxCount, Real>& a)
 } // namespace detail
 
 /**
- * sum_ijk W0_i W1_j W2_k V_ijk over the supports in `axes`, for values in VTK order on a grid of `dims`.
+ * How SumTensorProduct() reads control point `index` of a lattice of Values: three Values per control point,
+ * in VTK order. A lattice stored otherwise specializes it: the CUDA backend's float4 lattice (one 16-byte load
+ * per control point instead of three 4-byte ones).
+ */
+template <typename Value>
+struct LatticeValues
+{
+  template <typename Real>
+  FFD_INLINE static Vec3<Real> Get(const Value* values, int index)
+  {
+    const Value* v = values + 3 * index;
+    return { Real(v[0]), Real(v[1]), Real(v[2]) };
+  }
+};
+
+/**
+ * sum_ijk W0_i W1_j W2_k V_ijk over the supports in `axes`, for values in VTK order on a grid of `dims`
+ * (read through LatticeValues<Value>).
  * Value is the values' type, Real the weights' and the sum's: the same, or a Lanes type (FFDLanes.h) whose
  * lanes are points of one cell, each value then read once for all of them.
  */
@@ -265,7 +282,7 @@ FFD_INLINE Vec3<Real> SumTensorProduct(const Value* values, const int dims[3], c
       {
         break;
       }
-      const Value* v = values + 3 * (axes[0].First + dims[0] * ((axes[1].First + j) + dims[1] * (axes[2].First + k)));
+      const int row = axes[0].First + dims[0] * ((axes[1].First + j) + dims[1] * (axes[2].First + k));
       Vec3<Real> sumI = { 0, 0, 0 };
       FFD_UNROLL
       for (int i = 0; i < detail::LoopCount(axes[0]); ++i)
@@ -274,7 +291,7 @@ FFD_INLINE Vec3<Real> SumTensorProduct(const Value* values, const int dims[3], c
         {
           break;
         }
-        sumI = sumI + axes[0].W[i] * Vec3<Real>{ Real(v[3 * i]), Real(v[3 * i + 1]), Real(v[3 * i + 2]) };
+        sumI = sumI + axes[0].W[i] * LatticeValues<Value>::template Get<Real>(values, row + i);
       }
       sumJ = sumJ + axes[1].W[j] * sumI;
     }

@@ -120,17 +120,42 @@ struct GridDeformation
   /// X + D(s, t, u) for a point bound to `cell` (not -1); with lanes, every lane is bound to `cell`.
   FFD_INLINE Vec3<Lane> Deform(const Vec3<Lane>& x, int cell) const
   {
+    int c[3];
+    this->CellIndices(cell, c);
+    return this->DeformInCell(x, c);
+  }
+
+  /// Deform() for a cell given by its index along each axis (CellIndices()), for callers that take the flat
+  /// index apart faster themselves (the CUDA backend multiplies by reciprocals instead of dividing).
+  FFD_INLINE Vec3<Lane> DeformInCell(const Vec3<Lane>& x, const int cell[3]) const
+  {
     AxisWeights<MaxCount, Lane> axes[3];
     this->Weights(this->Frame.ToParametric(x), cell, false, axes);
     return x + SumTensorProduct(this->Displacements, this->Dims, axes);
+  }
+
+  /// The index along each axis of a bound cell: BindToGrid()'s flat index ci + cx (cj + cy ck) taken apart.
+  FFD_INLINE void CellIndices(int cell, int c[3]) const
+  {
+    const GridBasis basis = StaticBasis >= 0 ? static_cast<GridBasis>(StaticBasis) : this->Basis;
+    FFD_UNROLL
+    for (int a = 0; a < 2; ++a)
+    {
+      const int cells = BindingCells(basis, this->Voxels[a]);
+      c[a] = cell % cells;
+      cell /= cells;
+    }
+    c[2] = cell; // the last axis takes what is left: no division
   }
 
   /// Deform() and the Jacobian dX_ffd/dX there (one lane: Lane = Real).
   FFD_INLINE Vec3<Lane> Deform(const Vec3<Lane>& x, int cell, Mat3<Lane>& jacobian) const
   {
     const Vec3<Lane> stu = this->Frame.ToParametric(x);
+    int c[3];
+    this->CellIndices(cell, c);
     AxisWeights<MaxCount, Lane> axes[3];
-    this->Weights(stu, cell, true, axes);
+    this->Weights(stu, c, true, axes);
     Mat3<Lane> gradient;
     const Vec3<Lane> d = SumTensorProductWithGradient(this->Displacements, this->Dims, axes, gradient);
     const Lane lo = -ParametricTolerance<Lane>(), hi = Lane(1) + ParametricTolerance<Lane>();
@@ -146,22 +171,16 @@ struct GridDeformation
   }
 
 private:
-  /// The weights along each axis at parameters stu (clamped to the frame) of a point bound to `cell`.
-  FFD_INLINE void Weights(const Vec3<Lane>& stu, int cell, bool withDerivative, AxisWeights<MaxCount, Lane>* axes) const
+  /// The weights along each axis at parameters stu (clamped to the frame) of a point in cell (ci, cj, ck).
+  FFD_INLINE void Weights(
+    const Vec3<Lane>& stu, const int cell[3], bool withDerivative, AxisWeights<MaxCount, Lane>* axes) const
   {
     const Lane p[3] = { stu.x, stu.y, stu.z };
     const GridBasis basis = StaticBasis >= 0 ? static_cast<GridBasis>(StaticBasis) : this->Basis;
     FFD_UNROLL
     for (int a = 0; a < 3; ++a)
     {
-      int c = cell; // the last axis takes what is left: no division
-      if (a < 2)
-      {
-        const int cells = BindingCells(basis, this->Voxels[a]);
-        c = cell % cells;
-        cell /= cells;
-      }
-      ComputeAxisWeights(basis, this->Voxels[a], c, Clamp01(p[a]), withDerivative, axes[a]);
+      ComputeAxisWeights(basis, this->Voxels[a], cell[a], Clamp01(p[a]), withDerivative, axes[a]);
     }
   }
 };
