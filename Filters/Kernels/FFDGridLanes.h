@@ -75,8 +75,9 @@ constexpr int BlockSize = 16;
 /// Blocks whose points lie in at most this many cells (-1 counts as one) are deformed in place, once per
 /// cell, with each lane taking its own cell's result; the points of the others are gathered by cell. In place
 /// reads and writes memory in order; a gather and a scatter per point cost less than more evaluations only
-/// when the block has many cells (measured on meshes of 0.4 and 6.7 M points, BENCHMARKS.md).
-constexpr int MaxCellsInPlace = 4;
+/// when a block's points are scattered over many cells, as in a mesh in random vertex order (with 4, the
+/// 6.7 M-point armadillo of BENCHMARKS.md ran 2 times slower, its memory accessed at random).
+constexpr int MaxCellsInPlace = 8;
 
 /// True when block b (of n points) is deformed in place: it is whole and its points lie in at most
 /// MaxCellsInPlace cells.
