@@ -1,0 +1,201 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file BenchmarkFFDInteraction.cxx
+ * @brief Time from a control-point move to the re-rendered frame, split into pipeline and render.
+ *
+ * What a user of vtkFFDLatticeWidget waits for on every mouse move: the armadillo of the test data subdivided
+ * twice (vtkLinearSubdivisionFilter, ~0.42 M points, with point normals as a shaded mesh has them) in a local
+ * lattice over 10 x 10 x 10 voxels, drawn in an offscreen 800 x 800 window with the widget's representation.
+ * After a first render (which binds the points), each of the timed moves
+ *   1. moves one selected active control point through vtkFFDLatticeRepresentation::MoveSelectedControlPoints
+ *      (what a drag does),
+ *   2. "pipeline": vtkFFDDeform::Update() (the evaluation with the cached binding, normals included),
+ *   3. "render": vtkRenderWindow::Render() and WaitForCompletion() (the mapper uploads the new points and
+ *      normals, the lattice actor follows, the frame is drawn: llvmpipe under Xvfb here).
+ * It prints a table of medians (and the fastest and slowest move) per basis, with the median time of rendering
+ * the same frame again unchanged (drawing without upload), and never asserts times; the
+ * binding count must stay 1 through the moves (it prints it). Results: BENCHMARKS.md.
+ *
+ * Usage: BenchmarkFFDInteraction [--mesh FILE.vtp] [--levels N] [--moves N]   (in an X display:
+ * Utilities/with-display.sh build/bin/BenchmarkFFDInteraction)
+ */
+#include "vtkActor.h"
+#include "vtkFFDBuildLattice.h"
+#include "vtkFFDDeform.h"
+#include "vtkFFDLatticeActor.h"
+#include "vtkFFDLatticeRepresentation.h"
+#include "vtkFFDVoxelize.h"
+#include "vtkLinearSubdivisionFilter.h"
+#include "vtkMath.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkPolyData.h"
+#include "vtkPolyDataMapper.h"
+#include "vtkPolyDataNormals.h"
+#include "vtkProperty.h"
+#include "vtkRenderWindow.h"
+#include "vtkRenderer.h"
+#include "vtkSMPTools.h"
+#include "vtkStructuredGrid.h"
+#include "vtkXMLPolyDataReader.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace
+{
+using Clock = std::chrono::steady_clock;
+
+double Milliseconds(Clock::time_point a, Clock::time_point b)
+{
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+struct Stats
+{
+  double Median, Min, Max;
+};
+
+Stats Summarize(std::vector<double> values)
+{
+  std::sort(values.begin(), values.end());
+  return { values[values.size() / 2], values.front(), values.back() };
+}
+}
+
+int main(int argc, char* argv[])
+{
+  std::string meshPath = std::string(VOXELFFD_MESH_DIR) + "/armadillo.vtp";
+  int levels = 2;
+  int moves = 30;
+  for (int a = 1; a + 1 < argc; a += 2)
+  {
+    if (!std::strcmp(argv[a], "--mesh"))
+    {
+      meshPath = argv[a + 1];
+    }
+    else if (!std::strcmp(argv[a], "--levels"))
+    {
+      levels = std::atoi(argv[a + 1]);
+    }
+    else if (!std::strcmp(argv[a], "--moves"))
+    {
+      moves = std::max(1, std::atoi(argv[a + 1]));
+    }
+  }
+
+  vtkNew<vtkXMLPolyDataReader> reader;
+  reader->SetFileName(meshPath.c_str());
+  vtkNew<vtkLinearSubdivisionFilter> subdivide;
+  subdivide->SetInputConnection(reader->GetOutputPort());
+  subdivide->SetNumberOfSubdivisions(levels);
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputConnection(levels > 0 ? subdivide->GetOutputPort() : reader->GetOutputPort());
+  normals->SplittingOff();
+  normals->Update();
+  vtkNew<vtkPolyData> mesh;
+  mesh->ShallowCopy(normals->GetOutput());
+  if (mesh->GetNumberOfPoints() == 0)
+  {
+    std::fprintf(stderr, "%s: no points (run Utilities/setup.sh to fetch the meshes)\n", meshPath.c_str());
+    return EXIT_FAILURE;
+  }
+  std::printf("mesh: %s subdivided %d times: %lld points, %lld triangles, point normals; %d threads (%s)\n",
+    meshPath.c_str(), levels, static_cast<long long>(mesh->GetNumberOfPoints()),
+    static_cast<long long>(mesh->GetNumberOfPolys()), vtkSMPTools::GetEstimatedNumberOfThreads(),
+    vtkSMPTools::GetBackend());
+  std::printf("%d moves of one control point, 10x10x10 voxels, offscreen 800x800 window; times in ms\n\n", moves);
+  std::printf("| basis | control points (active) | bindings | pipeline median (min-max) | render median (min-max) "
+              "| move to frame median | unchanged frame median |\n|---|---|---|---|---|---|---|\n");
+
+  const int bases[2] = { vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::CUBIC_BSPLINE };
+  for (int basis : bases)
+  {
+    vtkNew<vtkFFDVoxelize> voxelize;
+    voxelize->SetInputData(mesh);
+    voxelize->SetDivisions(10, 10, 10);
+    vtkNew<vtkFFDBuildLattice> build;
+    build->SetInputConnection(voxelize->GetOutputPort());
+    build->SetBasis(basis);
+    build->Update();
+    vtkNew<vtkStructuredGrid> lattice;
+    lattice->DeepCopy(build->GetOutput());
+
+    vtkNew<vtkFFDDeform> deform;
+    deform->SetInputData(mesh);
+    deform->SetLatticeData(lattice);
+    vtkNew<vtkPolyDataMapper> mapper;
+    mapper->SetInputConnection(deform->GetOutputPort());
+    vtkNew<vtkActor> actor;
+    actor->SetMapper(mapper);
+    vtkNew<vtkFFDLatticeRepresentation> representation;
+    representation->SetLattice(lattice);
+    // The active control point nearest to the mesh's centre: its move deforms a part of the mesh.
+    double centre[3];
+    mesh->GetCenter(centre);
+    vtkIdType chosen = -1;
+    double nearest = VTK_DOUBLE_MAX;
+    vtkDataArray* active = lattice->GetPointData()->GetArray("Active");
+    for (vtkIdType id = 0; id < lattice->GetNumberOfPoints(); ++id)
+    {
+      const double d = vtkMath::Distance2BetweenPoints(lattice->GetPoint(id), centre);
+      if (active->GetComponent(id, 0) != 0.0 && d < nearest)
+      {
+        nearest = d;
+        chosen = id;
+      }
+    }
+    representation->SelectControlPoint(chosen);
+
+    vtkNew<vtkRenderer> renderer;
+    renderer->AddActor(actor);
+    renderer->AddViewProp(representation);
+    representation->SetRenderer(renderer);
+    vtkNew<vtkRenderWindow> window;
+    window->SetOffScreenRendering(1);
+    window->SetSize(800, 800);
+    window->AddRenderer(renderer);
+    renderer->ResetCamera();
+    window->Render(); // binds the points, uploads everything once
+
+    // The same frame again with nothing changed: the cost of drawing alone (no upload), for comparison.
+    std::vector<double> still;
+    for (int m = 0; m < 5; ++m)
+    {
+      const Clock::time_point t0 = Clock::now();
+      window->Render();
+      window->WaitForCompletion();
+      still.push_back(Milliseconds(t0, Clock::now()));
+    }
+
+    const double step = 0.01 * lattice->GetLength();
+    std::vector<double> pipeline, render, total;
+    for (int m = 0; m < moves; ++m)
+    {
+      const double sign = (m % 2) ? -1.0 : 1.0;
+      const double delta[3] = { sign * step, 0.5 * sign * step, 0.0 };
+      const Clock::time_point t0 = Clock::now();
+      representation->MoveSelectedControlPoints(delta);
+      deform->Update();
+      const Clock::time_point t1 = Clock::now();
+      window->Render();
+      window->WaitForCompletion();
+      const Clock::time_point t2 = Clock::now();
+      pipeline.push_back(Milliseconds(t0, t1));
+      render.push_back(Milliseconds(t1, t2));
+      total.push_back(Milliseconds(t0, t2));
+    }
+    const Stats p = Summarize(pipeline), r = Summarize(render), t = Summarize(total), u = Summarize(still);
+    std::printf("| %s | %lld (%lld) | %lld | %.1f (%.1f-%.1f) | %.1f (%.1f-%.1f) | %.1f | %.1f |\n",
+      vtkFFDBuildLattice::GetBasisAsString(basis), static_cast<long long>(lattice->GetNumberOfPoints()),
+      static_cast<long long>(build->GetNumberOfActiveControlPoints()),
+      static_cast<long long>(deform->GetNumberOfBindings()), p.Median, p.Min, p.Max, r.Median, r.Min, r.Max,
+      t.Median, u.Median);
+  }
+  return EXIT_SUCCESS;
+}
