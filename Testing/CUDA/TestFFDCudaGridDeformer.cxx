@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 #include <string>
@@ -38,12 +39,13 @@ struct Problem
   std::vector<float> Normals;
   std::vector<double> Displacements;
 
-  Problem(int basis, std::int64_t count, std::mt19937& rng)
+  // Divisions at random (up to 15 for the global basis, 5 for the local ones), or those given.
+  Problem(int basis, std::int64_t count, std::mt19937& rng, const int* givenDivisions = nullptr)
     : Basis(basis)
   {
     std::uniform_real_distribution<double> unit(-1.0, 1.0);
-    // Global degrees up to 15 reach both instantiations of the GPU's own kernel for the global basis (up to 8
-    // and 16 control points per axis) and, past its 48 KB of shared memory, the generic one.
+    // Global degrees up to 15 reach every kernel of the global basis: the tensor-core one (from 400 control
+    // points on), both instantiations of the shared-memory one (up to 8 and 16 control points per axis) below.
     std::uniform_int_distribution<int> divisions(1, basis == int(ffd::GridBasis::Bernstein) ? 15 : 5);
     const double base[12] = { -1, -2, 0.5, 2, 0, 0, 0, 3, 0, 0, 0, 1.5 };
     for (int c = 0; c < 12; ++c)
@@ -54,7 +56,7 @@ struct Problem
     std::int64_t controlPoints = 1;
     for (int a = 0; a < 3; ++a)
     {
-      this->Divisions[a] = divisions(rng);
+      this->Divisions[a] = givenDivisions ? givenDivisions[a] : divisions(rng);
       this->Dims[a] = ffd::ControlPointsAlongAxis(ffd::GridBasis(basis), this->Divisions[a]);
       controlPoints *= this->Dims[a];
     }
@@ -77,8 +79,11 @@ struct Problem
       const double length = std::sqrt(ffd::Dot(n, n)) + 1e-3;
       this->Normals.insert(this->Normals.end(), { float(n.x / length), float(n.y / length), float(n.z / length) });
     }
-    this->Points[3 * 7] = std::numeric_limits<double>::quiet_NaN();
-    this->Points[3 * 11 + 1] = std::numeric_limits<double>::infinity();
+    if (count > 11)
+    {
+      this->Points[3 * 7] = std::numeric_limits<double>::quiet_NaN();
+      this->Points[3 * 11 + 1] = std::numeric_limits<double>::infinity();
+    }
     for (std::int64_t v = 0; v < 3 * controlPoints; ++v)
     {
       this->Displacements.push_back(0.2 * unit(rng));
@@ -218,6 +223,85 @@ TYPED_TEST(CudaGridDeformerTest, MatchesCpuForEveryBasis)
   }
 }
 
+// Float32 points without normals or determinants (the kernels of an ordinary update: the float4 lattice, the
+// global basis's tensor-core and shared-memory kernels, DeformPointsKernel) against the CPU path in float64, on
+// fresh random problems: within 1e-5 of the frame's scale (about 3), the bound. Outputs are poisoned
+// first. Counts that are not multiples of the kernels' 4 points a thread or 32-point tiles, and lattices that
+// reach each kernel: for the global basis up to and past 16 control points per axis, on either side of the
+// 400 control points where the tensor-core kernel takes over; for the local ones many voxels per axis (the cell
+// index is split by multiplications on the device).
+void ExpectFloatMatchesDouble(int basis, const int divisions[3], std::int64_t count, bool clamp, std::mt19937& rng,
+  double* worst = nullptr)
+{
+  const Problem p(basis, count, rng, divisions);
+  std::vector<double> cpuPoints, cpuNormals, cpuDeterminants, jacobianScales;
+  CpuDeform<double>(p, clamp, cpuPoints, cpuNormals, cpuDeterminants, jacobianScales);
+  const std::vector<float> points(p.Points.begin(), p.Points.end());
+  ffd::cuda::GridDeformer gpu;
+  ASSERT_TRUE(gpu.SetPoints(points.data(), p.Count())) << gpu.GetLastError();
+  ASSERT_TRUE(gpu.Bind(p.Frame, basis, p.Divisions, clamp)) << gpu.GetLastError();
+  std::vector<float> out(points.size(), -12345.0f);
+  ASSERT_TRUE(gpu.Evaluate(p.Displacements.data(), p.ControlPoints(), false, false)) << gpu.GetLastError();
+  ASSERT_TRUE(gpu.Download(out.data(), nullptr, nullptr)) << gpu.GetLastError();
+  double largest = 0;
+  std::int64_t wrong = 0;
+  std::string firstWrong;
+  for (std::size_t v = 0; v < out.size(); ++v)
+  {
+    // float32 rounding of the input point itself is no error of the evaluation: the reference starts from the
+    // double point, so compare the displacement (y - x) and the kept points exactly.
+    const double x = p.Points[v], expected = cpuPoints[v], got = double(out[v]);
+    const double error = std::isfinite(expected) ? std::fabs((got - double(points[v])) - (expected - x)) : 0.0;
+    const bool ok = std::isfinite(expected) ? error <= 1e-5 * 3.0 : Same(got, double(points[v]), 0.0);
+    largest = std::max(largest, std::isfinite(error) ? error : 1e30);
+    if (!ok && wrong++ < 5)
+    {
+      firstWrong +=
+        "value " + std::to_string(v) + ": " + std::to_string(got) + " vs " + std::to_string(expected) + "; ";
+    }
+  }
+  EXPECT_EQ(wrong, 0) << "basis " << basis << " divisions " << divisions[0] << "x" << divisions[1] << "x"
+                      << divisions[2] << ", " << count << " points" << (clamp ? " clamped" : "") << ": " << firstWrong;
+  if (worst)
+  {
+    *worst = std::max(*worst, largest);
+  }
+}
+
+TEST(CudaGridDeformer, GlobalBasisInFloatMatchesDouble)
+{
+  FFD_REQUIRE_DEVICE();
+  std::mt19937 rng(20261123);
+  const int cases[][3] = { { 10, 10, 10 }, { 15, 15, 15 }, { 7, 7, 7 }, { 6, 6, 6 }, { 15, 2, 8 }, { 1, 15, 4 },
+    { 8, 15, 11 }, { 12, 1, 15 }, { 3, 3, 3 }, { 7, 9, 5 }, { 16, 4, 4 } };
+  double worst = 0;
+  int n = 0;
+  for (const auto& divisions : cases)
+  {
+    const std::int64_t count = n % 3 == 0 ? 100003 : (n % 3 == 1 ? 31 : 4099);
+    ExpectFloatMatchesDouble(int(ffd::GridBasis::Bernstein), divisions, count, n % 2 == 1, rng, &worst);
+    ++n;
+  }
+  std::printf("global basis, float32 without Jacobian against float64: largest error %.2e\n", worst);
+}
+
+TEST(CudaGridDeformer, LocalBasesInFloatMatchDouble)
+{
+  FFD_REQUIRE_DEVICE();
+  std::mt19937 rng(1123);
+  const int cases[][3] = { { 1, 1, 1 }, { 33, 7, 100 }, { 127, 64, 3 }, { 2, 255, 9 }, { 5, 5, 5 } };
+  const std::int64_t counts[] = { 100003, 4, 3, 50001, 7 };
+  double worst = 0;
+  for (int basis = int(ffd::GridBasis::Trilinear); basis <= int(ffd::GridBasis::CubicBSpline); ++basis)
+  {
+    for (int c = 0; c < 5; ++c)
+    {
+      ExpectFloatMatchesDouble(basis, cases[c], counts[(c + basis) % 5], (c + basis) % 2 == 0, rng, &worst);
+    }
+  }
+  std::printf("local bases, float32 without Jacobian against float64: largest error %.2e\n", worst);
+}
+
 // Only the lattice crosses the bus on an update: the points and the binding stay on the device.
 TEST(CudaGridDeformer, UpdatesUploadOnlyTheLattice)
 {
@@ -243,6 +327,17 @@ TEST(CudaGridDeformer, UpdatesUploadOnlyTheLattice)
   EXPECT_EQ(c.LatticeBytes, 2u * std::uint64_t(p.ControlPoints()) * 3 * sizeof(float));
   EXPECT_EQ(c.BytesDownloaded, 2u * points.size() * sizeof(float));
   EXPECT_NE(first, second); // the moved control point moved some points
+
+  // Trilinear in float32 without normals or determinants takes the lattice as float4: 16 bytes per control point.
+  const Problem t(int(ffd::GridBasis::Trilinear), 1000, rng);
+  const std::vector<float> tPoints(t.Points.begin(), t.Points.end());
+  ffd::cuda::GridDeformer trilinear;
+  std::vector<float> out(tPoints.size());
+  ASSERT_TRUE(trilinear.SetPoints(tPoints.data(), t.Count()) && trilinear.Bind(t.Frame, t.Basis, t.Divisions, false));
+  ASSERT_TRUE(trilinear.Evaluate(t.Displacements.data(), t.ControlPoints(), false, false));
+  ASSERT_TRUE(trilinear.Download(out.data(), nullptr, nullptr));
+  EXPECT_EQ(trilinear.GetCounters().LatticeBytes, std::uint64_t(t.ControlPoints()) * 4 * sizeof(float));
+  EXPECT_EQ(trilinear.GetCounters().PointUploads, 1u);
 }
 
 // Failures are reported, leave no device state behind, and a later use starts clean.
