@@ -4,6 +4,8 @@
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDCudaBackend.h"
 #include "vtkFFDDataContract.h"
+#include "vtkFFDForInChunks.h"
+#include "vtkFFDTetrahedralDeformation.h"
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkArrayDispatch.h"
@@ -16,8 +18,8 @@
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
-#include "vtkSMPTools.h"
 #include "vtkSmartPointer.h"
+#include "vtkUnstructuredGrid.h"
 
 #include "FFDGridLanes.h"
 
@@ -126,25 +128,6 @@ std::string ReadLattice(vtkPointSet* lattice, LatticeView& view)
 }
 
 //------------------------------------------------------------------------------------------------------------
-// Runs functor(begin, end) over [0, n) as a few vtkSMPTools::For calls, so that progress is reported and abort
-// honoured between them (never from inside an SMP body). Returns false when aborted.
-template <typename Functor>
-bool ForInChunks(vtkAlgorithm* self, vtkIdType n, Functor& functor, double progressBegin, double progressEnd)
-{
-  const vtkIdType chunks = std::max<vtkIdType>(1, std::min<vtkIdType>(10, n / 65536));
-  for (vtkIdType c = 0; c < chunks; ++c)
-  {
-    if (self->GetAbortExecute())
-    {
-      return false;
-    }
-    vtkSMPTools::For(n * c / chunks, n * (c + 1) / chunks, functor);
-    self->UpdateProgress(progressBegin + (progressEnd - progressBegin) * double(c + 1) / double(chunks));
-  }
-  return true;
-}
-
-//------------------------------------------------------------------------------------------------------------
 // Binding: the cell of every point (ffd::BindToGrid), -1 for points that keep their position.
 struct BindSettings
 {
@@ -180,7 +163,7 @@ struct BindWorker
     PointArrayT* points, const BindSettings& settings, int* cells, vtkAlgorithm* self, bool& completed)
   {
     BindFunctor<PointArrayT> functor{ points, settings, cells };
-    completed = ForInChunks(self, points->GetNumberOfTuples(), functor, 0.0, 0.5);
+    completed = vtkFFDForInChunks(self, points->GetNumberOfTuples(), functor, 0.0, 0.5);
   }
 };
 
@@ -325,15 +308,15 @@ struct EvaluateWorker
           gathered.data(), deformation, false };
         const vtkIdType blocks = (n + ffd::BlockSize - 1) / ffd::BlockSize;
         const double middle = progressBegin + (1.0 - progressBegin) * double(n - vtkIdType(gathered.size())) / double(n);
-        completed = ForInChunks(self, blocks, lanes, progressBegin, middle);
+        completed = vtkFFDForInChunks(self, blocks, lanes, progressBegin, middle);
         lanes.GatheredPass = true;
-        completed = completed && ForInChunks(self, vtkIdType(gathered.size()), lanes, middle, 1.0);
+        completed = completed && vtkFFDForInChunks(self, vtkIdType(gathered.size()), lanes, middle, 1.0);
         return;
       }
     }
     EvaluateFunctor<Deformation, Real, PointArrayT> functor{ inPoints, outPoints->GetPointer(0), cells,
       deformation, inNormals, outNormals, determinants ? determinants->GetPointer(0) : nullptr };
-    completed = ForInChunks(self, inPoints->GetNumberOfTuples(), functor, progressBegin, 1.0);
+    completed = vtkFFDForInChunks(self, inPoints->GetNumberOfTuples(), functor, progressBegin, 1.0);
   }
 };
 
@@ -368,6 +351,7 @@ struct vtkFFDDeform::vtkInternals
   std::vector<int> Gathered; // the points of blocks not in one cell, sorted by cell (ffd::GatherByCell)
   vtkFFDBindingKey Bound;    // what Cells and Gathered are for
   vtkFFDCudaBackend Cuda;
+  vtkFFDTetrahedralDeformation Tetrahedra; // the binding and evaluation of tetrahedral lattices
   // The last output's arrays (the executive empties the output before RequestData): the next update writes
   // into those that nothing else holds any more (OutputArray()).
   vtkSmartPointer<vtkDataArray> LastPoints, LastNormals, LastDeterminants;
@@ -425,11 +409,20 @@ int vtkFFDDeform::RequestData(
     return 1;
   }
 
+  vtkUnstructuredGrid* tetrahedra = vtkFFDTetrahedralDeformation::IsTetrahedralLattice(lattice)
+    ? vtkUnstructuredGrid::SafeDownCast(lattice)
+    : nullptr;
   LatticeView view;
-  const std::string problem = ReadLattice(lattice, view);
+  const std::string problem = tetrahedra ? internals.Tetrahedra.SetLattice(tetrahedra) : ReadLattice(lattice, view);
   if (!problem.empty())
   {
     vtkErrorMacro(<< problem);
+    return 0;
+  }
+  if (!tetrahedra && this->OutsidePolicy == EXTRAPOLATE)
+  {
+    vtkErrorMacro("The outside policy EXTRAPOLATE needs a tetrahedral lattice; a grid lattice keeps outside "
+                  "points (KEEP_POSITION) or clamps them to its frame (CLAMP_TO_EDGE).");
     return 0;
   }
 
@@ -456,6 +449,33 @@ int vtkFFDDeform::RequestData(
   {
     determinants = OutputArray(internals.LastDeterminants, realArray, 1, numberOfPoints);
     determinants->SetName(JacobianDeterminantArrayName());
+  }
+
+  if (tetrahedra)
+  {
+    bool rebound = false;
+    if (!internals.Tetrahedra.Bind(inPoints, this->OutsidePolicy, this, 0.0, 0.5, rebound) ||
+      !internals.Tetrahedra.Evaluate(
+        inPoints, inNormals, pointsArray, outNormals, determinants, this, 0.5, 1.0))
+    {
+      return 1; // aborted: the output stays empty
+    }
+    if (rebound)
+    {
+      ++this->NumberOfBindings;
+      if (internals.Tetrahedra.GetNumberOfDegenerateTetrahedra() > 0)
+      {
+        vtkWarningMacro(<< internals.Tetrahedra.GetNumberOfDegenerateTetrahedra() << " of "
+                        << internals.Tetrahedra.GetNumberOfTetrahedra()
+                        << " tetrahedra of the lattice have no volume (the first is cell "
+                        << internals.Tetrahedra.GetFirstDegenerateTetrahedron()
+                        << "); they are skipped: points in them are bound to a neighbour or follow the "
+                           "outside policy.");
+      }
+    }
+    this->LastBackendUsed = "CPU";
+    this->FillOutput(input, output, pointsArray, outNormals, determinants);
+    return 1;
   }
 
   const vtkFFDBindingKey key = vtkFFDBindingKey::Of(
@@ -544,6 +564,14 @@ int vtkFFDDeform::RequestData(
     this->LastBackendUsed = "CPU";
   }
 
+  this->FillOutput(input, output, pointsArray, outNormals, determinants);
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDDeform::FillOutput(vtkPointSet* input, vtkPointSet* output, vtkDataArray* pointsArray,
+  vtkDataArray* outNormals, vtkDataArray* determinants)
+{
   vtkNew<vtkPoints> outPoints;
   outPoints->SetData(pointsArray);
   output->CopyStructure(input);
@@ -560,18 +588,30 @@ int vtkFFDDeform::RequestData(
   {
     output->GetPointData()->AddArray(determinants);
   }
-  internals.LastPoints = pointsArray;
-  internals.LastNormals = outNormals;
-  internals.LastDeterminants = determinants;
-  return 1;
+  this->Internals->LastPoints = pointsArray;
+  this->Internals->LastNormals = outNormals;
+  this->Internals->LastDeterminants = determinants;
+}
+
+//------------------------------------------------------------------------------------------------------------
+const char* vtkFFDDeform::GetOutsidePolicyAsString()
+{
+  switch (this->OutsidePolicy)
+  {
+    case CLAMP_TO_EDGE:
+      return "ClampToEdge";
+    case EXTRAPOLATE:
+      return "Extrapolate";
+    default:
+      return "KeepPosition";
+  }
 }
 
 //------------------------------------------------------------------------------------------------------------
 void vtkFFDDeform::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "OutsidePolicy: " << (this->OutsidePolicy == CLAMP_TO_EDGE ? "ClampToEdge" : "KeepPosition")
-     << "\n";
+  os << indent << "OutsidePolicy: " << this->GetOutsidePolicyAsString() << "\n";
   os << indent << "Backend: " << (this->Backend == CPU ? "CPU" : (this->Backend == CUDA ? "CUDA" : "Automatic"))
      << "\n";
   os << indent << "LastBackendUsed: " << this->LastBackendUsed << "\n";

@@ -34,8 +34,20 @@
  * updates; an update uploads only the lattice and downloads the deformed points into the output array.
  * Progress is reported between chunks of points on the CPU, and the filter stops early when aborted.
  *
+ * Tetrahedral lattices (paper section III.E): input 1 may instead be a vtkUnstructuredGrid of tetrahedra with a
+ * `RestPosition` point array and no `FFDFrame` (from vtkFFDBuildTetrahedralLattice, or built by the user). Each
+ * point is bound to the tetrahedron that holds it, located with vtkStaticCellLocator and checked with the
+ * barycentric weights of equation 5 (4 bytes per point, cached as above, keyed on the lattice's RestPosition
+ * and cell arrays and their modification times); it moves by the weighted displacements of the tetrahedron's
+ * four nodes, an affine map per tetrahedron, so normals follow that map. Tetrahedra without volume are
+ * reported (a warning at binding) and skipped. Points outside every tetrahedron keep their position, take the
+ * displacement of the nearest point of the control mesh (CLAMP_TO_EDGE), or follow the affine map of the
+ * nearest tetrahedron (EXTRAPOLATE, tetrahedral lattices only). They are evaluated on the CPU.
+ *
  * A lattice without the contract's arrays, with a flat or non-finite frame, an unknown basis, non-finite
- * points, or a point count that does not match its divisions and basis is an error; the output is then empty.
+ * points, or a point count that does not match its divisions and basis is an error, as is a tetrahedral
+ * lattice with cells other than tetrahedra or without a RestPosition of one 3-vector per point; the output is
+ * then empty.
  *
  * @sa vtkFFDVoxelize vtkFFDBuildLattice vtkFFDDataContract vtkWarpVector
  */
@@ -46,6 +58,8 @@
 #include "vtkPointSetAlgorithm.h"
 
 #include <memory> // For std::unique_ptr
+
+class vtkDataArray;
 
 class VTKFFDFILTERS_EXPORT vtkFFDDeform : public vtkPointSetAlgorithm
 {
@@ -70,15 +84,22 @@ public:
   enum OutsidePolicies
   {
     KEEP_POSITION = 0,
-    CLAMP_TO_EDGE = 1
+    CLAMP_TO_EDGE = 1,
+    EXTRAPOLATE = 2
   };
 
   ///@{
-  /// What points outside the lattice's frame do (default KEEP_POSITION).
-  vtkSetClampMacro(OutsidePolicy, int, KEEP_POSITION, CLAMP_TO_EDGE);
+  /**
+   * What points outside the lattice do (default KEEP_POSITION): keep their position; take the displacement of
+   * the nearest point of the lattice (CLAMP_TO_EDGE); or, for tetrahedral lattices only, follow the affine map
+   * of the nearest tetrahedron (EXTRAPOLATE).
+   */
+  vtkSetClampMacro(OutsidePolicy, int, KEEP_POSITION, EXTRAPOLATE);
   vtkGetMacro(OutsidePolicy, int);
   void SetOutsidePolicyToKeepPosition() { this->SetOutsidePolicy(KEEP_POSITION); }
   void SetOutsidePolicyToClampToEdge() { this->SetOutsidePolicy(CLAMP_TO_EDGE); }
+  void SetOutsidePolicyToExtrapolate() { this->SetOutsidePolicy(EXTRAPOLATE); }
+  const char* GetOutsidePolicyAsString();
   ///@}
 
   ///@{
@@ -123,6 +144,10 @@ protected:
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  /// Gives the output the input's structure and data, the deformed points and the transformed normals and det J.
+  void FillOutput(vtkPointSet* input, vtkPointSet* output, vtkDataArray* points, vtkDataArray* normals,
+    vtkDataArray* determinants);
 
   int OutsidePolicy;
   int Backend;

@@ -79,18 +79,6 @@ FFD_INLINE Mat3<Real> DeformationJacobian(const Mat3<Real>& displacementGradient
 }
 
 /**
- * A unit normal carried by the deformation: the cofactor of the Jacobian times it (see Cofactor()),
- * renormalized; unchanged where that product vanishes.
- */
-template <typename Real>
-FFD_INLINE Vec3<Real> TransformNormal(const Mat3<Real>& jacobian, const Vec3<Real>& normal)
-{
-  const Vec3<Real> m = Cofactor(jacobian) * normal;
-  const Real length = std::sqrt(Dot(m, m));
-  return length > Real(0) ? (Real(1) / length) * m : normal;
-}
-
-/**
  * A grid lattice's deformation, as plain data that host and device code evaluate alike. MaxCount bounds the
  * control points per axis that influence a point: 4 covers every local basis (and global ones up to degree 3),
  * MaxBernsteinDegree + 1 every global one; callers pick it from the basis (vtkFFDDeform, the CUDA backend).

@@ -8,6 +8,8 @@
 
 #include "FFDHostDevice.h"
 
+#include <cmath>
+
 namespace ffd
 {
 
@@ -124,6 +126,18 @@ FFD_INLINE Mat3<Real> Cofactor(const Mat3<Real>& a)
   c.M[2][1] = a.M[0][2] * a.M[1][0] - a.M[0][0] * a.M[1][2];
   c.M[2][2] = a.M[0][0] * a.M[1][1] - a.M[0][1] * a.M[1][0];
   return c;
+}
+
+/**
+ * A unit normal carried by the deformation: the cofactor of the Jacobian times it (see Cofactor()),
+ * renormalized; unchanged where that product vanishes.
+ */
+template <typename Real>
+FFD_INLINE Vec3<Real> TransformNormal(const Mat3<Real>& jacobian, const Vec3<Real>& normal)
+{
+  const Vec3<Real> m = Cofactor(jacobian) * normal;
+  const Real length = std::sqrt(Dot(m, m));
+  return length > Real(0) ? (Real(1) / length) * m : normal;
 }
 
 } // namespace ffd

@@ -1,0 +1,373 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkFFDBuildTetrahedralLattice.h"
+
+#include "vtkFFDDataContract.h"
+#include "vtkFFDTetrahedralDeformation.h"
+
+#include "vtkCellArray.h"
+#include "vtkCellType.h"
+#include "vtkDataSetAttributes.h"
+#include "vtkDoubleArray.h"
+#include "vtkIdTypeArray.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPointSet.h"
+#include "vtkPoints.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkUnstructuredGrid.h"
+
+#include "FFDTetrahedra.h"
+
+#include <libqhull_r/libqhull_r.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+vtkStandardNewMacro(vtkFFDBuildTetrahedralLattice);
+
+namespace
+{
+// A control mesh under construction: 3 coordinates per node, 4 node ids per tetrahedron.
+struct TetrahedralMesh
+{
+  std::vector<double> Nodes;
+  std::vector<vtkIdType> Tetrahedra;
+
+  const double* Node(vtkIdType id) const { return this->Nodes.data() + 3 * id; }
+
+  double SignedVolume6(const vtkIdType t[4]) const
+  {
+    const ffd::Vec3<double> a = ffd::Vec3<double>::From(this->Node(t[0]));
+    return ffd::Dot(ffd::Cross(ffd::Vec3<double>::From(this->Node(t[1])) - a,
+                      ffd::Vec3<double>::From(this->Node(t[2])) - a),
+      ffd::Vec3<double>::From(this->Node(t[3])) - a);
+  }
+
+  /// Adds the tetrahedron, positively oriented.
+  void Add(vtkIdType a, vtkIdType b, vtkIdType c, vtkIdType d)
+  {
+    vtkIdType t[4] = { a, b, c, d };
+    if (this->SignedVolume6(t) < 0.0)
+    {
+      std::swap(t[2], t[3]);
+    }
+    this->Tetrahedra.insert(this->Tetrahedra.end(), t, t + 4);
+  }
+};
+
+// The triangles of the convex hull of `count` points (3 doubles each), as point indices, by Qhull (option Qt:
+// triangulated output). Returns an empty string, or Qhull's message.
+std::string ConvexHull(std::vector<double>& coordinates, std::vector<std::array<int, 3>>& triangles)
+{
+  qhT context;
+  qhT* qh = &context;
+  QHULL_LIB_CHECK
+  FILE* errors = std::tmpfile();
+  qh_zero(qh, errors);
+  char options[] = "qhull Qt";
+  const int count = static_cast<int>(coordinates.size() / 3);
+  const int exitCode = qh_new_qhull(qh, 3, count, coordinates.data(), False, options, nullptr, errors);
+  std::string message;
+  if (exitCode == 0)
+  {
+    facetT* facet;
+    vertexT *vertex, **vertexp;
+    FORALLfacets
+    {
+      std::array<int, 3> triangle;
+      int n = 0;
+      FOREACHvertex_(facet->vertices)
+      {
+        if (n < 3)
+        {
+          triangle[n] = qh_pointid(qh, vertex->point);
+        }
+        ++n;
+      }
+      if (n == 3)
+      {
+        triangles.push_back(triangle);
+      }
+    }
+  }
+  else if (errors)
+  {
+    std::rewind(errors);
+    char line[512];
+    while (std::fgets(line, sizeof(line), errors) && message.size() < 2000)
+    {
+      message += line;
+    }
+    if (message.empty())
+    {
+      message = "Qhull failed with exit code " + std::to_string(exitCode);
+    }
+  }
+  qh_freeqhull(qh, !qh_ALL);
+  int curlong, totlong;
+  qh_memfreeshort(qh, &curlong, &totlong);
+  if (errors)
+  {
+    std::fclose(errors);
+  }
+  return message;
+}
+
+// Splits every tetrahedron into eight: four at its corners, four around the shortest diagonal of the inner
+// octahedron; the midpoint of an edge shared by several tetrahedra is one node.
+TetrahedralMesh Subdivide(const TetrahedralMesh& coarse)
+{
+  TetrahedralMesh fine;
+  fine.Nodes = coarse.Nodes;
+  fine.Tetrahedra.reserve(8 * coarse.Tetrahedra.size());
+  std::unordered_map<unsigned long long, vtkIdType> midpoints;
+  auto midpoint = [&](vtkIdType a, vtkIdType b) {
+    const unsigned long long key =
+      (static_cast<unsigned long long>(std::min(a, b)) << 32) | static_cast<unsigned long long>(std::max(a, b));
+    const auto found = midpoints.find(key);
+    if (found != midpoints.end())
+    {
+      return found->second;
+    }
+    const vtkIdType id = static_cast<vtkIdType>(fine.Nodes.size() / 3);
+    for (int c = 0; c < 3; ++c)
+    {
+      fine.Nodes.push_back(0.5 * (coarse.Nodes[3 * a + c] + coarse.Nodes[3 * b + c]));
+    }
+    midpoints.emplace(key, id);
+    return id;
+  };
+  for (size_t t = 0; t < coarse.Tetrahedra.size(); t += 4)
+  {
+    const vtkIdType* v = coarse.Tetrahedra.data() + t;
+    vtkIdType m[4][4];
+    for (int i = 0; i < 4; ++i)
+    {
+      for (int j = i + 1; j < 4; ++j)
+      {
+        m[i][j] = m[j][i] = midpoint(v[i], v[j]);
+      }
+    }
+    fine.Add(v[0], m[0][1], m[0][2], m[0][3]);
+    fine.Add(m[0][1], v[1], m[1][2], m[1][3]);
+    fine.Add(m[0][2], m[1][2], v[2], m[2][3]);
+    fine.Add(m[0][3], m[1][3], m[2][3], v[3]);
+    // The octahedron's three diagonals join the midpoints of opposite edges; around each, the other four
+    // midpoints form a ring.
+    const vtkIdType diagonals[3][2] = { { m[0][1], m[2][3] }, { m[0][2], m[1][3] }, { m[0][3], m[1][2] } };
+    const vtkIdType rings[3][4] = { { m[0][2], m[0][3], m[1][3], m[1][2] }, { m[0][1], m[1][2], m[2][3], m[0][3] },
+      { m[0][1], m[0][2], m[2][3], m[1][3] } };
+    int shortest = 0;
+    double shortestLength = std::numeric_limits<double>::infinity();
+    for (int d = 0; d < 3; ++d)
+    {
+      const ffd::Vec3<double> e = ffd::Vec3<double>::From(fine.Node(diagonals[d][1])) -
+        ffd::Vec3<double>::From(fine.Node(diagonals[d][0]));
+      if (ffd::Dot(e, e) < shortestLength)
+      {
+        shortestLength = ffd::Dot(e, e);
+        shortest = d;
+      }
+    }
+    for (int k = 0; k < 4; ++k)
+    {
+      fine.Add(diagonals[shortest][0], diagonals[shortest][1], rings[shortest][k], rings[shortest][(k + 1) % 4]);
+    }
+  }
+  return fine;
+}
+} // namespace
+
+//------------------------------------------------------------------------------------------------------------
+vtkFFDBuildTetrahedralLattice::vtkFFDBuildTetrahedralLattice()
+  : Padding(0.05)
+  , SubdivisionLevels(0)
+  , NumberOfHullFaces(0)
+  , NumberOfActiveNodes(0)
+{
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDBuildTetrahedralLattice::FillInputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPointSet");
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDBuildTetrahedralLattice::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPointSet* input = vtkPointSet::GetData(inputVector[0]);
+  vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector);
+  this->NumberOfHullFaces = 0;
+  this->NumberOfActiveNodes = 0;
+  if (!input || input->GetNumberOfPoints() == 0)
+  {
+    return 1; // an empty input gives an empty output
+  }
+
+  // The finite points and their centroid.
+  const vtkIdType numberOfPoints = input->GetNumberOfPoints();
+  std::vector<double> coordinates;
+  coordinates.reserve(3 * numberOfPoints);
+  double centroid[3] = { 0.0, 0.0, 0.0 };
+  for (vtkIdType id = 0; id < numberOfPoints; ++id)
+  {
+    double x[3];
+    input->GetPoint(id, x);
+    if (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))
+    {
+      coordinates.insert(coordinates.end(), x, x + 3);
+      for (int c = 0; c < 3; ++c)
+      {
+        centroid[c] += x[c];
+      }
+    }
+  }
+  const vtkIdType finite = static_cast<vtkIdType>(coordinates.size() / 3);
+  if (finite < 4)
+  {
+    vtkErrorMacro("The input has " << finite << " finite points; a tetrahedral lattice needs at least 4 that "
+                                   << "are not coplanar.");
+    return 0;
+  }
+  for (int c = 0; c < 3; ++c)
+  {
+    centroid[c] /= static_cast<double>(finite);
+  }
+
+  std::vector<std::array<int, 3>> triangles;
+  const std::string qhullMessage = ConvexHull(coordinates, triangles);
+  if (!qhullMessage.empty() || triangles.empty())
+  {
+    vtkErrorMacro("The convex hull of the input's points cannot be computed (are they coplanar?). Qhull says: "
+      << qhullMessage);
+    return 0;
+  }
+  this->UpdateProgress(0.3);
+
+  // One tetrahedron per hull triangle and the centroid (node 0); the hull's nodes moved out by Padding.
+  TetrahedralMesh mesh;
+  mesh.Nodes.assign(centroid, centroid + 3);
+  std::unordered_map<int, vtkIdType> nodeOfPoint;
+  auto node = [&](int point) {
+    const auto found = nodeOfPoint.find(point);
+    if (found != nodeOfPoint.end())
+    {
+      return found->second;
+    }
+    const vtkIdType id = static_cast<vtkIdType>(mesh.Nodes.size() / 3);
+    for (int c = 0; c < 3; ++c)
+    {
+      mesh.Nodes.push_back(centroid[c] + (1.0 + this->Padding) * (coordinates[3 * point + c] - centroid[c]));
+    }
+    nodeOfPoint.emplace(point, id);
+    return id;
+  };
+  for (const auto& triangle : triangles)
+  {
+    const vtkIdType a = node(triangle[0]), b = node(triangle[1]), c = node(triangle[2]);
+    // Qhull's triangulation of a facet with coplanar points may add triangles of no area: no volume either.
+    if (ffd::CheckTetrahedron(mesh.Node(0), mesh.Node(a), mesh.Node(b), mesh.Node(c)) == ffd::FrameStatus::Valid)
+    {
+      mesh.Add(0, a, b, c);
+    }
+  }
+  this->NumberOfHullFaces = static_cast<vtkIdType>(mesh.Tetrahedra.size() / 4);
+  for (int level = 0; level < this->SubdivisionLevels; ++level)
+  {
+    mesh = Subdivide(mesh);
+  }
+  this->UpdateProgress(0.5);
+
+  // The output: nodes at rest, tetrahedra, RestPosition.
+  const vtkIdType numberOfNodes = static_cast<vtkIdType>(mesh.Nodes.size() / 3);
+  const vtkIdType numberOfTetrahedra = static_cast<vtkIdType>(mesh.Tetrahedra.size() / 4);
+  vtkNew<vtkDoubleArray> nodes;
+  nodes->SetNumberOfComponents(3);
+  nodes->SetNumberOfTuples(numberOfNodes);
+  std::copy(mesh.Nodes.begin(), mesh.Nodes.end(), nodes->GetPointer(0));
+  vtkNew<vtkPoints> points;
+  points->SetData(nodes);
+  vtkNew<vtkDoubleArray> rest;
+  rest->DeepCopy(nodes);
+  rest->SetName(vtkFFDDataContract::RestPositionArrayName());
+  vtkNew<vtkIdTypeArray> offsets;
+  offsets->SetNumberOfValues(numberOfTetrahedra + 1);
+  for (vtkIdType t = 0; t <= numberOfTetrahedra; ++t)
+  {
+    offsets->SetValue(t, 4 * t);
+  }
+  vtkNew<vtkIdTypeArray> connectivity;
+  connectivity->SetNumberOfValues(4 * numberOfTetrahedra);
+  std::copy(mesh.Tetrahedra.begin(), mesh.Tetrahedra.end(), connectivity->GetPointer(0));
+  vtkNew<vtkCellArray> cells;
+  cells->SetData(offsets, connectivity);
+  output->SetPoints(points);
+  output->SetCells(VTK_TETRA, cells);
+  output->GetPointData()->AddArray(rest);
+
+  // Active nodes: those of tetrahedra holding an input point, as vtkFFDDeform binds them.
+  vtkFFDTetrahedralDeformation binding;
+  const std::string problem = binding.SetLattice(output);
+  bool rebound = false;
+  if (!problem.empty() ||
+    !binding.Bind(input->GetPoints(), vtkFFDTetrahedralDeformation::KEEP_POSITION, this, 0.5, 1.0, rebound))
+  {
+    if (!problem.empty())
+    {
+      vtkErrorMacro(<< problem);
+    }
+    output->Initialize();
+    return problem.empty() ? 1 : 0; // aborted, or an internal inconsistency
+  }
+  vtkNew<vtkUnsignedCharArray> active;
+  active->SetName(vtkFFDDataContract::ActiveArrayName());
+  active->SetNumberOfValues(numberOfNodes);
+  active->FillValue(0);
+  for (const int tetrahedron : binding.GetCells())
+  {
+    if (tetrahedron >= 0)
+    {
+      for (int i = 0; i < 4; ++i)
+      {
+        active->SetValue(mesh.Tetrahedra[4 * tetrahedron + i], 1);
+      }
+    }
+  }
+  output->GetPointData()->AddArray(active);
+  this->NumberOfActiveNodes = std::count(active->GetPointer(0), active->GetPointer(0) + numberOfNodes, 1);
+  if (this->NumberOfActiveNodes < numberOfNodes)
+  {
+    // Culled nodes are hidden; the ghost array exists only when some are.
+    vtkNew<vtkUnsignedCharArray> ghosts;
+    ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
+    ghosts->SetNumberOfValues(numberOfNodes);
+    for (vtkIdType id = 0; id < numberOfNodes; ++id)
+    {
+      ghosts->SetValue(id, active->GetValue(id) ? 0 : vtkDataSetAttributes::HIDDENPOINT);
+    }
+    output->GetPointData()->AddArray(ghosts);
+  }
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDBuildTetrahedralLattice::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Padding: " << this->Padding << "\n";
+  os << indent << "SubdivisionLevels: " << this->SubdivisionLevels << "\n";
+  os << indent << "NumberOfHullFaces: " << this->NumberOfHullFaces << "\n";
+  os << indent << "NumberOfActiveNodes: " << this->NumberOfActiveNodes << "\n";
+}

@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkFFDBuildTetrahedralLattice
+ * @brief   builds a tetrahedral control mesh around a mesh from its convex hull and centroid
+ *
+ * The tetrahedral counterpart of vtkFFDVoxelize + vtkFFDBuildLattice (paper section III.E, Figure 9). The input
+ * is any vtkPointSet; the output is a vtkUnstructuredGrid of tetrahedra that encloses the input's finite points:
+ * the convex hull of the points (computed by Qhull, triangulated) joined to their centroid, one tetrahedron per
+ * hull triangle. Its points are double precision and rest in place, with the data contract's point arrays
+ * `RestPosition` and `Active` (vtkFFDDataContract). Connect it to vtkFFDDeform's input 1 and move its points to
+ * deform the mesh.
+ *
+ * - Padding (default 0.05) moves the hull's nodes away from the centroid by that fraction of their distance,
+ *   so that the points on the hull lie inside the control mesh, not on its faces.
+ * - SubdivisionLevels (default 0) refines the control mesh for finer control (level of detail): each level
+ *   splits every tetrahedron into eight at its edges' midpoints (its inner octahedron along the shortest
+ *   diagonal), so a level multiplies the tetrahedra by 8 and the nodes by about 5.
+ * - A node is active when a tetrahedron it belongs to holds an input point (the binding of vtkFFDDeform decides
+ *   which); the others are culled: `Active` is 0 and the ghost array marks them HIDDENPOINT, as
+ *   vtkFFDBuildLattice does for grid lattices.
+ *
+ * Every tetrahedron is positively oriented. An input with fewer than four finite points, or whose points are
+ * flat (no 3D hull), is an error and gives an empty output; non-finite points are ignored.
+ *
+ * @sa vtkFFDDeform vtkFFDBuildLattice vtkFFDDataContract
+ */
+#ifndef vtkFFDBuildTetrahedralLattice_h
+#define vtkFFDBuildTetrahedralLattice_h
+
+#include "vtkFFDFiltersModule.h" // For export macro
+#include "vtkUnstructuredGridAlgorithm.h"
+
+class VTKFFDFILTERS_EXPORT vtkFFDBuildTetrahedralLattice : public vtkUnstructuredGridAlgorithm
+{
+public:
+  static vtkFFDBuildTetrahedralLattice* New();
+  vtkTypeMacro(vtkFFDBuildTetrahedralLattice, vtkUnstructuredGridAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// How far the hull's nodes move away from the centroid, as a fraction of their distance (default 0.05).
+  vtkSetClampMacro(Padding, double, 0.0, 10.0);
+  vtkGetMacro(Padding, double);
+  ///@}
+
+  ///@{
+  /// Times every tetrahedron is split into eight (default 0, at most 5).
+  vtkSetClampMacro(SubdivisionLevels, int, 0, 5);
+  vtkGetMacro(SubdivisionLevels, int);
+  ///@}
+
+  ///@{
+  /// Statistics of the last execution: triangles of the convex hull, and nodes marked active.
+  vtkGetMacro(NumberOfHullFaces, vtkIdType);
+  vtkGetMacro(NumberOfActiveNodes, vtkIdType);
+  ///@}
+
+protected:
+  vtkFFDBuildTetrahedralLattice();
+  ~vtkFFDBuildTetrahedralLattice() override = default;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  double Padding;
+  int SubdivisionLevels;
+  vtkIdType NumberOfHullFaces;
+  vtkIdType NumberOfActiveNodes;
+
+private:
+  vtkFFDBuildTetrahedralLattice(const vtkFFDBuildTetrahedralLattice&) = delete;
+  void operator=(const vtkFFDBuildTetrahedralLattice&) = delete;
+};
+
+#endif

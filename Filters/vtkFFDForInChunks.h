@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file vtkFFDForInChunks.h
+ * @brief vtkSMPTools::For in a few chunks, with progress and abort between them (private to the Filters module).
+ */
+#ifndef vtkFFDForInChunks_h
+#define vtkFFDForInChunks_h
+
+#include "vtkAlgorithm.h"
+#include "vtkSMPTools.h"
+
+#include <algorithm>
+
+/**
+ * Runs functor(begin, end) over [0, n) as a few vtkSMPTools::For calls, so that progress is reported and abort
+ * honoured between them (never from inside an SMP body). `self` may be null. Returns false when aborted.
+ */
+template <typename Functor>
+bool vtkFFDForInChunks(vtkAlgorithm* self, vtkIdType n, Functor& functor, double progressBegin, double progressEnd)
+{
+  const vtkIdType chunks = std::max<vtkIdType>(1, std::min<vtkIdType>(10, n / 65536));
+  for (vtkIdType c = 0; c < chunks; ++c)
+  {
+    if (self && self->GetAbortExecute())
+    {
+      return false;
+    }
+    vtkSMPTools::For(n * c / chunks, n * (c + 1) / chunks, functor);
+    if (self)
+    {
+      self->UpdateProgress(progressBegin + (progressEnd - progressBegin) * double(c + 1) / double(chunks));
+    }
+  }
+  return true;
+}
+
+#endif

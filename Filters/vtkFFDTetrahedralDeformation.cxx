@@ -1,0 +1,441 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkFFDTetrahedralDeformation.h"
+
+#include "vtkFFDDataContract.h"
+#include "vtkFFDForInChunks.h"
+
+#include "vtkAOSDataArrayTemplate.h"
+#include "vtkArrayDispatch.h"
+#include "vtkCellArray.h"
+#include "vtkCellType.h"
+#include "vtkDataArray.h"
+#include "vtkDataArrayRange.h"
+#include "vtkFieldData.h"
+#include "vtkGenericCell.h"
+#include "vtkIdList.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkSMPThreadLocalObject.h"
+#include "vtkSMPTools.h"
+#include "vtkStaticCellLocator.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkUnstructuredGrid.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace
+{
+// Weight units by which a point may lie outside its tetrahedron and still count as inside: the band that
+// absorbs rounding on faces, as ffd::ParametricTolerance() does for grid frames.
+constexpr double InsideTolerance = 1e-10;
+
+// Marks points that lie outside every tetrahedron until the outside policy decides.
+constexpr int Outside = -2;
+
+bool IsFinite(const double x[3])
+{
+  return std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
+}
+
+//------------------------------------------------------------------------------------------------------------
+// Locates every point: VTK's locator proposes a tetrahedron (its own inside test has a looser tolerance), the
+// weights of equation 5 confirm it; a point the proposal does not hold is tested against every tetrahedron of
+// its locator bin and goes to the one it lies deepest in.
+struct LocateFunctor
+{
+  vtkPoints* Points;
+  vtkStaticCellLocator* Locator;
+  const std::vector<ffd::Frame<double>>& Frames;
+  const std::vector<unsigned char>& Degenerate;
+  int* Cells;
+  vtkSMPThreadLocalObject<vtkGenericCell> Cell;
+  vtkSMPThreadLocalObject<vtkIdList> Candidates;
+
+  void Initialize() {}
+
+  double Margin(vtkIdType tetrahedron, const double x[3]) const
+  {
+    return this->Degenerate[tetrahedron]
+      ? -std::numeric_limits<double>::infinity()
+      : ffd::InsideMargin(this->Frames[tetrahedron].ToParametric(ffd::Vec3<double>::From(x)));
+  }
+
+  void operator()(vtkIdType begin, vtkIdType end)
+  {
+    vtkGenericCell* cell = this->Cell.Local();
+    vtkIdList* candidates = this->Candidates.Local();
+    for (vtkIdType id = begin; id < end; ++id)
+    {
+      double x[3], pcoords[3], weights[4];
+      this->Points->GetPoint(id, x);
+      if (!IsFinite(x))
+      {
+        this->Cells[id] = -1;
+        continue;
+      }
+      const vtkIdType proposed = this->Locator->FindCell(x, 0.0, cell, pcoords, weights);
+      if (proposed >= 0 && this->Margin(proposed, x) >= 0.0)
+      {
+        this->Cells[id] = static_cast<int>(proposed);
+        continue;
+      }
+      double bounds[6] = { x[0], x[0], x[1], x[1], x[2], x[2] };
+      this->Locator->FindCellsWithinBounds(bounds, candidates);
+      vtkIdType best = -1;
+      double bestMargin = -std::numeric_limits<double>::infinity();
+      for (vtkIdType c = 0; c < candidates->GetNumberOfIds(); ++c)
+      {
+        const double margin = this->Margin(candidates->GetId(c), x);
+        if (margin > bestMargin)
+        {
+          bestMargin = margin;
+          best = candidates->GetId(c);
+        }
+      }
+      this->Cells[id] = bestMargin >= -InsideTolerance ? static_cast<int>(best) : Outside;
+    }
+  }
+
+  void Reduce() {}
+};
+
+//------------------------------------------------------------------------------------------------------------
+// Evaluation in the precision Real of the output points.
+template <typename Real, typename PointArrayT>
+struct EvaluateFunctor
+{
+  PointArrayT* InPoints;
+  Real* OutPoints;
+  const int* Cells;
+  const ffd::TetrahedronMap<Real>* Maps;
+  vtkDataArray* InNormals; // nullptr: no normals to transform
+  vtkDataArray* OutNormals;
+  Real* Determinants; // nullptr: not asked for
+
+  void operator()(vtkIdType begin, vtkIdType end)
+  {
+    const auto inPoints = vtk::DataArrayTupleRange<3>(this->InPoints, begin, end);
+    vtkIdType id = begin;
+    for (const auto x : inPoints)
+    {
+      const ffd::Vec3<Real> xr = { Real(x[0]), Real(x[1]), Real(x[2]) };
+      const int cell = this->Cells[id];
+      const ffd::Vec3<Real> y = cell >= 0 ? this->Maps[cell].Deform(xr) : xr;
+      Real* out = this->OutPoints + 3 * id;
+      out[0] = y.x;
+      out[1] = y.y;
+      out[2] = y.z;
+      if (this->OutNormals || this->Determinants)
+      {
+        const ffd::Mat3<Real> jacobian = cell >= 0 ? this->Maps[cell].Jacobian() : ffd::Mat3<Real>::Identity();
+        if (this->OutNormals)
+        {
+          double n[3];
+          this->InNormals->GetTuple(id, n);
+          const ffd::Vec3<Real> m = ffd::TransformNormal(jacobian, ffd::Vec3<Real>::From(n));
+          this->OutNormals->SetTuple3(id, m.x, m.y, m.z);
+        }
+        if (this->Determinants)
+        {
+          this->Determinants[id] = ffd::Determinant(jacobian);
+        }
+      }
+      ++id;
+    }
+  }
+};
+
+template <typename Real>
+struct EvaluateWorker
+{
+  template <typename PointArrayT>
+  void operator()(PointArrayT* inPoints, const int* cells, const ffd::TetrahedronMap<Real>* maps,
+    vtkDataArray* inNormals, vtkDataArray* outNormals, Real* outPoints, Real* determinants, vtkAlgorithm* self,
+    double progressBegin, double progressEnd, bool& completed)
+  {
+    EvaluateFunctor<Real, PointArrayT> functor{ inPoints, outPoints, cells, maps, inNormals, outNormals,
+      determinants };
+    completed = vtkFFDForInChunks(self, inPoints->GetNumberOfTuples(), functor, progressBegin, progressEnd);
+  }
+};
+} // namespace
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDTetrahedralDeformation::Key::operator==(const Key& o) const
+{
+  return this->Points == o.Points && this->PointsMTime == o.PointsMTime &&
+    this->NumberOfPoints == o.NumberOfPoints && this->Rest == o.Rest && this->RestMTime == o.RestMTime &&
+    this->Cells == o.Cells && this->CellsMTime == o.CellsMTime && this->NumberOfCells == o.NumberOfCells &&
+    this->Policy == o.Policy;
+}
+
+vtkFFDTetrahedralDeformation::vtkFFDTetrahedralDeformation() = default;
+vtkFFDTetrahedralDeformation::~vtkFFDTetrahedralDeformation() = default;
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDTetrahedralDeformation::IsTetrahedralLattice(vtkDataObject* lattice)
+{
+  return vtkUnstructuredGrid::SafeDownCast(lattice) &&
+    !lattice->GetFieldData()->GetAbstractArray(vtkFFDDataContract::FrameArrayName());
+}
+
+//------------------------------------------------------------------------------------------------------------
+std::string vtkFFDTetrahedralDeformation::SetLattice(vtkUnstructuredGrid* lattice)
+{
+  this->Lattice = lattice;
+  const std::string fix = " Build it with vtkFFDBuildTetrahedralLattice, or give a vtkUnstructuredGrid of "
+                          "tetrahedra with a RestPosition point array (see vtkFFDDeform).";
+  const vtkIdType numberOfCells = lattice->GetNumberOfCells();
+  const vtkIdType numberOfNodes = lattice->GetNumberOfPoints();
+  if (numberOfCells == 0 || numberOfNodes == 0)
+  {
+    return "The tetrahedral lattice has no cells." + fix;
+  }
+  for (vtkIdType c = 0; c < numberOfCells; ++c)
+  {
+    if (lattice->GetCellType(c) != VTK_TETRA)
+    {
+      std::ostringstream msg;
+      msg << "The tetrahedral lattice's cell " << c << " is not a tetrahedron (VTK cell type "
+          << lattice->GetCellType(c) << ")." << fix;
+      return msg.str();
+    }
+  }
+  vtkDataArray* rest = lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
+  if (!rest || rest->GetNumberOfComponents() != 3 || rest->GetNumberOfTuples() != numberOfNodes)
+  {
+    return "The tetrahedral lattice has no RestPosition point array of 3 components per point." + fix;
+  }
+  this->RestPositions = rest;
+  this->RestValues.resize(3 * numberOfNodes);
+  this->Displacements.resize(3 * numberOfNodes);
+  for (vtkIdType p = 0; p < numberOfNodes; ++p)
+  {
+    double x[3], x0[3];
+    lattice->GetPoint(p, x);
+    rest->GetTuple(p, x0);
+    for (int c = 0; c < 3; ++c)
+    {
+      const double d = x[c] - x0[c];
+      if (!std::isfinite(d))
+      {
+        return "Tetrahedral lattice point " + std::to_string(p) + " or its RestPosition is not finite.";
+      }
+      this->RestValues[3 * p + c] = x0[c];
+      this->Displacements[3 * p + c] = d;
+    }
+  }
+  this->Nodes.resize(4 * numberOfCells);
+  vtkCellArray* cells = lattice->GetCells();
+  for (vtkIdType c = 0; c < numberOfCells; ++c)
+  {
+    vtkIdType count;
+    const vtkIdType* ids;
+    cells->GetCellAtId(c, count, ids);
+    std::copy(ids, ids + 4, this->Nodes.begin() + 4 * c);
+  }
+  return std::string();
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkFFDTetrahedralDeformation::Key vtkFFDTetrahedralDeformation::KeyOf(vtkPoints* points, int policy) const
+{
+  Key key;
+  key.Points = points;
+  key.PointsMTime = points->GetMTime();
+  key.NumberOfPoints = points->GetNumberOfPoints();
+  key.Rest = this->RestPositions.Get();
+  key.RestMTime = this->RestPositions->GetMTime();
+  key.Cells = this->Lattice->GetCells();
+  key.CellsMTime = this->Lattice->GetCells()->GetMTime();
+  key.NumberOfCells = this->Lattice->GetNumberOfCells();
+  key.Policy = policy;
+  return key;
+}
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vtkAlgorithm* self,
+  double progressBegin, double progressEnd, bool& rebound)
+{
+  rebound = false;
+  const Key key = this->KeyOf(points, outsidePolicy);
+  if (key == this->Bound)
+  {
+    return true;
+  }
+  this->Bound = Key();
+
+  // The rest frame of every tetrahedron; those without volume are never bound to.
+  const vtkIdType numberOfTetrahedra = static_cast<vtkIdType>(this->Nodes.size() / 4);
+  this->Frames.resize(numberOfTetrahedra);
+  this->Degenerate.assign(numberOfTetrahedra, 0);
+  vtkSMPTools::For(0, numberOfTetrahedra, [this](vtkIdType begin, vtkIdType end) {
+    for (vtkIdType t = begin; t < end; ++t)
+    {
+      const double* corner[4];
+      for (int i = 0; i < 4; ++i)
+      {
+        corner[i] = this->RestValues.data() + 3 * this->Nodes[4 * t + i];
+      }
+      if (ffd::CheckTetrahedron(corner[0], corner[1], corner[2], corner[3]) != ffd::FrameStatus::Valid)
+      {
+        this->Degenerate[t] = 1;
+        continue;
+      }
+      this->Frames[t] = ffd::TetrahedronFrame(corner[0], corner[1], corner[2], corner[3]);
+    }
+  });
+  this->NumberOfDegenerate = std::count(this->Degenerate.begin(), this->Degenerate.end(), 1);
+  const auto first = std::find(this->Degenerate.begin(), this->Degenerate.end(), 1);
+  this->FirstDegenerate = first == this->Degenerate.end() ? -1 : first - this->Degenerate.begin();
+
+  // VTK's locator over the rest tetrahedra.
+  vtkNew<vtkPoints> restPoints;
+  restPoints->SetData(this->RestPositions);
+  vtkNew<vtkUnstructuredGrid> rest;
+  rest->SetPoints(restPoints);
+  rest->SetCells(this->Lattice->GetCellTypesArray(), this->Lattice->GetCells());
+  vtkNew<vtkStaticCellLocator> locator;
+  locator->SetDataSet(rest);
+  locator->BuildLocator();
+  vtkNew<vtkGenericCell> warmUp;
+  rest->GetCell(0, warmUp); // the first GetCell() is not thread-safe (vtkDataSet)
+
+  const vtkIdType numberOfPoints = points->GetNumberOfPoints();
+  this->Cells.resize(numberOfPoints);
+  LocateFunctor locate{ points, locator, this->Frames, this->Degenerate, this->Cells.data(), {}, {} };
+  if (!vtkFFDForInChunks(self, numberOfPoints, locate, progressBegin, progressEnd))
+  {
+    return false;
+  }
+
+  // The outside policy, for the (usually few) points outside every tetrahedron.
+  this->Clamped.clear();
+  this->NumberOfOutsideBound = 0;
+  vtkNew<vtkGenericCell> cell;
+  for (vtkIdType id = 0; id < numberOfPoints; ++id)
+  {
+    if (this->Cells[id] != Outside)
+    {
+      continue;
+    }
+    this->Cells[id] = -1;
+    if (outsidePolicy == KEEP_POSITION)
+    {
+      continue;
+    }
+    double x[3], closest[3], dist2;
+    vtkIdType tetrahedron;
+    int subId;
+    points->GetPoint(id, x);
+    locator->FindClosestPoint(x, closest, cell, tetrahedron, subId, dist2);
+    if (tetrahedron < 0 || this->Degenerate[tetrahedron])
+    {
+      continue; // its nearest tetrahedron has no map: it keeps its position
+    }
+    ++this->NumberOfOutsideBound;
+    if (outsidePolicy == EXTRAPOLATE)
+    {
+      this->Cells[id] = static_cast<int>(tetrahedron);
+      continue;
+    }
+    const ffd::Frame<double>& frame = this->Frames[tetrahedron];
+    const ffd::Vec3<double> c = ffd::Vec3<double>::From(closest);
+    this->Clamped.push_back({ id, static_cast<int>(tetrahedron), c,
+      ffd::ClosestPointGradient(frame, frame.ToParametric(c), 1e-9) });
+  }
+  this->Bound = key;
+  rebound = true;
+  return true;
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDTetrahedralDeformation::ComputeMaps()
+{
+  const vtkIdType numberOfTetrahedra = static_cast<vtkIdType>(this->Frames.size());
+  this->Maps.resize(numberOfTetrahedra);
+  vtkSMPTools::For(0, numberOfTetrahedra, [this](vtkIdType begin, vtkIdType end) {
+    for (vtkIdType t = begin; t < end; ++t)
+    {
+      if (this->Degenerate[t])
+      {
+        this->Maps[t] = ffd::TetrahedronMap<double>{}; // never used: nothing is bound to it
+        continue;
+      }
+      ffd::Vec3<double> d[4];
+      for (int i = 0; i < 4; ++i)
+      {
+        d[i] = ffd::Vec3<double>::From(this->Displacements.data() + 3 * this->Nodes[4 * t + i]);
+      }
+      this->Maps[t] = ffd::MakeTetrahedronMap(this->Frames[t], d[0], d[1], d[2], d[3]);
+    }
+  });
+}
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDTetrahedralDeformation::Evaluate(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints,
+  vtkDataArray* outNormals, vtkDataArray* outDeterminants, vtkAlgorithm* self, double progressBegin,
+  double progressEnd)
+{
+  this->ComputeMaps();
+  bool completed = false;
+  auto evaluate = [&](auto realTag) {
+    using Real = decltype(realTag);
+    using RealArray = vtkAOSDataArrayTemplate<Real>;
+    std::vector<ffd::TetrahedronMap<Real>> maps(this->Maps.size());
+    std::transform(this->Maps.begin(), this->Maps.end(), maps.begin(),
+      [](const ffd::TetrahedronMap<double>& m) { return m.template As<Real>(); });
+    Real* out = static_cast<RealArray*>(outPoints)->GetPointer(0);
+    Real* det = outDeterminants ? static_cast<RealArray*>(outDeterminants)->GetPointer(0) : nullptr;
+    EvaluateWorker<Real> worker;
+    if (!vtkArrayDispatch::DispatchByValueType<vtkArrayDispatch::Reals>::Execute(points->GetData(), worker,
+          this->Cells.data(), maps.data(), normals, outNormals, out, det, self, progressBegin, progressEnd,
+          completed))
+    {
+      worker(points->GetData(), this->Cells.data(), maps.data(), normals, outNormals, out, det, self,
+        progressBegin, progressEnd, completed);
+    }
+    // Points clamped to the control mesh move by the displacement of their nearest point there.
+    for (const ClampedPoint& p : this->Clamped)
+    {
+      const ffd::TetrahedronMap<double>& map = this->Maps[p.Tetrahedron];
+      double x[3];
+      points->GetPoint(p.Point, x);
+      const ffd::Vec3<double> y = ffd::Vec3<double>::From(x) + map.Displacement(p.Closest);
+      for (int c = 0; c < 3; ++c)
+      {
+        out[3 * p.Point + c] = static_cast<Real>(y[c]);
+      }
+      if (outNormals || det)
+      {
+        ffd::Mat3<double> jacobian = map.Gradient * p.Gradient;
+        for (int c = 0; c < 3; ++c)
+        {
+          jacobian.M[c][c] += 1.0;
+        }
+        if (outNormals)
+        {
+          double n[3];
+          normals->GetTuple(p.Point, n);
+          const ffd::Vec3<double> m = ffd::TransformNormal(jacobian, ffd::Vec3<double>::From(n));
+          outNormals->SetTuple3(p.Point, m.x, m.y, m.z);
+        }
+        if (det)
+        {
+          det[p.Point] = static_cast<Real>(ffd::Determinant(jacobian));
+        }
+      }
+    }
+  };
+  if (outPoints->GetDataType() == VTK_DOUBLE)
+  {
+    evaluate(double());
+  }
+  else
+  {
+    evaluate(float());
+  }
+  return completed;
+}

@@ -1,0 +1,150 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkFFDTetrahedralDeformation
+ * @brief   vtkFFDDeform's path for tetrahedral lattices: reading, binding and CPU evaluation
+ *
+ * Private to the Filters module (not wrapped). A tetrahedral lattice (paper section III.E) is a
+ * vtkUnstructuredGrid whose cells are all VTK_TETRA, with a `RestPosition` point array (3 components, one per
+ * point) and without the grid lattices' `FFDFrame`; its deformation is its points minus `RestPosition`.
+ *
+ * Binding, once per input points and lattice rest shape (ffd::TetrahedronFrame, Filters/Kernels/FFDTetrahedra.h):
+ * every point is located with VTK's vtkStaticCellLocator over the rest tetrahedra and checked with the weights
+ * of equation 5; a point on a face shared by two tetrahedra goes to the one it lies deeper in. It stores one int
+ * per point, the tetrahedron, or -1 for a point that keeps its position. Tetrahedra without volume
+ * (ffd::CheckTetrahedron) are never bound to: points in them fall to a neighbour or to the outside policy.
+ * Points outside every tetrahedron keep their position (KEEP_POSITION), take the displacement of the nearest
+ * point of the control mesh (CLAMP_TO_EDGE, as grid lattices do), or follow the affine map of the nearest
+ * tetrahedron (EXTRAPOLATE). Non-finite points always keep theirs.
+ *
+ * Evaluation, at every update: each tetrahedron's affine map (ffd::MakeTetrahedronMap) from its nodes'
+ * displacements, then every point through its tetrahedron's map (ffd::TetrahedronMap::Deform), with normals
+ * by the map's cofactor and det J on request, on vtkSMPTools.
+ *
+ * The same binding serves vtkFFDBuildTetrahedralLattice, which marks the nodes of tetrahedra holding mesh points
+ * `Active`.
+ */
+#ifndef vtkFFDTetrahedralDeformation_h
+#define vtkFFDTetrahedralDeformation_h
+
+#include "vtkSmartPointer.h"
+#include "vtkType.h"
+
+#include "FFDTetrahedra.h"
+
+#include <string>
+#include <vector>
+
+class vtkAlgorithm;
+class vtkDataArray;
+class vtkDataObject;
+class vtkPoints;
+class vtkStaticCellLocator;
+class vtkUnstructuredGrid;
+
+class vtkFFDTetrahedralDeformation
+{
+public:
+  vtkFFDTetrahedralDeformation();
+  ~vtkFFDTetrahedralDeformation();
+  vtkFFDTetrahedralDeformation(const vtkFFDTetrahedralDeformation&) = delete;
+  vtkFFDTetrahedralDeformation& operator=(const vtkFFDTetrahedralDeformation&) = delete;
+
+  /// Outside policies, vtkFFDDeform's values.
+  enum Policies
+  {
+    KEEP_POSITION = 0,
+    CLAMP_TO_EDGE = 1,
+    EXTRAPOLATE = 2
+  };
+
+  /// Whether `lattice` is meant as a tetrahedral lattice: a vtkUnstructuredGrid without the `FFDFrame` of grid
+  /// lattices (SetLattice() then says what else is wrong with it, if anything).
+  static bool IsTetrahedralLattice(vtkDataObject* lattice);
+
+  /**
+   * Reads and checks a tetrahedral lattice and keeps its nodes' displacements for Evaluate(). Returns an empty
+   * string, or what is wrong: cells other than tetrahedra, no or a malformed `RestPosition`, non-finite
+   * positions, no cells.
+   */
+  std::string SetLattice(vtkUnstructuredGrid* lattice);
+
+  /**
+   * Binds the points to the lattice of SetLattice() unless the binding is already for them, the same rest
+   * tetrahedra (arrays and modification times) and the same policy. Progress goes to `self` (may be null) from
+   * `progressBegin` to `progressEnd`. Returns false when aborted (the binding is then dropped); `rebound` tells
+   * whether it bound.
+   */
+  bool Bind(vtkPoints* points, int outsidePolicy, vtkAlgorithm* self, double progressBegin, double progressEnd,
+    bool& rebound);
+
+  /**
+   * Deforms the bound points into outPoints (a float or double AOS array of their count), with the normals
+   * (3 components, may be null) transformed into outNormals and det J into outDeterminants (of outPoints' type)
+   * when those are not null. Returns false when aborted.
+   */
+  bool Evaluate(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals,
+    vtkDataArray* outDeterminants, vtkAlgorithm* self, double progressBegin, double progressEnd);
+
+  ///@{
+  /// The binding: per point its tetrahedron (-1: keeps its position, or clamped, see below).
+  const std::vector<int>& GetCells() const { return this->Cells; }
+  vtkIdType GetNumberOfTetrahedra() const { return static_cast<vtkIdType>(this->Frames.size()); }
+  ///@}
+
+  ///@{
+  /// Tetrahedra without volume in the bound lattice, and the first of them (-1 when none).
+  vtkIdType GetNumberOfDegenerateTetrahedra() const { return this->NumberOfDegenerate; }
+  vtkIdType GetFirstDegenerateTetrahedron() const { return this->FirstDegenerate; }
+  ///@}
+
+  /// Points bound outside every tetrahedron by the policy (clamped or extrapolated) at the last binding.
+  vtkIdType GetNumberOfOutsidePointsBound() const { return this->NumberOfOutsideBound; }
+
+private:
+  struct Key
+  {
+    const void* Points = nullptr;
+    vtkMTimeType PointsMTime = 0;
+    vtkIdType NumberOfPoints = -1;
+    const void* Rest = nullptr;
+    vtkMTimeType RestMTime = 0;
+    const void* Cells = nullptr;
+    vtkMTimeType CellsMTime = 0;
+    vtkIdType NumberOfCells = -1;
+    int Policy = -1;
+    bool operator==(const Key& o) const;
+  };
+  /// A point outside the control mesh clamped to it: it moves by the displacement of its nearest point there.
+  struct ClampedPoint
+  {
+    vtkIdType Point;
+    int Tetrahedron;
+    ffd::Vec3<double> Closest;  ///< the nearest point of the control mesh
+    ffd::Mat3<double> Gradient; ///< d(Closest)/dX (ffd::ClosestPointGradient)
+  };
+
+  Key KeyOf(vtkPoints* points, int policy) const;
+  void ComputeMaps();
+
+  // The lattice of SetLattice().
+  vtkSmartPointer<vtkUnstructuredGrid> Lattice;
+  vtkSmartPointer<vtkDataArray> RestPositions;
+  std::vector<double> RestValues;    // 3 per node: RestPosition
+  std::vector<double> Displacements; // 3 per node: the node minus RestPosition
+  std::vector<vtkIdType> Nodes;      // 4 per tetrahedron
+
+  // The binding and what it is for.
+  Key Bound;
+  std::vector<ffd::Frame<double>> Frames; // rest frame per tetrahedron
+  std::vector<unsigned char> Degenerate;  // 1 per tetrahedron without volume
+  vtkIdType NumberOfDegenerate = 0;
+  vtkIdType FirstDegenerate = -1;
+  std::vector<int> Cells;
+  std::vector<ClampedPoint> Clamped;
+  vtkIdType NumberOfOutsideBound = 0;
+
+  // Per update: each tetrahedron's map.
+  std::vector<ffd::TetrahedronMap<double>> Maps;
+};
+
+#endif
