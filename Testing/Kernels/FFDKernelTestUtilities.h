@@ -60,6 +60,20 @@ inline double RelativeVolume(const ffdref::Frame& f)
   return std::fabs(ffdref::Dot(ffdref::Cross(f.S, f.T), f.U)) / (Norm(f.S) * Norm(f.T) * Norm(f.U));
 }
 
+/// Largest norm of the dual vectors (rows of d(s,t,u)/dX): how much a world error grows in parameters.
+inline double DualNorm(const ffdref::Frame& f)
+{
+  const ffdref::Vec tu = ffdref::Cross(f.T, f.U), su = ffdref::Cross(f.S, f.U), st = ffdref::Cross(f.S, f.T);
+  return std::max({ Norm(tu) / std::fabs(ffdref::Dot(tu, f.S)), Norm(su) / std::fabs(ffdref::Dot(su, f.T)),
+    Norm(st) / std::fabs(ffdref::Dot(st, f.U)) });
+}
+
+/// Size of the numbers a frame computation rounds: |x|, |X0| and the edges.
+inline double WorldScale(const ffdref::Frame& f, const ffdref::Vec& x)
+{
+  return MaxAbs(x) + MaxAbs(f.X0) + Norm(f.S) + Norm(f.T) + Norm(f.U);
+}
+
 /**
  * A random non-orthogonal parallelepiped near the origin: X0 in [-1, 1]^3, edges of random direction and
  * length in [0.5, 2], rejected until its relative volume is at least 0.2 (so its parameter map is well

@@ -13,9 +13,11 @@
 namespace
 {
 using ffdref::Vec;
+using ffdtest::DualNorm;
 using ffdtest::Eps;
 using ffdtest::MaxAbs;
 using ffdtest::Norm;
+using ffdtest::WorldScale;
 
 template <typename Real>
 class FFDFrameTest : public ::testing::Test
@@ -34,20 +36,6 @@ ffd::Frame<Real> KernelFrame(const ffdref::Frame& f)
   ffdtest::FrameToArray(f, a);
   EXPECT_EQ(ffd::CheckFrame(a), ffd::FrameStatus::Valid);
   return ffd::Frame<Real>::FromArray(a);
-}
-
-/// Largest norm of the dual vectors (rows of d(s,t,u)/dX): how much a world error grows in parameters.
-double DualNorm(const ffdref::Frame& f)
-{
-  const Vec tu = ffdref::Cross(f.T, f.U), su = ffdref::Cross(f.S, f.U), st = ffdref::Cross(f.S, f.T);
-  return std::max({ Norm(tu) / std::fabs(ffdref::Dot(tu, f.S)), Norm(su) / std::fabs(ffdref::Dot(su, f.T)),
-    Norm(st) / std::fabs(ffdref::Dot(st, f.U)) });
-}
-
-/// Size of the numbers a frame computation rounds: |x|, |X0| and the edges.
-double WorldScale(const ffdref::Frame& f, const Vec& x)
-{
-  return MaxAbs(x) + MaxAbs(f.X0) + Norm(f.S) + Norm(f.T) + Norm(f.U);
 }
 
 TYPED_TEST(FFDFrameTest, ToParametricMatchesReference)

@@ -231,6 +231,37 @@ inline Vec DeformLocal(
   }
   return EvaluateLocal(b, divisions, p, stu);
 }
+/**
+ * Tetrahedral FFD (paper section III.E), written independently of equation 5's dual vectors: the barycentric
+ * weights of x in tetrahedron (a, b, c, d) are ratios of signed volumes, w_a = vol(x, b, c, d) / vol(a, b, c, d)
+ * and so on, so that x = w_a a + w_b b + w_c c + w_d d with weights summing to 1.
+ */
+inline double SignedVolume(const Vec& a, const Vec& b, const Vec& c, const Vec& d)
+{
+  return Dot(Cross(Sub(b, a), Sub(c, a)), Sub(d, a)) / 6.0;
+}
+
+inline std::array<double, 4> TetrahedronWeights(const Vec& a, const Vec& b, const Vec& c, const Vec& d, const Vec& x)
+{
+  const double v = SignedVolume(a, b, c, d);
+  return { SignedVolume(x, b, c, d) / v, SignedVolume(a, x, c, d) / v, SignedVolume(a, b, x, d) / v,
+    SignedVolume(a, b, c, x) / v };
+}
+
+/// The absolute form of the tetrahedral FFD: sum over the four nodes of weight times the node's position.
+inline Vec DeformInTetrahedron(const std::array<Vec, 4>& rest, const std::array<Vec, 4>& moved, const Vec& x)
+{
+  const std::array<double, 4> w = TetrahedronWeights(rest[0], rest[1], rest[2], rest[3], x);
+  Vec y = { 0.0, 0.0, 0.0 };
+  for (int i = 0; i < 4; ++i)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      y[c] += w[i] * moved[i][c];
+    }
+  }
+  return y;
+}
 } // namespace ffdref
 
 #endif
