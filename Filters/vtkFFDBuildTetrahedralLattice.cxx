@@ -35,6 +35,9 @@ vtkStandardNewMacro(vtkFFDBuildTetrahedralLattice);
 
 namespace
 {
+// The weight above which a node influences a point (vtkFFDBuildTetrahedralLattice's `Active`).
+constexpr double ActiveWeight = 1e-9;
+
 // A control mesh under construction: 3 coordinates per node, 4 node ids per tetrahedron.
 struct TetrahedralMesh
 {
@@ -316,7 +319,8 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   output->SetCells(VTK_TETRA, cells);
   output->GetPointData()->AddArray(rest);
 
-  // Active nodes: those of tetrahedra holding an input point, as vtkFFDDeform binds them.
+  // Active nodes: those with a weight for some input point in its tetrahedron, as vtkFFDDeform binds it. A
+  // point on a face has a weight of (nearly) zero for the opposite node, which it does not move.
   vtkFFDTetrahedralDeformation binding;
   const std::string problem = binding.SetLattice(output);
   bool rebound = false;
@@ -334,13 +338,25 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   active->SetName(vtkFFDDataContract::ActiveArrayName());
   active->SetNumberOfValues(numberOfNodes);
   active->FillValue(0);
-  for (const int tetrahedron : binding.GetCells())
+  const std::vector<int>& bound = binding.GetCells();
+  for (vtkIdType id = 0; id < numberOfPoints; ++id)
   {
-    if (tetrahedron >= 0)
+    if (bound[id] < 0)
     {
-      for (int i = 0; i < 4; ++i)
+      continue;
+    }
+    const vtkIdType* nodes = mesh.Tetrahedra.data() + 4 * bound[id];
+    double x[3];
+    input->GetPoint(id, x);
+    const ffd::Vec3<double> stu =
+      ffd::TetrahedronFrame(mesh.Node(nodes[0]), mesh.Node(nodes[1]), mesh.Node(nodes[2]), mesh.Node(nodes[3]))
+        .ToParametric(ffd::Vec3<double>::From(x));
+    const double weights[4] = { 1.0 - stu.x - stu.y - stu.z, stu.x, stu.y, stu.z };
+    for (int i = 0; i < 4; ++i)
+    {
+      if (weights[i] > ActiveWeight)
       {
-        active->SetValue(mesh.Tetrahedra[4 * tetrahedron + i], 1);
+        active->SetValue(nodes[i], 1);
       }
     }
   }

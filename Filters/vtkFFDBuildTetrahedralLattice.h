@@ -15,9 +15,9 @@
  * - SubdivisionLevels (default 0) refines the control mesh for finer control (level of detail): each level
  *   splits every tetrahedron into eight at its edges' midpoints (its inner octahedron along the shortest
  *   diagonal), so a level multiplies the tetrahedra by 8 and the nodes by about 5.
- * - A node is active when a tetrahedron it belongs to holds an input point (the binding of vtkFFDDeform decides
- *   which); the others are culled: `Active` is 0 and the ghost array marks them HIDDENPOINT, as
- *   vtkFFDBuildLattice does for grid lattices.
+ * - A node is active when it influences an input point: it has a weight above 1e-9 for a point in one of its
+ *   tetrahedra (bound as vtkFFDDeform binds it). The others are culled: `Active` is 0 and the ghost array marks
+ *   them HIDDENPOINT, as vtkFFDBuildLattice does for grid lattices.
  *
  * Every tetrahedron is positively oriented. An input with fewer than four finite points, or whose points are
  * flat (no 3D hull), is an error and gives an empty output; non-finite points are ignored.

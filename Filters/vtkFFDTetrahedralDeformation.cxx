@@ -166,9 +166,7 @@ struct EvaluateWorker
 bool vtkFFDTetrahedralDeformation::Key::operator==(const Key& o) const
 {
   return this->Points == o.Points && this->PointsMTime == o.PointsMTime &&
-    this->NumberOfPoints == o.NumberOfPoints && this->Rest == o.Rest && this->RestMTime == o.RestMTime &&
-    this->Cells == o.Cells && this->CellsMTime == o.CellsMTime && this->NumberOfCells == o.NumberOfCells &&
-    this->Policy == o.Policy;
+    this->NumberOfPoints == o.NumberOfPoints && this->Policy == o.Policy;
 }
 
 vtkFFDTetrahedralDeformation::vtkFFDTetrahedralDeformation() = default;
@@ -246,11 +244,6 @@ vtkFFDTetrahedralDeformation::Key vtkFFDTetrahedralDeformation::KeyOf(vtkPoints*
   key.Points = points;
   key.PointsMTime = points->GetMTime();
   key.NumberOfPoints = points->GetNumberOfPoints();
-  key.Rest = this->RestPositions.Get();
-  key.RestMTime = this->RestPositions->GetMTime();
-  key.Cells = this->Lattice->GetCells();
-  key.CellsMTime = this->Lattice->GetCells()->GetMTime();
-  key.NumberOfCells = this->Lattice->GetNumberOfCells();
   key.Policy = policy;
   return key;
 }
@@ -261,7 +254,7 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
 {
   rebound = false;
   const Key key = this->KeyOf(points, outsidePolicy);
-  if (key == this->Bound)
+  if (key == this->Bound && this->RestValues == this->BoundRest && this->Nodes == this->BoundNodes)
   {
     return true;
   }
@@ -347,6 +340,8 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
       ffd::ClosestPointGradient(frame, frame.ToParametric(c), 1e-9) });
   }
   this->Bound = key;
+  this->BoundRest = this->RestValues;
+  this->BoundNodes = this->Nodes;
   rebound = true;
   return true;
 }

@@ -10,7 +10,8 @@
  * Binding, once per input points and lattice rest shape (ffd::TetrahedronFrame, Filters/Kernels/FFDTetrahedra.h):
  * every point is located with VTK's vtkStaticCellLocator over the rest tetrahedra and checked with the weights
  * of equation 5; a point on a face shared by two tetrahedra goes to the one it lies deeper in. It stores one int
- * per point, the tetrahedron, or -1 for a point that keeps its position. Tetrahedra without volume
+ * per point, the tetrahedron, or -1 for a point that keeps its position; it is kept while the points (their
+ * vtkPoints, its modification time and count), the rest tetrahedra (by value) and the policy stay the same. Tetrahedra without volume
  * (ffd::CheckTetrahedron) are never bound to: points in them fall to a neighbour or to the outside policy.
  * Points outside every tetrahedron keep their position (KEEP_POSITION), take the displacement of the nearest
  * point of the control mesh (CLAMP_TO_EDGE, as grid lattices do), or follow the affine map of the nearest
@@ -70,7 +71,7 @@ public:
 
   /**
    * Binds the points to the lattice of SetLattice() unless the binding is already for them, the same rest
-   * tetrahedra (arrays and modification times) and the same policy. Progress goes to `self` (may be null) from
+   * tetrahedra (by value) and the same policy. Progress goes to `self` (may be null) from
    * `progressBegin` to `progressEnd`. Returns false when aborted (the binding is then dropped); `rebound` tells
    * whether it bound.
    */
@@ -101,16 +102,13 @@ public:
   vtkIdType GetNumberOfOutsidePointsBound() const { return this->NumberOfOutsideBound; }
 
 private:
+  /// What a binding is for: the points (identity, modification time, count) and the policy; the rest
+  /// tetrahedra are compared by value (BoundRest, BoundNodes), so a rebuilt but identical lattice keeps it.
   struct Key
   {
     const void* Points = nullptr;
     vtkMTimeType PointsMTime = 0;
     vtkIdType NumberOfPoints = -1;
-    const void* Rest = nullptr;
-    vtkMTimeType RestMTime = 0;
-    const void* Cells = nullptr;
-    vtkMTimeType CellsMTime = 0;
-    vtkIdType NumberOfCells = -1;
     int Policy = -1;
     bool operator==(const Key& o) const;
   };
@@ -135,6 +133,8 @@ private:
 
   // The binding and what it is for.
   Key Bound;
+  std::vector<double> BoundRest;
+  std::vector<vtkIdType> BoundNodes;
   std::vector<ffd::Frame<double>> Frames; // rest frame per tetrahedron
   std::vector<unsigned char> Degenerate;  // 1 per tetrahedron without volume
   vtkIdType NumberOfDegenerate = 0;
