@@ -21,6 +21,8 @@
 #include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -31,8 +33,10 @@ namespace
 // absorbs rounding on faces, as ffd::ParametricTolerance() does for grid frames.
 constexpr double InsideTolerance = 1e-10;
 
-// Marks points that lie outside every tetrahedron until the outside policy decides.
+// Marks points that lie outside every tetrahedron until the outside policy decides, and points the walk
+// could not place (binding only).
 constexpr int Outside = -2;
+constexpr int Undecided = -3;
 
 bool IsFinite(const double x[3])
 {
@@ -40,15 +44,105 @@ bool IsFinite(const double x[3])
 }
 
 //------------------------------------------------------------------------------------------------------------
-// Locates every point: VTK's locator proposes a tetrahedron (its own inside test has a looser tolerance), the
-// weights of equation 5 confirm it; a point the proposal does not hold is tested against every tetrahedron of
-// its locator bin and goes to the one it lies deepest in.
+// Locating points in the rest tetrahedra: a walk through face neighbours from a nearby seed does most of the
+// work; VTK's vtkStaticCellLocator is the authority where the walk stops without an answer.
+struct Walker
+{
+  const std::vector<ffd::Frame<double>>& Frames;
+  const std::vector<unsigned char>& Degenerate;
+  const std::vector<int>& Neighbours; // 4 per tetrahedron: across the face opposite node i, -1 on the boundary
+
+  // Steps after which a walk gives up (it may cycle in a mesh that is not Delaunay); the locator takes over.
+  static constexpr int MaxSteps = 256;
+
+  /**
+   * The tetrahedron holding x (its smallest weight >= -InsideTolerance) reached from `start` by stepping across
+   * the face opposite the most negative weight, or -1 when the walk leaves the mesh, meets a tetrahedron without
+   * volume or runs too long; `last` is the last tetrahedron it visited.
+   */
+  int Walk(int start, const ffd::Vec3<double>& x, int& last) const
+  {
+    int t = start;
+    for (int step = 0; step < MaxSteps && t >= 0; ++step)
+    {
+      last = t;
+      if (this->Degenerate[t])
+      {
+        return -1;
+      }
+      const ffd::Vec3<double> stu = this->Frames[t].ToParametric(x);
+      const double w[4] = { 1.0 - stu.x - stu.y - stu.z, stu.x, stu.y, stu.z };
+      int k = 0;
+      for (int i = 1; i < 4; ++i)
+      {
+        k = w[i] < w[k] ? i : k;
+      }
+      if (w[k] >= -InsideTolerance)
+      {
+        return t;
+      }
+      t = this->Neighbours[4 * t + k];
+    }
+    return -1;
+  }
+};
+
+// A uniform grid over the rest nodes' bounds whose cells remember a tetrahedron near their centre, where walks
+// start.
+struct Seeds
+{
+  double Origin[3], Spacing[3];
+  int Size = 1;
+  std::vector<int> Tetrahedra;
+
+  int Of(const double x[3]) const
+  {
+    int index = 0;
+    for (int a = 2; a >= 0; --a)
+    {
+      const double c = std::floor((x[a] - this->Origin[a]) / this->Spacing[a]);
+      index = index * this->Size + static_cast<int>(std::min(std::max(c, 0.0), double(this->Size - 1)));
+    }
+    return this->Tetrahedra[index];
+  }
+};
+
+// Walks every point from its seed to its tetrahedron; points the walk leaves undecided go to LocateFunctor.
+struct WalkFunctor
+{
+  vtkPoints* Points;
+  const Walker& Walk;
+  const Seeds& Starts;
+  int* Cells;
+
+  void operator()(vtkIdType begin, vtkIdType end) const
+  {
+    for (vtkIdType id = begin; id < end; ++id)
+    {
+      double x[3];
+      this->Points->GetPoint(id, x);
+      if (!IsFinite(x))
+      {
+        this->Cells[id] = -1;
+        continue;
+      }
+      int last;
+      const int walked = this->Walk.Walk(this->Starts.Of(x), ffd::Vec3<double>::From(x), last);
+      this->Cells[id] = walked >= 0 ? walked : Undecided;
+    }
+  }
+};
+
+// Locates the points the walks left undecided with VTK's locator: it proposes a tetrahedron (its own inside
+// test has a looser tolerance) that the weights of equation 5 confirm, and failing that, every tetrahedron of
+// the point's locator bin is tested and the one the point lies deepest in wins.
 struct LocateFunctor
 {
   vtkPoints* Points;
   vtkStaticCellLocator* Locator;
   const std::vector<ffd::Frame<double>>& Frames;
   const std::vector<unsigned char>& Degenerate;
+  const std::vector<vtkIdType>& Undecided;
   int* Cells;
   vtkSMPThreadLocalObject<vtkGenericCell> Cell;
   vtkSMPThreadLocalObject<vtkIdList> Candidates;
@@ -66,15 +160,11 @@ struct LocateFunctor
   {
     vtkGenericCell* cell = this->Cell.Local();
     vtkIdList* candidates = this->Candidates.Local();
-    for (vtkIdType id = begin; id < end; ++id)
+    for (vtkIdType u = begin; u < end; ++u)
     {
+      const vtkIdType id = this->Undecided[u];
       double x[3], pcoords[3], weights[4];
       this->Points->GetPoint(id, x);
-      if (!IsFinite(x))
-      {
-        this->Cells[id] = -1;
-        continue;
-      }
       const vtkIdType proposed = this->Locator->FindCell(x, 0.0, cell, pcoords, weights);
       if (proposed >= 0 && this->Margin(proposed, x) >= 0.0)
       {
@@ -100,6 +190,91 @@ struct LocateFunctor
 
   void Reduce() {}
 };
+
+// The face neighbours of every tetrahedron (4 per tetrahedron, across the face opposite node i; -1 on the
+// boundary), by sorting the faces.
+std::vector<int> FaceNeighbours(const std::vector<vtkIdType>& nodes)
+{
+  struct Face
+  {
+    std::array<vtkIdType, 3> Nodes;
+    int Side; // 4 * tetrahedron + the opposite node
+    bool operator<(const Face& o) const { return this->Nodes < o.Nodes; }
+  };
+  const int numberOfTetrahedra = static_cast<int>(nodes.size() / 4);
+  std::vector<Face> faces;
+  faces.reserve(4 * numberOfTetrahedra);
+  for (int t = 0; t < numberOfTetrahedra; ++t)
+  {
+    for (int i = 0; i < 4; ++i)
+    {
+      Face face{ {}, 4 * t + i };
+      for (int k = 0, n = 0; k < 4; ++k)
+      {
+        if (k != i)
+        {
+          face.Nodes[n++] = nodes[4 * t + k];
+        }
+      }
+      std::sort(face.Nodes.begin(), face.Nodes.end());
+      faces.push_back(face);
+    }
+  }
+  vtkSMPTools::Sort(faces.begin(), faces.end());
+  std::vector<int> neighbours(4 * numberOfTetrahedra, -1);
+  for (size_t f = 0; f + 1 < faces.size(); ++f)
+  {
+    if (faces[f].Nodes == faces[f + 1].Nodes)
+    {
+      neighbours[faces[f].Side] = faces[f + 1].Side / 4;
+      neighbours[faces[f + 1].Side] = faces[f].Side / 4;
+      ++f;
+    }
+  }
+  return neighbours;
+}
+
+// Seeds for the walks: about 8 tetrahedra per grid cell, each cell's tetrahedron found by a walk from its
+// neighbour's (or, outside the mesh, the boundary tetrahedron where that walk stopped).
+Seeds MakeSeeds(const std::vector<double>& rest, const Walker& walk)
+{
+  Seeds seeds;
+  double lo[3] = { rest[0], rest[1], rest[2] }, hi[3] = { rest[0], rest[1], rest[2] };
+  for (size_t i = 0; i < rest.size(); i += 3)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      lo[a] = std::min(lo[a], rest[i + a]);
+      hi[a] = std::max(hi[a], rest[i + a]);
+    }
+  }
+  const double cells = static_cast<double>(walk.Frames.size()) / 8.0;
+  seeds.Size = std::max(1, std::min(64, static_cast<int>(std::cbrt(cells))));
+  for (int a = 0; a < 3; ++a)
+  {
+    seeds.Origin[a] = lo[a];
+    seeds.Spacing[a] = std::max(hi[a] - lo[a], std::numeric_limits<double>::min()) / seeds.Size;
+  }
+  seeds.Tetrahedra.resize(static_cast<size_t>(seeds.Size) * seeds.Size * seeds.Size);
+  int previous = static_cast<int>(
+    std::find(walk.Degenerate.begin(), walk.Degenerate.end(), 0) - walk.Degenerate.begin());
+  for (int k = 0, index = 0; k < seeds.Size; ++k)
+  {
+    for (int j = 0; j < seeds.Size; ++j)
+    {
+      for (int i = 0; i < seeds.Size; ++i, ++index)
+      {
+        const ffd::Vec3<double> centre = { seeds.Origin[0] + (i + 0.5) * seeds.Spacing[0],
+          seeds.Origin[1] + (j + 0.5) * seeds.Spacing[1], seeds.Origin[2] + (k + 0.5) * seeds.Spacing[2] };
+        int last = previous;
+        const int found = walk.Walk(previous, centre, last);
+        previous = found >= 0 ? found : (walk.Degenerate[last] ? previous : last);
+        seeds.Tetrahedra[index] = previous;
+      }
+    }
+  }
+  return seeds;
+}
 
 //------------------------------------------------------------------------------------------------------------
 // Evaluation in the precision Real of the output points.
@@ -191,7 +366,8 @@ std::string vtkFFDTetrahedralDeformation::SetLattice(vtkUnstructuredGrid* lattic
   {
     return "The tetrahedral lattice has no cells." + fix;
   }
-  for (vtkIdType c = 0; c < numberOfCells; ++c)
+  const bool allTetrahedra = lattice->IsHomogeneous() && lattice->GetCellType(0) == VTK_TETRA;
+  for (vtkIdType c = 0; c < numberOfCells && !allTetrahedra; ++c)
   {
     if (lattice->GetCellType(c) != VTK_TETRA)
     {
@@ -225,14 +401,21 @@ std::string vtkFFDTetrahedralDeformation::SetLattice(vtkUnstructuredGrid* lattic
       this->Displacements[3 * p + c] = d;
     }
   }
-  this->Nodes.resize(4 * numberOfCells);
+  // The connectivity is read again only when its array changed (an update usually moves nodes only).
   vtkCellArray* cells = lattice->GetCells();
-  for (vtkIdType c = 0; c < numberOfCells; ++c)
+  if (cells != this->NodesSource || cells->GetMTime() != this->NodesSourceMTime ||
+    this->Nodes.size() != static_cast<size_t>(4 * numberOfCells))
   {
-    vtkIdType count;
-    const vtkIdType* ids;
-    cells->GetCellAtId(c, count, ids);
-    std::copy(ids, ids + 4, this->Nodes.begin() + 4 * c);
+    this->Nodes.resize(4 * numberOfCells);
+    for (vtkIdType c = 0; c < numberOfCells; ++c)
+    {
+      vtkIdType count;
+      const vtkIdType* ids;
+      cells->GetCellAtId(c, count, ids);
+      std::copy(ids, ids + 4, this->Nodes.begin() + 4 * c);
+    }
+    this->NodesSource = cells;
+    this->NodesSourceMTime = cells->GetMTime();
   }
   return std::string();
 }
@@ -284,24 +467,59 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
   const auto first = std::find(this->Degenerate.begin(), this->Degenerate.end(), 1);
   this->FirstDegenerate = first == this->Degenerate.end() ? -1 : first - this->Degenerate.begin();
 
-  // VTK's locator over the rest tetrahedra.
+  // VTK's locators over the rest tetrahedra, built only when a walk leaves a point undecided or the outside
+  // policy needs nearest points.
   vtkNew<vtkPoints> restPoints;
   restPoints->SetData(this->RestPositions);
   vtkNew<vtkUnstructuredGrid> rest;
   rest->SetPoints(restPoints);
   rest->SetCells(this->Lattice->GetCellTypesArray(), this->Lattice->GetCells());
   vtkNew<vtkStaticCellLocator> locator;
-  locator->SetDataSet(rest);
-  locator->BuildLocator();
-  vtkNew<vtkGenericCell> warmUp;
-  rest->GetCell(0, warmUp); // the first GetCell() is not thread-safe (vtkDataSet)
+  auto buildLocator = [&]() {
+    if (!locator->GetDataSet())
+    {
+      locator->SetDataSet(rest);
+      locator->BuildLocator();
+      vtkNew<vtkGenericCell> warmUp;
+      rest->GetCell(0, warmUp); // the first GetCell() is not thread-safe (vtkDataSet)
+    }
+  };
 
   const vtkIdType numberOfPoints = points->GetNumberOfPoints();
   this->Cells.resize(numberOfPoints);
-  LocateFunctor locate{ points, locator, this->Frames, this->Degenerate, this->Cells.data(), {}, {} };
-  if (!vtkFFDForInChunks(self, numberOfPoints, locate, progressBegin, progressEnd))
+  if (this->NumberOfDegenerate == numberOfTetrahedra)
   {
-    return false;
+    std::fill(this->Cells.begin(), this->Cells.end(), Undecided);
+  }
+  else
+  {
+    this->Neighbours = FaceNeighbours(this->Nodes);
+    const Walker walker{ this->Frames, this->Degenerate, this->Neighbours };
+    const Seeds seeds = MakeSeeds(this->RestValues, walker);
+    WalkFunctor walk{ points, walker, seeds, this->Cells.data() };
+    const double middle = progressBegin + 0.8 * (progressEnd - progressBegin);
+    if (!vtkFFDForInChunks(self, numberOfPoints, walk, progressBegin, middle))
+    {
+      return false;
+    }
+  }
+  std::vector<vtkIdType> undecided;
+  for (vtkIdType id = 0; id < numberOfPoints; ++id)
+  {
+    if (this->Cells[id] == Undecided)
+    {
+      undecided.push_back(id);
+    }
+  }
+  if (!undecided.empty())
+  {
+    buildLocator();
+    LocateFunctor locate{ points, locator, this->Frames, this->Degenerate, undecided, this->Cells.data(), {}, {} };
+    if (!vtkFFDForInChunks(self, static_cast<vtkIdType>(undecided.size()), locate,
+          progressBegin + 0.8 * (progressEnd - progressBegin), progressEnd))
+    {
+      return false;
+    }
   }
 
   // The outside policy, for the (usually few) points outside every tetrahedron.
@@ -323,6 +541,7 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
     vtkIdType tetrahedron;
     int subId;
     points->GetPoint(id, x);
+    buildLocator();
     locator->FindClosestPoint(x, closest, cell, tetrahedron, subId, dist2);
     if (tetrahedron < 0 || this->Degenerate[tetrahedron])
     {
@@ -347,24 +566,28 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
 }
 
 //------------------------------------------------------------------------------------------------------------
-void vtkFFDTetrahedralDeformation::ComputeMaps()
+ffd::TetrahedronMap<double> vtkFFDTetrahedralDeformation::Map(vtkIdType tetrahedron) const
 {
-  const vtkIdType numberOfTetrahedra = static_cast<vtkIdType>(this->Frames.size());
-  this->Maps.resize(numberOfTetrahedra);
-  vtkSMPTools::For(0, numberOfTetrahedra, [this](vtkIdType begin, vtkIdType end) {
+  if (this->Degenerate[tetrahedron])
+  {
+    return ffd::TetrahedronMap<double>{}; // never used: nothing is bound to it
+  }
+  ffd::Vec3<double> d[4];
+  for (int i = 0; i < 4; ++i)
+  {
+    d[i] = ffd::Vec3<double>::From(this->Displacements.data() + 3 * this->Nodes[4 * tetrahedron + i]);
+  }
+  return ffd::MakeTetrahedronMap(this->Frames[tetrahedron], d[0], d[1], d[2], d[3]);
+}
+
+template <typename Real>
+void vtkFFDTetrahedralDeformation::ComputeMaps(std::vector<ffd::TetrahedronMap<Real>>& maps) const
+{
+  maps.resize(this->Frames.size());
+  vtkSMPTools::For(0, static_cast<vtkIdType>(maps.size()), [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType t = begin; t < end; ++t)
     {
-      if (this->Degenerate[t])
-      {
-        this->Maps[t] = ffd::TetrahedronMap<double>{}; // never used: nothing is bound to it
-        continue;
-      }
-      ffd::Vec3<double> d[4];
-      for (int i = 0; i < 4; ++i)
-      {
-        d[i] = ffd::Vec3<double>::From(this->Displacements.data() + 3 * this->Nodes[4 * t + i]);
-      }
-      this->Maps[t] = ffd::MakeTetrahedronMap(this->Frames[t], d[0], d[1], d[2], d[3]);
+      maps[t] = this->Map(t).template As<Real>();
     }
   });
 }
@@ -374,14 +597,12 @@ bool vtkFFDTetrahedralDeformation::Evaluate(vtkPoints* points, vtkDataArray* nor
   vtkDataArray* outNormals, vtkDataArray* outDeterminants, vtkAlgorithm* self, double progressBegin,
   double progressEnd)
 {
-  this->ComputeMaps();
   bool completed = false;
   auto evaluate = [&](auto realTag) {
     using Real = decltype(realTag);
     using RealArray = vtkAOSDataArrayTemplate<Real>;
-    std::vector<ffd::TetrahedronMap<Real>> maps(this->Maps.size());
-    std::transform(this->Maps.begin(), this->Maps.end(), maps.begin(),
-      [](const ffd::TetrahedronMap<double>& m) { return m.template As<Real>(); });
+    std::vector<ffd::TetrahedronMap<Real>> maps;
+    this->ComputeMaps(maps);
     Real* out = static_cast<RealArray*>(outPoints)->GetPointer(0);
     Real* det = outDeterminants ? static_cast<RealArray*>(outDeterminants)->GetPointer(0) : nullptr;
     EvaluateWorker<Real> worker;
@@ -395,7 +616,7 @@ bool vtkFFDTetrahedralDeformation::Evaluate(vtkPoints* points, vtkDataArray* nor
     // Points clamped to the control mesh move by the displacement of their nearest point there.
     for (const ClampedPoint& p : this->Clamped)
     {
-      const ffd::TetrahedronMap<double>& map = this->Maps[p.Tetrahedron];
+      const ffd::TetrahedronMap<double> map = this->Map(p.Tetrahedron);
       double x[3];
       points->GetPoint(p.Point, x);
       const ffd::Vec3<double> y = ffd::Vec3<double>::From(x) + map.Displacement(p.Closest);

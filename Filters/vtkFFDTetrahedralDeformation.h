@@ -8,8 +8,11 @@
  * point) and without the grid lattices' `FFDFrame`; its deformation is its points minus `RestPosition`.
  *
  * Binding, once per input points and lattice rest shape (ffd::TetrahedronFrame, Filters/Kernels/FFDTetrahedra.h):
- * every point is located with VTK's vtkStaticCellLocator over the rest tetrahedra and checked with the weights
- * of equation 5; a point on a face shared by two tetrahedra goes to the one it lies deeper in. It stores one int
+ * every point is located in the rest tetrahedra by the weights of equation 5, walking across faces from a seed
+ * of a coarse grid towards the face of the most negative weight; where a walk gives no answer (it left a
+ * non-convex mesh, met a tetrahedron without volume, or cycled), VTK's vtkStaticCellLocator decides. VTK's
+ * locator alone tests each candidate through vtkCell::EvaluatePosition, 10 times slower here on the long
+ * tetrahedra of a hull's fan, whose bounds overlap by the hundreds. It stores one int
  * per point, the tetrahedron, or -1 for a point that keeps its position; it is kept while the points (their
  * vtkPoints, its modification time and count), the rest tetrahedra (by value) and the policy stay the same. Tetrahedra without volume
  * (ffd::CheckTetrahedron) are never bound to: points in them fall to a neighbour or to the outside policy.
@@ -122,7 +125,11 @@ private:
   };
 
   Key KeyOf(vtkPoints* points, int policy) const;
-  void ComputeMaps();
+  /// The map of a tetrahedron from its nodes' displacements (double precision).
+  ffd::TetrahedronMap<double> Map(vtkIdType tetrahedron) const;
+  /// Every tetrahedron's map, in the evaluation's precision.
+  template <typename Real>
+  void ComputeMaps(std::vector<ffd::TetrahedronMap<Real>>& maps) const;
 
   // The lattice of SetLattice().
   vtkSmartPointer<vtkUnstructuredGrid> Lattice;
@@ -130,6 +137,8 @@ private:
   std::vector<double> RestValues;    // 3 per node: RestPosition
   std::vector<double> Displacements; // 3 per node: the node minus RestPosition
   std::vector<vtkIdType> Nodes;      // 4 per tetrahedron
+  const void* NodesSource = nullptr; // the cell array Nodes was read from, and its modification time
+  vtkMTimeType NodesSourceMTime = 0;
 
   // The binding and what it is for.
   Key Bound;
@@ -137,14 +146,12 @@ private:
   std::vector<vtkIdType> BoundNodes;
   std::vector<ffd::Frame<double>> Frames; // rest frame per tetrahedron
   std::vector<unsigned char> Degenerate;  // 1 per tetrahedron without volume
+  std::vector<int> Neighbours;            // 4 per tetrahedron: across the face opposite each node, or -1
   vtkIdType NumberOfDegenerate = 0;
   vtkIdType FirstDegenerate = -1;
   std::vector<int> Cells;
   std::vector<ClampedPoint> Clamped;
   vtkIdType NumberOfOutsideBound = 0;
-
-  // Per update: each tetrahedron's map.
-  std::vector<ffd::TetrahedronMap<double>> Maps;
 };
 
 #endif

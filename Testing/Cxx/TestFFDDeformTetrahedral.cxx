@@ -5,6 +5,7 @@
 // for the hull, against VTK's vtkDelaunay3D as a peer.
 #include "FFDTestErrorObserver.h"
 #include "FFDTestMeshes.h"
+#include "FFDTestTetrahedra.h"
 
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDBuildTetrahedralLattice.h"
@@ -104,57 +105,12 @@ Vec ReferenceDeform(vtkUnstructuredGrid* lattice, vtkIdType cell, const Vec& x)
   return ffdref::DeformInTetrahedron(rest, moved, x);
 }
 
-/// The Kuhn triangulation of the box [lo, hi]^3 split into n^3 cubes: six tetrahedra around each cube's main
-/// diagonal, conforming across cubes; the interior nodes jittered by up to `jitter` of a cube (so that the
-/// tetrahedra are irregular), every third tetrahedron inverted (two nodes swapped) when `invertSome`.
+/// The Kuhn triangulation of the box [lo, hi]^3 (FFDTestTetrahedra.h).
 vtkSmartPointer<vtkUnstructuredGrid> BoxLattice(
   int n, double lo, double hi, double jitter, bool invertSome, unsigned seed = 1)
 {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  const double h = (hi - lo) / n;
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  auto id = [n](int i, int j, int k) { return vtkIdType(i + (n + 1) * (j + (n + 1) * k)); };
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i)
-      {
-        const bool interior = i > 0 && i < n && j > 0 && j < n && k > 0 && k < n;
-        const double e = interior ? jitter * h : 0.0;
-        points->InsertNextPoint(lo + i * h + e * unit(rng), lo + j * h + e * unit(rng), lo + k * h + e * unit(rng));
-      }
-  vtkNew<vtkCellArray> cells;
-  const int perms[6][3] = { { 0, 1, 2 }, { 0, 2, 1 }, { 1, 0, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 2, 1, 0 } };
-  vtkIdType count = 0;
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        for (const auto& p : perms)
-        {
-          int c[3] = { i, j, k };
-          vtkIdType t[4];
-          t[0] = id(c[0], c[1], c[2]);
-          for (int s = 0; s < 3; ++s)
-          {
-            ++c[p[s]];
-            t[s + 1] = id(c[0], c[1], c[2]);
-          }
-          if (invertSome && count % 3 == 0)
-          {
-            std::swap(t[1], t[2]);
-          }
-          cells->InsertNextCell(4, t);
-          ++count;
-        }
-  vtkNew<vtkUnstructuredGrid> lattice;
-  lattice->SetPoints(points);
-  lattice->SetCells(VTK_TETRA, cells);
-  vtkNew<vtkDoubleArray> rest;
-  rest->DeepCopy(points->GetData());
-  rest->SetName(vtkFFDDataContract::RestPositionArrayName());
-  lattice->GetPointData()->AddArray(rest);
-  return lattice;
+  const double bounds[6] = { lo, hi, lo, hi, lo, hi };
+  return ffdtest::KuhnBoxLattice(n, bounds, jitter, invertSome, seed);
 }
 
 /// Moves every node of the lattice by a random displacement of up to `amplitude` per coordinate.
