@@ -197,6 +197,49 @@ TEST(vtkFFDDeformTetrahedral, MatchesTheReferenceInsideAndKeepsPointsOutside)
   }
 }
 
+// A non-convex lattice (a U: the box without the upper middle column of cells), where walks from a seed in
+// one arm leave the mesh before reaching a point in the other: VTK's locator places those points.
+TEST(vtkFFDDeformTetrahedral, NonConvexLatticesAreLocatedWhereWalksLeaveThem)
+{
+  auto box = BoxLattice(3, 0.0, 3.0, 0.1, false, 71);
+  vtkNew<vtkUnstructuredGrid> lattice;
+  lattice->SetPoints(box->GetPoints());
+  lattice->GetPointData()->ShallowCopy(box->GetPointData());
+  vtkNew<vtkCellArray> cells;
+  for (vtkIdType c = 0; c < box->GetNumberOfCells(); ++c)
+  {
+    const vtkIdType cube = c / 6; // i + 3 (j + 3 k)
+    if (cube % 3 == 1 && cube / 9 >= 1)
+    {
+      continue;
+    }
+    vtkNew<vtkIdList> ids;
+    box->GetCellPoints(c, ids);
+    cells->InsertNextCell(ids);
+  }
+  lattice->SetCells(VTK_TETRA, cells);
+  DisplaceNodes(lattice, 0.2, 73);
+  auto mesh = RandomPoints(3000, 0.0, 3.0, VTK_DOUBLE, 79);
+  auto output = Deform(mesh, lattice);
+  int inside = 0, outside = 0;
+  for (vtkIdType i = 0; i < mesh->GetNumberOfPoints(); ++i)
+  {
+    const Vec x = Point(mesh->GetPoints(), i);
+    const Vec y = Point(output->GetPoints(), i);
+    const vtkIdType cell = ReferenceTetrahedron(lattice, x);
+    if (cell < 0)
+    {
+      EXPECT_EQ(y, x) << "outside point " << i;
+      ++outside;
+      continue;
+    }
+    ++inside;
+    EXPECT_LT(Distance(y, ReferenceDeform(lattice, cell, x)), 1e-12) << "point " << i;
+  }
+  EXPECT_GT(inside, 1000);
+  EXPECT_GT(outside, 500);
+}
+
 // The rest lattice built around a real mesh leaves it exactly as it is; an affine motion of every node moves
 // it by that motion, normals by its cofactor and det J is its determinant.
 TEST(vtkFFDDeformTetrahedral, RestIsTheIdentityAndAffineMotionsAreReproducedOnARealMesh)
