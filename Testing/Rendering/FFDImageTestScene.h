@@ -92,7 +92,7 @@ inline bool BuildTestLattice(
 }
 
 /// `mesh` deformed by `lattice`, with a `Displacement` point array: the distance each point moved.
-inline vtkSmartPointer<vtkPolyData> DeformWithDisplacement(vtkPolyData* mesh, vtkStructuredGrid* lattice)
+inline vtkSmartPointer<vtkPolyData> DeformWithDisplacement(vtkPolyData* mesh, vtkPointSet* lattice)
 {
   vtkNew<vtkFFDDeform> deform;
   deform->SetInputData(mesh);
@@ -137,7 +137,7 @@ inline vtkIdType CountMovedPoints(vtkPolyData* deformed, double tolerance)
  * with small spheres (`pointRadius` in world units, 0 for vtkFFDLatticeActor's automatic size) and thin,
  * light edges, so that the mesh stays visible through it. Returns the lattice's actor, for more settings.
  */
-inline vtkFFDLatticeActor* AddDeformedScene(vtkRenderer* renderer, vtkPolyData* deformed, vtkStructuredGrid* lattice,
+inline vtkFFDLatticeActor* AddDeformedScene(vtkRenderer* renderer, vtkPolyData* deformed, vtkPointSet* lattice,
   double maxDisplacement, double pointRadius = 0.0)
 {
   vtkNew<vtkLookupTable> colours;
