@@ -119,7 +119,7 @@ def deform_lattice(lattice):
     lattice.GetPoints().Modified()  # numpy wrote behind VTK's back: tell the pipeline
 
 
-def render(output_path, size, mesh, lattice, camera_bounds):
+def render(output_path, size, mesh, lattice, camera_bounds, point_radius=None):
     mesh_mapper = vtkPolyDataMapper()
     mesh_mapper.SetInputData(mesh)
     mesh_actor = vtkActor()
@@ -130,6 +130,9 @@ def render(output_path, size, mesh, lattice, camera_bounds):
 
     lattice_actor = vtkffd.vtkFFDLatticeActor()  # red control points, dark grey edges
     lattice_actor.SetInputData(lattice)
+    if point_radius:  # else a fraction of the lattice's diagonal, too large for a dense control mesh
+        lattice_actor.SetPointRadius(point_radius)
+        lattice_actor.GetEdgeProperty().SetLineWidth(1.0)
 
     renderer = vtkRenderer()
     renderer.AddActor(mesh_actor)
