@@ -601,7 +601,7 @@ bool vtkFFDTetrahedralDeformation::Evaluate(vtkPoints* points, vtkDataArray* nor
   auto evaluate = [&](auto realTag) {
     using Real = decltype(realTag);
     using RealArray = vtkAOSDataArrayTemplate<Real>;
-    std::vector<ffd::TetrahedronMap<Real>> maps;
+    std::vector<ffd::TetrahedronMap<Real>>& maps = this->MapsIn(Real());
     this->ComputeMaps(maps);
     Real* out = static_cast<RealArray*>(outPoints)->GetPointer(0);
     Real* det = outDeterminants ? static_cast<RealArray*>(outDeterminants)->GetPointer(0) : nullptr;

@@ -152,6 +152,13 @@ private:
   std::vector<int> Cells;
   std::vector<ClampedPoint> Clamped;
   vtkIdType NumberOfOutsideBound = 0;
+
+  // Every tetrahedron's map, in the precision of the last evaluation: kept, so that an update neither allocates
+  // nor page-faults them again (8.5 MB for 71 k tetrahedra in double).
+  std::vector<ffd::TetrahedronMap<float>> MapsFloat;
+  std::vector<ffd::TetrahedronMap<double>> MapsDouble;
+  std::vector<ffd::TetrahedronMap<float>>& MapsIn(float) { return this->MapsFloat; }
+  std::vector<ffd::TetrahedronMap<double>>& MapsIn(double) { return this->MapsDouble; }
 };
 
 #endif

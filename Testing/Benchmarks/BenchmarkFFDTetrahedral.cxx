@@ -235,7 +235,7 @@ int main(int argc, char* argv[])
       surface->SetInputData(lattice.Grid);
       surface->Update();
       vtkPolyData* control = surface->GetOutput();
-      if (control->GetNumberOfCells() > 1500)
+      if (control->GetNumberOfCells() > 3000)
       {
         continue;
       }
