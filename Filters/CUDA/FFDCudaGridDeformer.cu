@@ -1,14 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "FFDCudaGridDeformer.h"
 
+#include "FFDCudaDevice.cuh"
 #include "FFDGridDeformation.h"
 
-#include <cuda_runtime.h>
-
 #include <algorithm>
-#include <cstring>
 #include <type_traits>
-#include <vector>
 
 namespace ffd
 {
@@ -29,16 +26,10 @@ namespace cuda
 {
 namespace
 {
-constexpr int ThreadsPerBlock = 256;
-// Size of each of the two pinned buffers that stage a download: large enough to run the bus at full speed,
-// small enough that the host copy of one chunk overlaps the transfer of the next (8 MB chunks made an update
-// of 1 M points 1.4-1.6 times the bare download, the host copy of the first chunk waiting alone).
-constexpr std::size_t StagingBytes = std::size_t(2) << 20;
-
-unsigned BlocksFor(std::int64_t n)
-{
-  return unsigned((n + ThreadsPerBlock - 1) / ThreadsPerBlock);
-}
+using detail::BlocksFor;
+using detail::Check;
+using detail::CudaError;
+using detail::ThreadsPerBlock;
 
 // The binding's flat cell index ci + cx (cj + cy ck) taken apart with multiplications instead of the integer
 // divisions of GridDeformation::CellIndices() (some 30 instructions a point less; same indices). n / d is
@@ -81,57 +72,18 @@ struct CellSplit
   }
 };
 
-// A CUDA failure, turned into a message by Check().
-struct CudaError
+// A grid's deformation on a float4 lattice whose cells are split by CellSplit, for DeformPointsKernel.
+template <typename Deformer>
+struct SplitCellDeformation
 {
-  cudaError_t Code;
-  const char* What;
-};
+  Deformer Deformation;
+  CellSplit Split;
 
-void Check(cudaError_t code, const char* what)
-{
-  if (code != cudaSuccess)
+  __device__ __forceinline__ ffd::Vec3<float> Deform(const ffd::Vec3<float>& x, int cell) const
   {
-    throw CudaError{ code, what };
-  }
-}
-
-// Device memory (cudaMalloc), or pinned host memory (cudaMallocHost) for the staging of transfers.
-struct Buffer
-{
-  const bool Pinned;
-  void* Data = nullptr;
-  std::size_t Bytes = 0;
-
-  explicit Buffer(bool pinned = false)
-    : Pinned(pinned)
-  {
-  }
-  ~Buffer() { this->Free(); }
-
-  void Reserve(std::size_t bytes, const char* what)
-  {
-    if (bytes <= this->Bytes)
-    {
-      return;
-    }
-    this->Free();
-    Check(this->Pinned ? cudaMallocHost(&this->Data, bytes) : cudaMalloc(&this->Data, bytes), what);
-    this->Bytes = bytes;
-  }
-  void Free()
-  {
-    if (this->Data)
-    {
-      this->Pinned ? cudaFreeHost(this->Data) : cudaFree(this->Data);
-    }
-    this->Data = nullptr;
-    this->Bytes = 0;
-  }
-  template <typename T>
-  T* As() const
-  {
-    return static_cast<T*>(this->Data);
+    int c[3];
+    this->Split.Apply(cell, c);
+    return this->Deformation.DeformInCell(x, c);
   }
 };
 
@@ -149,107 +101,6 @@ __global__ void BindKernel(const Real* points, std::int64_t count, ffd::Frame<do
   const Real* p = points + 3 * i;
   cells[i] = ffd::BindToGrid(frame, basis, voxels, ffd::Vec3<double>{ double(p[0]), double(p[1]), double(p[2]) },
     clampOutside);
-}
-
-// With the Jacobian (normals, determinants) one point a thread; without, four points a thread, ThreadsPerBlock
-// apart (consecutive threads, consecutive points), so that their independent lattice gathers overlap, and an
-// instantiation that needs fewer registers. Launch bounds keep at least 4 (6) blocks of 256 threads on a
-// multiprocessor: the gathers are dependent loads, and more threads in flight hide their latency. Trilinear on
-// an H200: 58-62 % of the copy roofline with one point a thread, 64-70 % with four. (Staging the points through
-// shared memory was slower.) For float32 trilinear without the Jacobian DeformPointsKernel is faster; for the
-// local bases of 3 or 4 control points per axis its layout, the float4 lattice or CellSplit here were up to
-// 20 % slower on an H200 (BENCHMARKS.md), so they stay on this kernel.
-template <typename Deformer, typename Real, bool WithJacobian>
-__global__ void __launch_bounds__(ThreadsPerBlock, WithJacobian ? 4 : 6) DeformKernel(const Real* __restrict__ points,
-  const int* __restrict__ cells, std::int64_t count, Deformer deformation,
-  Real* __restrict__ outPoints, const float* __restrict__ normals, float* __restrict__ outNormals,
-  Real* __restrict__ determinants)
-{
-  constexpr int PointsPerThread = WithJacobian ? 1 : 4;
-  FFD_UNROLL
-  for (int r = 0; r < PointsPerThread; ++r)
-  {
-    const std::int64_t i =
-      blockIdx.x * std::int64_t(PointsPerThread * ThreadsPerBlock) + r * ThreadsPerBlock + threadIdx.x;
-    if (i >= count)
-    {
-      return;
-    }
-    const Real* p = points + 3 * i;
-    const ffd::Vec3<Real> x = { p[0], p[1], p[2] };
-    const int cell = cells[i];
-    ffd::Vec3<Real> y = x;
-    ffd::Mat3<Real> jacobian = ffd::Mat3<Real>::Identity();
-    if (cell >= 0)
-    {
-      y = WithJacobian ? deformation.Deform(x, cell, jacobian) : deformation.Deform(x, cell);
-    }
-    Real* out = outPoints + 3 * i;
-    out[0] = y.x;
-    out[1] = y.y;
-    out[2] = y.z;
-    if (!WithJacobian)
-    {
-      continue;
-    }
-    if (outNormals)
-    {
-      const ffd::Vec3<Real> n = ffd::TransformNormal(jacobian, ffd::Vec3<Real>::From(normals + 3 * i));
-      outNormals[3 * i] = float(n.x);
-      outNormals[3 * i + 1] = float(n.y);
-      outNormals[3 * i + 2] = float(n.z);
-    }
-    if (determinants)
-    {
-      determinants[i] = ffd::Determinant(jacobian);
-    }
-  }
-}
-
-// Float32 points without the Jacobian (the common update): each thread deforms four consecutive points, read as
-// three 16-byte words (and their cells as one) with streaming hints (they are touched once) and written alike; the
-// lattice is float4 (LatticeValues<float4>) and the cell is split by multiplications (CellSplit). Launch bounds
-// allow 64 registers: all four points' loads are issued before the first lattice gather. Trilinear on an H200,
-// 16 M points: 0.158-0.161 ms with DeformKernel, 0.135-0.139 ms so (BENCHMARKS.md says what each part gave).
-template <typename Deformer>
-__global__ void __launch_bounds__(ThreadsPerBlock, 4) DeformPointsKernel(const float* __restrict__ points,
-  const int* __restrict__ cells, std::int64_t count, Deformer deformation, CellSplit split,
-  float* __restrict__ outPoints)
-{
-  auto deform = [&](ffd::Vec3<float>& x, int cell) {
-    if (cell >= 0)
-    {
-      int c[3];
-      split.Apply(cell, c);
-      x = deformation.DeformInCell(x, c);
-    }
-  };
-  const std::int64_t group = blockIdx.x * std::int64_t(ThreadsPerBlock) + threadIdx.x;
-  const std::int64_t first = 4 * group;
-  if (first + 4 <= count)
-  {
-    const float4* in = reinterpret_cast<const float4*>(points) + 3 * group;
-    const float4 a = __ldcs(in), b = __ldcs(in + 1), c = __ldcs(in + 2);
-    const int4 cell = __ldcs(reinterpret_cast<const int4*>(cells) + group);
-    ffd::Vec3<float> x[4] = { { a.x, a.y, a.z }, { a.w, b.x, b.y }, { b.z, b.w, c.x }, { c.y, c.z, c.w } };
-    deform(x[0], cell.x);
-    deform(x[1], cell.y);
-    deform(x[2], cell.z);
-    deform(x[3], cell.w);
-    float4* out = reinterpret_cast<float4*>(outPoints) + 3 * group;
-    __stcs(out, make_float4(x[0].x, x[0].y, x[0].z, x[1].x));
-    __stcs(out + 1, make_float4(x[1].y, x[1].z, x[2].x, x[2].y));
-    __stcs(out + 2, make_float4(x[2].z, x[3].x, x[3].y, x[3].z));
-    return;
-  }
-  for (std::int64_t i = first; i < count; ++i) // the last one to three points
-  {
-    ffd::Vec3<float> x = { points[3 * i], points[3 * i + 1], points[3 * i + 2] };
-    deform(x, cells[i]);
-    outPoints[3 * i] = x.x;
-    outPoints[3 * i + 1] = x.y;
-    outPoints[3 * i + 2] = x.z;
-  }
 }
 
 // The global basis without Jacobian on small lattices (under 400 control points; BernsteinTensorKernel takes the
@@ -603,119 +454,11 @@ __global__ void __launch_bounds__(32 * TensorWarps, 2) BernsteinTensorKernel(con
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
-bool DeviceAvailable(std::string* why)
+struct GridDeformer::Impl : ResidentPoints::State
 {
-  int count = 0;
-  const cudaError_t code = cudaGetDeviceCount(&count);
-  if (code != cudaSuccess || count == 0)
-  {
-    if (why)
-    {
-      *why = code != cudaSuccess ? std::string("no CUDA device: ") + cudaGetErrorString(code)
-                                 : std::string("no CUDA device");
-    }
-    cudaGetLastError(); // clear the sticky error of a failed query
-    return false;
-  }
-  return true;
-}
-
-//------------------------------------------------------------------------------------------------------------
-struct GridDeformer::Impl
-{
-  std::int64_t Count = 0;
-  bool IsDouble = false;
-  bool HasNormals = false;
-  bool Bound = false;
-  bool Evaluated = false, EvaluatedNormals = false, EvaluatedDeterminants = false;
   ffd::GridBasis Basis = ffd::GridBasis::Bernstein;
   int Divisions[3] = { 0, 0, 0 };
   double Frame[12] = {};
-  Buffer Points, Normals, Cells, Displacements, OutPoints, OutNormals, OutDeterminants;
-  Buffer Staging[2] = { Buffer(true), Buffer(true) };
-  Buffer LatticeStaging{ true };
-  cudaStream_t Stream = nullptr;
-  cudaEvent_t ChunkDone[2] = { nullptr, nullptr };
-  cudaEvent_t KernelStart = nullptr, KernelStop = nullptr; // to time the evaluation kernel
-  int Multiprocessors = 0;                                   // of the current device, for persistent grids
-  std::string LastError;
-  Counters Counts;
-
-  void EnsureStream()
-  {
-    if (!this->Stream)
-    {
-      int device = 0;
-      Check(cudaGetDevice(&device), "querying the device");
-      Check(cudaDeviceGetAttribute(&this->Multiprocessors, cudaDevAttrMultiProcessorCount, device),
-        "querying the device");
-      Check(cudaStreamCreateWithFlags(&this->Stream, cudaStreamNonBlocking), "creating a stream");
-      Check(cudaEventCreateWithFlags(&this->ChunkDone[0], cudaEventDisableTiming), "creating an event");
-      Check(cudaEventCreateWithFlags(&this->ChunkDone[1], cudaEventDisableTiming), "creating an event");
-      Check(cudaEventCreate(&this->KernelStart), "creating an event");
-      Check(cudaEventCreate(&this->KernelStop), "creating an event");
-    }
-  }
-
-  void Release()
-  {
-    for (Buffer* b : { &this->Points, &this->Normals, &this->Cells, &this->Displacements, &this->OutPoints,
-           &this->OutNormals, &this->OutDeterminants })
-    {
-      b->Free();
-    }
-    this->Staging[0].Free();
-    this->Staging[1].Free();
-    this->LatticeStaging.Free();
-    for (cudaEvent_t* e : { &this->ChunkDone[0], &this->ChunkDone[1], &this->KernelStart, &this->KernelStop })
-    {
-      if (*e)
-      {
-        cudaEventDestroy(*e);
-      }
-      *e = nullptr;
-    }
-    if (this->Stream)
-    {
-      cudaStreamDestroy(this->Stream);
-    }
-    this->Stream = nullptr;
-    this->Count = 0;
-    this->HasNormals = false;
-    this->Bound = false;
-    this->Evaluated = false;
-  }
-
-  // Runs `step`, turning a CUDA failure into false, a message and no device state.
-  template <typename Step>
-  bool Guard(Step&& step)
-  {
-    try
-    {
-      step();
-      return true;
-    }
-    catch (const CudaError& e)
-    {
-      this->LastError = std::string("CUDA failed while ") + e.What + ": " + cudaGetErrorString(e.Code);
-      cudaGetLastError(); // clear a non-sticky error so that later calls start clean
-      this->Release();
-      return false;
-    }
-  }
-
-  template <typename Real>
-  void Upload(const Real* xyz, std::int64_t count)
-  {
-    this->Release();
-    this->EnsureStream();
-    const std::size_t bytes = std::size_t(count) * 3 * sizeof(Real);
-    this->Points.Reserve(bytes, "allocating the points");
-    Check(cudaMemcpy(this->Points.Data, xyz, bytes, cudaMemcpyHostToDevice), "uploading the points");
-    this->Count = count;
-    this->IsDouble = sizeof(Real) == sizeof(double);
-    ++this->Counts.PointUploads;
-  }
 
   template <typename Real>
   void RunBind(const ffd::Frame<double>& frame, bool clampOutside)
@@ -727,43 +470,10 @@ struct GridDeformer::Impl
     Check(cudaStreamSynchronize(this->Stream), "binding the points");
   }
 
-  // Copies `bytes` from the device to pageable host memory through the two pinned buffers, so that the host
-  // copy of one chunk overlaps the transfer of the next.
-  void Download(const void* device, void* host, std::size_t bytes)
-  {
-    const std::size_t chunks = (bytes + StagingBytes - 1) / StagingBytes;
-    for (std::size_t c = 0; c <= chunks; ++c)
-    {
-      if (c < chunks)
-      {
-        const std::size_t offset = c * StagingBytes, size = std::min(StagingBytes, bytes - offset);
-        Check(cudaMemcpyAsync(this->Staging[c % 2].Data, static_cast<const char*>(device) + offset, size,
-                cudaMemcpyDeviceToHost, this->Stream),
-          "downloading");
-        Check(cudaEventRecord(this->ChunkDone[c % 2], this->Stream), "recording an event");
-      }
-      if (c > 0)
-      {
-        const std::size_t previous = c - 1, offset = previous * StagingBytes;
-        const std::size_t size = std::min(StagingBytes, bytes - offset);
-        Check(cudaEventSynchronize(this->ChunkDone[previous % 2]), "downloading");
-        std::memcpy(static_cast<char*>(host) + offset, this->Staging[previous % 2].Data, size);
-      }
-    }
-    this->Counts.BytesDownloaded += bytes;
-  }
-
   template <typename Real>
   void RunEvaluate(const double* displacements, std::int64_t controlPoints, bool withNormals, bool withDeterminants)
   {
-    if (!this->Bound || (this->IsDouble != (sizeof(Real) == sizeof(double))))
-    {
-      throw CudaError{ cudaErrorInvalidValue, "evaluating: no points bound in this precision" };
-    }
-    if (withNormals && !this->HasNormals)
-    {
-      throw CudaError{ cudaErrorInvalidValue, "evaluating: normals asked for but none uploaded" };
-    }
+    this->RequireBound<Real>(withNormals);
     const int dims[3] = { ffd::ControlPointsAlongAxis(this->Basis, this->Divisions[0]),
       ffd::ControlPointsAlongAxis(this->Basis, this->Divisions[1]),
       ffd::ControlPointsAlongAxis(this->Basis, this->Divisions[2]) };
@@ -779,8 +489,7 @@ struct GridDeformer::Impl
       (this->Basis == ffd::GridBasis::Trilinear || this->Basis == ffd::GridBasis::Bernstein);
     const int stride = asFloat4 ? 4 : 3;
     const std::size_t latticeBytes = std::size_t(controlPoints) * stride * sizeof(Real);
-    this->LatticeStaging.Reserve(latticeBytes, "allocating the lattice's staging buffer");
-    Real* staged = static_cast<Real*>(this->LatticeStaging.Data);
+    Real* staged = static_cast<Real*>(this->StageLattice(latticeBytes));
     for (std::int64_t v = 0; v < controlPoints; ++v)
     {
       for (int c = 0; c < 3; ++c)
@@ -792,48 +501,27 @@ struct GridDeformer::Impl
         staged[stride * v + 3] = Real(0);
       }
     }
-    this->Displacements.Reserve(latticeBytes, "allocating the lattice");
-    Check(cudaMemcpyAsync(this->Displacements.Data, staged, latticeBytes, cudaMemcpyHostToDevice, this->Stream),
-      "uploading the lattice");
-    ++this->Counts.LatticeUploads;
-    this->Counts.LatticeBytes += latticeBytes;
+    this->UploadLattice(latticeBytes);
 
-    this->OutPoints.Reserve(std::size_t(this->Count) * 3 * sizeof(Real), "allocating the deformed points");
-    if (withNormals)
-    {
-      this->OutNormals.Reserve(std::size_t(this->Count) * 3 * sizeof(float), "allocating the normals");
-    }
-    if (withDeterminants)
-    {
-      this->OutDeterminants.Reserve(std::size_t(this->Count) * sizeof(Real), "allocating the determinants");
-    }
+    this->BeginEvaluation<Real>(withNormals, withDeterminants);
     float* normalsOut = withNormals ? this->OutNormals.As<float>() : nullptr;
     Real* determinantsOut = withDeterminants ? this->OutDeterminants.As<Real>() : nullptr;
-    Check(cudaEventRecord(this->KernelStart, this->Stream), "recording an event");
     if constexpr (std::is_same<Real, float>::value)
     {
       if (asFloat4)
       {
-        this->LaunchFloat4(this->Displacements.As<float4>(), dims);
+        this->LaunchFloat4(this->Lattice.As<float4>(), dims);
       }
       else
       {
-        this->LaunchGeneric<float>(this->Displacements.As<float>(), dims, normalsOut, determinantsOut);
+        this->LaunchGeneric<float>(this->Lattice.As<float>(), dims, normalsOut, determinantsOut);
       }
     }
     else
     {
-      this->LaunchGeneric<Real>(this->Displacements.As<Real>(), dims, normalsOut, determinantsOut);
+      this->LaunchGeneric<Real>(this->Lattice.As<Real>(), dims, normalsOut, determinantsOut);
     }
-    Check(cudaGetLastError(), "launching the evaluation");
-    Check(cudaEventRecord(this->KernelStop, this->Stream), "recording an event");
-    Check(cudaStreamSynchronize(this->Stream), "evaluating");
-    Check(cudaEventElapsedTime(&this->Counts.LastKernelMilliseconds, this->KernelStart, this->KernelStop),
-      "timing the evaluation");
-    this->Evaluated = true;
-    this->EvaluatedNormals = withNormals;
-    this->EvaluatedDeterminants = withDeterminants;
-    ++this->Counts.Evaluations;
+    this->FinishEvaluation(withNormals, withDeterminants, false);
   }
 
   // Calls launch(maxCount, basis) with the basis as a compile-time constant (one kernel per basis, see
@@ -875,18 +563,8 @@ struct GridDeformer::Impl
       using Deformer = ffd::GridDeformation<decltype(maxCount)::value, Real, decltype(basis)::value>;
       const Deformer deformation{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
         { dims[0], dims[1], dims[2] }, d, frame };
-      if (normalsOut || determinantsOut)
-      {
-        DeformKernel<Deformer, Real, true><<<BlocksFor(this->Count), ThreadsPerBlock, 0, this->Stream>>>(
-          this->Points.As<Real>(), this->Cells.As<int>(), this->Count, deformation, this->OutPoints.As<Real>(),
-          this->Normals.As<float>(), normalsOut, determinantsOut);
-      }
-      else
-      {
-        DeformKernel<Deformer, Real, false><<<BlocksFor((this->Count + 3) / 4), ThreadsPerBlock, 0, this->Stream>>>(
-          this->Points.As<Real>(), this->Cells.As<int>(), this->Count, deformation, this->OutPoints.As<Real>(),
-          nullptr, nullptr, nullptr);
-      }
+      detail::LaunchDeform(deformation, this->Points.As<Real>(), this->Cells.As<int>(), this->Count,
+        this->OutPoints.As<Real>(), this->Normals.As<float>(), normalsOut, determinantsOut, this->Stream);
     });
   }
 
@@ -898,10 +576,10 @@ struct GridDeformer::Impl
     const CellSplit split = CellSplit::For(this->Basis, this->Divisions);
     auto launch = [&](auto maxCount, auto basis) {
       using Deformer = ffd::GridDeformation<decltype(maxCount)::value, float4, decltype(basis)::value, float>;
-      const Deformer deformation{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
+      const Deformer grid{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
         { dims[0], dims[1], dims[2] }, d, frame };
-      DeformPointsKernel<Deformer><<<BlocksFor((this->Count + 3) / 4), ThreadsPerBlock, 0, this->Stream>>>(
-        this->Points.As<float>(), this->Cells.As<int>(), this->Count, deformation, split, this->OutPoints.As<float>());
+      detail::LaunchDeformPoints(SplitCellDeformation<Deformer>{ grid, split }, this->Points.As<float>(),
+        this->Cells.As<int>(), this->Count, this->OutPoints.As<float>(), this->Stream);
     };
     if (this->Basis == ffd::GridBasis::Trilinear)
     {
@@ -1001,64 +679,18 @@ struct GridDeformer::Impl
     return true;
   }
 
-  template <typename Real>
-  void RunDownload(Real* outPoints, float* outNormals, Real* outDeterminants)
-  {
-    if (!this->Evaluated || (this->IsDouble != (sizeof(Real) == sizeof(double))) ||
-      (outNormals && !this->EvaluatedNormals) || (outDeterminants && !this->EvaluatedDeterminants))
-    {
-      throw CudaError{ cudaErrorInvalidValue, "downloading: nothing of that was evaluated" };
-    }
-    this->Staging[0].Reserve(StagingBytes, "allocating the staging buffers");
-    this->Staging[1].Reserve(StagingBytes, "allocating the staging buffers");
-    this->Download(this->OutPoints.Data, outPoints, std::size_t(this->Count) * 3 * sizeof(Real));
-    if (outNormals)
-    {
-      this->Download(this->OutNormals.Data, outNormals, std::size_t(this->Count) * 3 * sizeof(float));
-    }
-    if (outDeterminants)
-    {
-      this->Download(this->OutDeterminants.Data, outDeterminants, std::size_t(this->Count) * sizeof(Real));
-    }
-  }
 };
 
 //------------------------------------------------------------------------------------------------------------
 GridDeformer::GridDeformer()
-  : P(new Impl)
+  : ResidentPoints(std::unique_ptr<State>(new Impl))
 {
-}
-
-GridDeformer::~GridDeformer()
-{
-  this->P->Release();
-}
-
-bool GridDeformer::SetPoints(const float* xyz, std::int64_t count)
-{
-  return this->P->Guard([&] { this->P->Upload(xyz, count); });
-}
-
-bool GridDeformer::SetPoints(const double* xyz, std::int64_t count)
-{
-  return this->P->Guard([&] { this->P->Upload(xyz, count); });
-}
-
-bool GridDeformer::SetNormals(const float* normals)
-{
-  return this->P->Guard([&] {
-    const std::size_t bytes = std::size_t(this->P->Count) * 3 * sizeof(float);
-    this->P->Normals.Reserve(bytes, "allocating the normals");
-    Check(cudaMemcpy(this->P->Normals.Data, normals, bytes, cudaMemcpyHostToDevice), "uploading the normals");
-    this->P->HasNormals = true;
-    ++this->P->Counts.NormalUploads;
-  });
 }
 
 bool GridDeformer::Bind(const double frame[12], int basis, const int divisions[3], bool clampOutside)
 {
-  return this->P->Guard([&] {
-    Impl& p = *this->P;
+  Impl& p = static_cast<Impl&>(*this->S);
+  return p.Guard([&] {
     if (p.Count == 0 || !ffd::IsGridBasis(basis))
     {
       throw CudaError{ cudaErrorInvalidValue, "binding: no points, or an unknown basis" };
@@ -1085,41 +717,17 @@ bool GridDeformer::Bind(const double frame[12], int basis, const int divisions[3
 bool GridDeformer::Evaluate(const double* displacements, std::int64_t controlPoints, bool withNormals,
   bool withDeterminants)
 {
-  return this->P->Guard([&] {
-    if (this->P->IsDouble)
+  Impl& p = static_cast<Impl&>(*this->S);
+  return p.Guard([&] {
+    if (p.IsDouble)
     {
-      this->P->RunEvaluate<double>(displacements, controlPoints, withNormals, withDeterminants);
+      p.RunEvaluate<double>(displacements, controlPoints, withNormals, withDeterminants);
     }
     else
     {
-      this->P->RunEvaluate<float>(displacements, controlPoints, withNormals, withDeterminants);
+      p.RunEvaluate<float>(displacements, controlPoints, withNormals, withDeterminants);
     }
   });
-}
-
-bool GridDeformer::Download(float* outPoints, float* outNormals, float* outDeterminants)
-{
-  return this->P->Guard([&] { this->P->RunDownload(outPoints, outNormals, outDeterminants); });
-}
-
-bool GridDeformer::Download(double* outPoints, float* outNormals, double* outDeterminants)
-{
-  return this->P->Guard([&] { this->P->RunDownload(outPoints, outNormals, outDeterminants); });
-}
-
-void GridDeformer::Release()
-{
-  this->P->Release();
-}
-
-const std::string& GridDeformer::GetLastError() const
-{
-  return this->P->LastError;
-}
-
-const Counters& GridDeformer::GetCounters() const
-{
-  return this->P->Counts;
 }
 
 } // namespace cuda
