@@ -8,6 +8,8 @@
 
 #ifdef VOXELFFD_HAS_CUDA
 #include "FFDCudaGridDeformer.h"
+#include "FFDCudaTetrahedralDeformer.h"
+#include "vtkFFDTetrahedralDeformation.h"
 #endif
 
 #include <algorithm>
@@ -52,67 +54,152 @@ const T* Contiguous(vtkDataArray* array, std::vector<T>& copy)
   std::copy(values.begin(), values.end(), copy.begin());
   return copy.data();
 }
+
+// The normals a device holds: which array, at which modification time.
+struct NormalsOnDevice
+{
+  const vtkDataArray* Array = nullptr;
+  vtkMTimeType MTime = 0;
+};
+
+// The steps both lattices share, in the evaluation's precision Real: the input's points uploaded when
+// `uploadPoints` (which drops the device's binding and normals), bind() when `rebind`, the normals uploaded when
+// they changed, evaluate(withNormals, withDeterminants), the download into the output arrays. False on any
+// failure, after which the device holds nothing.
+template <typename Real, typename Bind, typename Evaluate>
+bool Run(ffd::cuda::ResidentPoints& device, NormalsOnDevice& normalsOnDevice, bool uploadPoints, bool rebind,
+  vtkPoints* points, vtkDataArray* normals, vtkAOSDataArrayTemplate<Real>* outPoints, vtkDataArray* outNormals,
+  vtkAOSDataArrayTemplate<Real>* outDeterminants, Bind&& bind, Evaluate&& evaluate)
+{
+  if (uploadPoints)
+  {
+    normalsOnDevice = NormalsOnDevice();
+    std::vector<Real> copy;
+    if (!device.SetPoints(Contiguous(points->GetData(), copy), points->GetNumberOfPoints()))
+    {
+      return false;
+    }
+  }
+  if (rebind && !bind())
+  {
+    return false;
+  }
+  if (outNormals && (normals != normalsOnDevice.Array || normals->GetMTime() != normalsOnDevice.MTime))
+  {
+    normalsOnDevice = NormalsOnDevice();
+    std::vector<float> copy;
+    if (!device.SetNormals(Contiguous(normals, copy)))
+    {
+      return false;
+    }
+    normalsOnDevice = { normals, normals->GetMTime() };
+  }
+  std::vector<float> normalsCopy;
+  auto* floatNormals = outNormals ? vtkAOSDataArrayTemplate<float>::FastDownCast(outNormals) : nullptr;
+  if (outNormals && !floatNormals)
+  {
+    normalsCopy.resize(3 * static_cast<size_t>(points->GetNumberOfPoints()));
+  }
+  float* normalsTarget = floatNormals ? floatNormals->GetPointer(0) : (outNormals ? normalsCopy.data() : nullptr);
+  if (!evaluate(outNormals != nullptr, outDeterminants != nullptr) ||
+    !device.Download(outPoints->GetPointer(0), normalsTarget,
+      outDeterminants ? outDeterminants->GetPointer(0) : nullptr))
+  {
+    return false;
+  }
+  if (outNormals && !floatNormals)
+  {
+    auto values = vtk::DataArrayValueRange<3>(outNormals);
+    std::copy(normalsCopy.begin(), normalsCopy.end(), values.begin());
+  }
+  return true;
+}
 } // namespace
 
 struct vtkFFDCudaBackend::vtkState
 {
-  ffd::cuda::GridDeformer Device;
-  vtkFFDBindingKey Key;            // what the device's points and binding are for
-  int PointsType = 0;              // VTK_FLOAT or VTK_DOUBLE: the precision they were uploaded in
-  const vtkDataArray* Normals = nullptr; // the normals on the device, and their modification time
-  vtkMTimeType NormalsMTime = 0;
+  ffd::cuda::GridDeformer Grid;
+  vtkFFDBindingKey GridKey; // what the grid device's points and binding are for
+  int GridType = 0;         // VTK_FLOAT or VTK_DOUBLE: the precision they were uploaded in
+  NormalsOnDevice GridNormals;
+
+  ffd::cuda::TetrahedralDeformer Tetrahedra;
+  const vtkPoints* TetrahedraPoints = nullptr; // the tetrahedral device's points, their time and precision
+  vtkMTimeType TetrahedraPointsMTime = 0;
+  int TetrahedraType = 0;
+  vtkMTimeType TetrahedraBindTime = 0; // vtkFFDTetrahedralDeformation::GetBindTime() of its binding
+  NormalsOnDevice TetrahedraNormals;
 
   template <typename Real>
-  bool Run(const vtkFFDBindingKey& key, vtkPoints* points, vtkDataArray* normals, const double* displacements,
+  bool RunGrid(const vtkFFDBindingKey& key, vtkPoints* points, vtkDataArray* normals, const double* displacements,
     vtkIdType controlPoints, vtkAOSDataArrayTemplate<Real>* outPoints, vtkDataArray* outNormals,
     vtkAOSDataArrayTemplate<Real>* outDeterminants, bool& bound)
   {
     const int type = outPoints->GetDataType();
-    if (key != this->Key || type != this->PointsType)
+    const bool rebind = key != this->GridKey || type != this->GridType;
+    this->GridKey = vtkFFDBindingKey(); // valid again once everything succeeded
+    if (!Run(
+          this->Grid, this->GridNormals, rebind, rebind, points, normals, outPoints, outNormals, outDeterminants,
+          [&] { return this->Grid.Bind(key.Frame.data(), key.Basis, key.Divisions.data(), key.OutsidePolicy != 0); },
+          [&](bool withNormals, bool withDeterminants) {
+            return this->Grid.Evaluate(displacements, controlPoints, withNormals, withDeterminants);
+          }))
     {
-      this->Key = vtkFFDBindingKey();
-      this->Normals = nullptr;
-      std::vector<Real> copy;
-      if (!this->Device.SetPoints(Contiguous(points->GetData(), copy), key.NumberOfPoints) ||
-        !this->Device.Bind(key.Frame.data(), key.Basis, key.Divisions.data(), key.OutsidePolicy != 0))
-      {
-        return false;
-      }
-      this->Key = key;
-      this->PointsType = type;
-      bound = true;
-    }
-    if (outNormals && (normals != this->Normals || normals->GetMTime() != this->NormalsMTime))
-    {
-      std::vector<float> copy;
-      if (!this->Device.SetNormals(Contiguous(normals, copy)))
-      {
-        this->Key = vtkFFDBindingKey();
-        return false;
-      }
-      this->Normals = normals;
-      this->NormalsMTime = normals->GetMTime();
-    }
-    std::vector<float> normalsCopy;
-    auto* floatNormals = outNormals ? vtkAOSDataArrayTemplate<float>::FastDownCast(outNormals) : nullptr;
-    if (outNormals && !floatNormals)
-    {
-      normalsCopy.resize(3 * static_cast<size_t>(key.NumberOfPoints));
-    }
-    float* normalsTarget = floatNormals ? floatNormals->GetPointer(0) : (outNormals ? normalsCopy.data() : nullptr);
-    if (!this->Device.Evaluate(displacements, controlPoints, outNormals != nullptr, outDeterminants != nullptr) ||
-      !this->Device.Download(outPoints->GetPointer(0), normalsTarget,
-        outDeterminants ? outDeterminants->GetPointer(0) : nullptr))
-    {
-      this->Key = vtkFFDBindingKey(); // the device dropped its state
       return false;
     }
-    if (outNormals && !floatNormals)
-    {
-      auto values = vtk::DataArrayValueRange<3>(outNormals);
-      std::copy(normalsCopy.begin(), normalsCopy.end(), values.begin());
-    }
+    this->GridKey = key;
+    this->GridType = type;
+    bound = rebind;
     return true;
+  }
+
+  template <typename Real>
+  bool RunTetrahedra(const vtkFFDTetrahedralDeformation& tetrahedra, vtkPoints* points, vtkDataArray* normals,
+    vtkAOSDataArrayTemplate<Real>* outPoints, vtkDataArray* outNormals,
+    vtkAOSDataArrayTemplate<Real>* outDeterminants)
+  {
+    const int type = outPoints->GetDataType();
+    const bool uploadPoints = points != this->TetrahedraPoints ||
+      points->GetMTime() != this->TetrahedraPointsMTime || type != this->TetrahedraType;
+    const bool rebind = uploadPoints || tetrahedra.GetBindTime() != this->TetrahedraBindTime;
+    this->TetrahedraPoints = nullptr; // valid again once everything succeeded
+    const vtkIdType nodes = static_cast<vtkIdType>(tetrahedra.GetDisplacements().size() / 3);
+    auto bind = [&] {
+      const std::vector<vtkIdType>& ids = tetrahedra.GetNodes();
+      const std::vector<int> nodeIds(ids.begin(), ids.end());
+      return this->Tetrahedra.Bind(tetrahedra.GetCells().data(), tetrahedra.GetFrames().data(), nodeIds.data(),
+        tetrahedra.GetNumberOfTetrahedra(), nodes);
+    };
+    auto evaluate = [&](bool withNormals, bool withDeterminants) {
+      return this->Tetrahedra.Evaluate(tetrahedra.GetDisplacements().data(), nodes, withNormals, withDeterminants);
+    };
+    if (!Run(this->Tetrahedra, this->TetrahedraNormals, uploadPoints, rebind, points, normals, outPoints,
+          outNormals, outDeterminants, bind, evaluate))
+    {
+      return false;
+    }
+    this->TetrahedraPoints = points;
+    this->TetrahedraPointsMTime = points->GetMTime();
+    this->TetrahedraType = type;
+    this->TetrahedraBindTime = tetrahedra.GetBindTime();
+    tetrahedra.ApplyClampedPoints(points, normals, outPoints, outNormals, outDeterminants);
+    return true;
+  }
+
+  // Calls run(outPoints, outDeterminants) with the output arrays of the evaluation's precision; false when they
+  // are of neither float nor double.
+  template <typename RunT>
+  static bool WithOutputs(vtkDataArray* outPoints, vtkDataArray* outDeterminants, RunT&& run)
+  {
+    if (auto* out = vtkAOSDataArrayTemplate<double>::FastDownCast(outPoints))
+    {
+      return run(out, vtkAOSDataArrayTemplate<double>::FastDownCast(outDeterminants));
+    }
+    if (auto* out = vtkAOSDataArrayTemplate<float>::FastDownCast(outPoints))
+    {
+      return run(out, vtkAOSDataArrayTemplate<float>::FastDownCast(outDeterminants));
+    }
+    return false;
   }
 };
 #else
@@ -145,20 +232,13 @@ bool vtkFFDCudaBackend::Deform(const vtkFFDBindingKey& key, vtkPoints* points, v
 {
   bound = false;
 #ifdef VOXELFFD_HAS_CUDA
-  bool ok = false;
-  if (auto* out = vtkAOSDataArrayTemplate<double>::FastDownCast(outPoints))
-  {
-    ok = this->State->Run(key, points, normals, displacements, controlPoints, out, outNormals,
-      vtkAOSDataArrayTemplate<double>::FastDownCast(outDeterminants), bound);
-  }
-  else if (auto* outFloat = vtkAOSDataArrayTemplate<float>::FastDownCast(outPoints))
-  {
-    ok = this->State->Run(key, points, normals, displacements, controlPoints, outFloat, outNormals,
-      vtkAOSDataArrayTemplate<float>::FastDownCast(outDeterminants), bound);
-  }
+  const bool ok = vtkState::WithOutputs(outPoints, outDeterminants, [&](auto* out, auto* determinants) {
+    return this->State->RunGrid(
+      key, points, normals, displacements, controlPoints, out, outNormals, determinants, bound);
+  });
   if (!ok)
   {
-    why = this->State->Device.GetLastError();
+    why = this->State->Grid.GetLastError();
   }
   return ok;
 #else
@@ -167,6 +247,31 @@ bool vtkFFDCudaBackend::Deform(const vtkFFDBindingKey& key, vtkPoints* points, v
   (void)normals;
   (void)displacements;
   (void)controlPoints;
+  (void)outPoints;
+  (void)outNormals;
+  (void)outDeterminants;
+  why = "VoxelFFD was built without CUDA";
+  return false;
+#endif
+}
+
+bool vtkFFDCudaBackend::DeformTetrahedra(const vtkFFDTetrahedralDeformation& tetrahedra, vtkPoints* points,
+  vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
+  std::string& why)
+{
+#ifdef VOXELFFD_HAS_CUDA
+  const bool ok = vtkState::WithOutputs(outPoints, outDeterminants, [&](auto* out, auto* determinants) {
+    return this->State->RunTetrahedra(tetrahedra, points, normals, out, outNormals, determinants);
+  });
+  if (!ok)
+  {
+    why = this->State->Tetrahedra.GetLastError();
+  }
+  return ok;
+#else
+  (void)tetrahedra;
+  (void)points;
+  (void)normals;
   (void)outPoints;
   (void)outNormals;
   (void)outDeterminants;

@@ -3,10 +3,13 @@
  * @class   vtkFFDCudaBackend
  * @brief   vtkFFDDeform's glue to the CUDA backend (Filters/CUDA): residency, precision, array layout
  *
- * Private to the Filters module (not wrapped). It keeps one ffd::cuda::GridDeformer per vtkFFDDeform, uploads the
- * input's points and normals only when they change, re-binds only when they or the lattice's rest frame, shape
- * or the outside policy change (the same key as the CPU binding, vtkFFDBindingKey), and on an update uploads
- * only the lattice's displacements and downloads straight into the output arrays.
+ * Private to the Filters module (not wrapped). It keeps one ffd::cuda::GridDeformer and one
+ * ffd::cuda::TetrahedralDeformer per vtkFFDDeform, uploads the input's points and normals only when they change.
+ * A grid lattice's points are re-bound on the device only when they or the lattice's rest frame, shape or the
+ * outside policy change (the same key as the CPU binding, vtkFFDBindingKey); a tetrahedral lattice's binding is
+ * the host's (vtkFFDTetrahedralDeformation: it needs VTK's cell locator), uploaded once per binding. An update
+ * uploads only the lattice's displacements (of control points or of nodes) and downloads straight into the
+ * output arrays.
  *
  * In a build without CUDA every call answers "not available", so vtkFFDDeform needs no conditional code.
  */
@@ -20,6 +23,7 @@
 #include <string>
 
 class vtkDataArray;
+class vtkFFDTetrahedralDeformation;
 class vtkPoints;
 
 /// What a binding was computed for: the input's points (identity, modification time, count), the lattice's rest
@@ -64,6 +68,15 @@ public:
   bool Deform(const vtkFFDBindingKey& key, vtkPoints* points, vtkDataArray* normals, const double* displacements,
     vtkIdType controlPoints, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
     bool& bound, std::string& why);
+
+  /**
+   * Deforms on the device the input's points bound by `tetrahedra` (whose Bind() ran for them; its binding is
+   * uploaded when the device does not hold it) by the nodes' displacements of its last SetLattice(), then moves
+   * the points clamped to the control mesh on the host with its ApplyClampedPoints(), as the CPU does. Outputs
+   * and failures as Deform().
+   */
+  bool DeformTetrahedra(const vtkFFDTetrahedralDeformation& tetrahedra, vtkPoints* points, vtkDataArray* normals,
+    vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants, std::string& why);
 
 private:
   struct vtkState;

@@ -451,12 +451,37 @@ int vtkFFDDeform::RequestData(
     determinants->SetName(JacobianDeterminantArrayName());
   }
 
+  // On the GPU where the Backend setting and a device allow it: true when `deform(why)` deformed there; false when
+  // the CPU must, with a warning where CUDA was asked for and cannot run, or failed.
+  auto deformedOnCuda = [this](auto&& deform) {
+    std::string why;
+    if (this->Backend == CPU)
+    {
+      return false;
+    }
+    if (!vtkFFDCudaBackend::IsAvailable(why))
+    {
+      if (this->Backend == CUDA)
+      {
+        vtkWarningMacro("The CUDA backend cannot run (" << why << "); deforming on the CPU.");
+      }
+      return false;
+    }
+    if (!deform(why))
+    {
+      vtkWarningMacro("The CUDA backend failed (" << why << "); deforming on the CPU.");
+      return false;
+    }
+    this->LastBackendUsed = "CUDA";
+    this->UpdateProgress(1.0);
+    return true;
+  };
+
   if (tetrahedra)
   {
+    // The binding needs VTK's cell locator: on the CPU for either backend, then cached.
     bool rebound = false;
-    if (!internals.Tetrahedra.Bind(inPoints, this->OutsidePolicy, this, 0.0, 0.5, rebound) ||
-      !internals.Tetrahedra.Evaluate(
-        inPoints, inNormals, pointsArray, outNormals, determinants, this, 0.5, 1.0))
+    if (!internals.Tetrahedra.Bind(inPoints, this->OutsidePolicy, this, 0.0, 0.5, rebound))
     {
       return 1; // aborted: the output stays empty
     }
@@ -473,37 +498,31 @@ int vtkFFDDeform::RequestData(
                            "outside policy.");
       }
     }
-    this->LastBackendUsed = "CPU";
+    if (!deformedOnCuda([&](std::string& why) {
+          return internals.Cuda.DeformTetrahedra(
+            internals.Tetrahedra, inPoints, inNormals, pointsArray, outNormals, determinants, why);
+        }))
+    {
+      if (!internals.Tetrahedra.Evaluate(
+            inPoints, inNormals, pointsArray, outNormals, determinants, this, 0.5, 1.0))
+      {
+        return 1; // aborted: the output stays empty
+      }
+      this->LastBackendUsed = "CPU";
+    }
     this->FillOutput(input, output, pointsArray, outNormals, determinants);
     return 1;
   }
 
   const vtkFFDBindingKey key = vtkFFDBindingKey::Of(
     inPoints, view.Frame, view.Divisions, static_cast<int>(view.Basis), this->OutsidePolicy);
-  bool done = false;
-  std::string why;
-  const bool cudaAvailable = this->Backend != CPU && vtkFFDCudaBackend::IsAvailable(why);
-  if (this->Backend == CUDA && !cudaAvailable)
-  {
-    vtkWarningMacro("The CUDA backend cannot run (" << why << "); deforming on the CPU.");
-  }
-  if (cudaAvailable)
-  {
-    bool bound = false;
-    done = internals.Cuda.Deform(key, inPoints, inNormals, view.Displacements.data(),
+  bool bound = false;
+  const bool done = deformedOnCuda([&](std::string& why) {
+    return internals.Cuda.Deform(key, inPoints, inNormals, view.Displacements.data(),
       vtkIdType(view.Displacements.size() / 3), pointsArray, outNormals, determinants, bound, why);
-    this->NumberOfBindings += bound ? 1 : 0;
-    if (!done)
-    {
-      vtkWarningMacro("The CUDA backend failed (" << why << "); deforming on the CPU.");
-    }
-  }
-  if (done)
-  {
-    this->LastBackendUsed = "CUDA";
-    this->UpdateProgress(1.0);
-  }
-  else
+  });
+  this->NumberOfBindings += bound ? 1 : 0;
+  if (!done)
   {
     // CPU binding, only when the points or the lattice's rest frame or shape or the policy changed.
     if (key != internals.Bound)

@@ -561,6 +561,7 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
   this->Bound = key;
   this->BoundRest = this->RestValues;
   this->BoundNodes = this->Nodes;
+  this->BindTime.Modified();
   rebound = true;
   return true;
 }
@@ -613,37 +614,6 @@ bool vtkFFDTetrahedralDeformation::Evaluate(vtkPoints* points, vtkDataArray* nor
       worker(points->GetData(), this->Cells.data(), maps.data(), normals, outNormals, out, det, self,
         progressBegin, progressEnd, completed);
     }
-    // Points clamped to the control mesh move by the displacement of their nearest point there.
-    for (const ClampedPoint& p : this->Clamped)
-    {
-      const ffd::TetrahedronMap<double> map = this->Map(p.Tetrahedron);
-      double x[3];
-      points->GetPoint(p.Point, x);
-      const ffd::Vec3<double> y = ffd::Vec3<double>::From(x) + map.Displacement(p.Closest);
-      for (int c = 0; c < 3; ++c)
-      {
-        out[3 * p.Point + c] = static_cast<Real>(y[c]);
-      }
-      if (outNormals || det)
-      {
-        ffd::Mat3<double> jacobian = map.Gradient * p.Gradient;
-        for (int c = 0; c < 3; ++c)
-        {
-          jacobian.M[c][c] += 1.0;
-        }
-        if (outNormals)
-        {
-          double n[3];
-          normals->GetTuple(p.Point, n);
-          const ffd::Vec3<double> m = ffd::TransformNormal(jacobian, ffd::Vec3<double>::From(n));
-          outNormals->SetTuple3(p.Point, m.x, m.y, m.z);
-        }
-        if (det)
-        {
-          det[p.Point] = static_cast<Real>(ffd::Determinant(jacobian));
-        }
-      }
-    }
   };
   if (outPoints->GetDataType() == VTK_DOUBLE)
   {
@@ -653,5 +623,42 @@ bool vtkFFDTetrahedralDeformation::Evaluate(vtkPoints* points, vtkDataArray* nor
   {
     evaluate(float());
   }
+  if (completed)
+  {
+    this->ApplyClampedPoints(points, normals, outPoints, outNormals, outDeterminants);
+  }
   return completed;
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDTetrahedralDeformation::ApplyClampedPoints(vtkPoints* points, vtkDataArray* normals,
+  vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants) const
+{
+  for (const ClampedPoint& p : this->Clamped)
+  {
+    const ffd::TetrahedronMap<double> map = this->Map(p.Tetrahedron);
+    double x[3];
+    points->GetPoint(p.Point, x);
+    const ffd::Vec3<double> y = ffd::Vec3<double>::From(x) + map.Displacement(p.Closest);
+    outPoints->SetTuple3(p.Point, y.x, y.y, y.z);
+    if (outNormals || outDeterminants)
+    {
+      ffd::Mat3<double> jacobian = map.Gradient * p.Gradient;
+      for (int c = 0; c < 3; ++c)
+      {
+        jacobian.M[c][c] += 1.0;
+      }
+      if (outNormals)
+      {
+        double n[3];
+        normals->GetTuple(p.Point, n);
+        const ffd::Vec3<double> m = ffd::TransformNormal(jacobian, ffd::Vec3<double>::From(n));
+        outNormals->SetTuple3(p.Point, m.x, m.y, m.z);
+      }
+      if (outDeterminants)
+      {
+        outDeterminants->SetTuple1(p.Point, ffd::Determinant(jacobian));
+      }
+    }
+  }
 }

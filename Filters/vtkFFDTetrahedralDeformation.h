@@ -22,7 +22,9 @@
  *
  * Evaluation, at every update: each tetrahedron's affine map (ffd::MakeTetrahedronMap) from its nodes'
  * displacements, then every point through its tetrahedron's map (ffd::TetrahedronMap::Deform), with normals
- * by the map's cofactor and det J on request, on vtkSMPTools.
+ * by the map's cofactor and det J on request, on vtkSMPTools. The CUDA backend (vtkFFDCudaBackend) evaluates the
+ * same binding on the device; either backend then moves the points clamped to the control mesh with
+ * ApplyClampedPoints().
  *
  * The same binding serves vtkFFDBuildTetrahedralLattice, which marks the nodes of tetrahedra holding mesh points
  * `Active`.
@@ -31,6 +33,7 @@
 #define vtkFFDTetrahedralDeformation_h
 
 #include "vtkSmartPointer.h"
+#include "vtkTimeStamp.h"
 #include "vtkType.h"
 
 #include "FFDTetrahedra.h"
@@ -89,11 +92,27 @@ public:
   bool Evaluate(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals,
     vtkDataArray* outDeterminants, vtkAlgorithm* self, double progressBegin, double progressEnd);
 
+  /**
+   * Moves the points clamped to the control mesh (CLAMP_TO_EDGE) by the displacement of their nearest point
+   * there, in double precision, over what the evaluation wrote for them (their position): the last step of
+   * Evaluate(), and of the CUDA backend's evaluation, on the host. Arguments as Evaluate()'s.
+   */
+  void ApplyClampedPoints(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints,
+    vtkDataArray* outNormals, vtkDataArray* outDeterminants) const;
+
   ///@{
-  /// The binding: per point its tetrahedron (-1: keeps its position, or clamped, see below).
+  /// The binding: per point its tetrahedron (-1: keeps its position, or clamped, see above); per tetrahedron its
+  /// rest frame (zero for tetrahedra without volume, which nothing is bound to) and its 4 nodes; when it was
+  /// computed (a vtkTimeStamp: a new binding has a later time).
   const std::vector<int>& GetCells() const { return this->Cells; }
   vtkIdType GetNumberOfTetrahedra() const { return static_cast<vtkIdType>(this->Frames.size()); }
+  const std::vector<ffd::Frame<double>>& GetFrames() const { return this->Frames; }
+  const std::vector<vtkIdType>& GetNodes() const { return this->Nodes; }
+  vtkMTimeType GetBindTime() const { return this->BindTime.GetMTime(); }
   ///@}
+
+  /// The lattice's nodes' displacements of the last SetLattice(): 3 per node.
+  const std::vector<double>& GetDisplacements() const { return this->Displacements; }
 
   ///@{
   /// Tetrahedra without volume in the bound lattice, and the first of them (-1 when none).
@@ -144,6 +163,7 @@ private:
   Key Bound;
   std::vector<double> BoundRest;
   std::vector<vtkIdType> BoundNodes;
+  vtkTimeStamp BindTime;
   std::vector<ffd::Frame<double>> Frames; // rest frame per tetrahedron
   std::vector<unsigned char> Degenerate;  // 1 per tetrahedron without volume
   std::vector<int> Neighbours;            // 4 per tetrahedron: across the face opposite each node, or -1
