@@ -3,6 +3,7 @@
 // basis, on fresh random inputs with fixed seeds; device residency (what is uploaded on an update); failures.
 // Without a CUDA device every test skips.
 #include "FFDCudaGridDeformer.h"
+#include "FFDCudaTestSupport.h"
 #include "FFDGridDeformation.h"
 
 #include <gtest/gtest.h>
@@ -17,16 +18,6 @@
 
 namespace
 {
-#define FFD_REQUIRE_DEVICE()                                                                                     \
-  do                                                                                                             \
-  {                                                                                                              \
-    std::string why;                                                                                             \
-    if (!ffd::cuda::DeviceAvailable(&why))                                                                       \
-    {                                                                                                            \
-      GTEST_SKIP() << why;                                                                                       \
-    }                                                                                                            \
-  } while (false)
-
 // A random problem: a skewed frame, divisions, points (mostly inside, some outside, a few non-finite) and
 // displacements of up to a fifth of the frame.
 struct Problem
