@@ -3,9 +3,14 @@
 // basis for 1 M, 16 M and 64 M points, beside the device-to-device copy bandwidth measured in the same run, the
 // fraction of the bandwidth roofline each evaluation reaches (bytes it must move: the point and its 4-byte
 // binding in, the deformed point out), the float32 accuracy of the global basis against float64, and the
-// end-to-end update (lattice upload + evaluation + download) against the bare download of the same bytes.
-// It prints tables and asserts nothing. Options: --quick (1 M points only).
+// end-to-end update (lattice upload + evaluation + download) against the bare download of the same bytes; and the
+// tetrahedral lattices' evaluation (ffd::cuda::TetrahedralDeformer) for 1 M and 16 M points in about 10 k and
+// 100 k tetrahedra, float32 and float64, beside the trilinear grid's in the same run, with what an update would
+// cost if it uploaded the tetrahedra's maps instead of the nodes' displacements.
+// It prints tables and asserts nothing. Options: --quick (1 M points only), --tetrahedra (that section alone).
 #include "FFDCudaGridDeformer.h"
+#include "FFDCudaTestSupport.h"
+#include "FFDCudaTetrahedralDeformer.h"
 #include "FFDGridBasis.h"
 
 #include <cuda_runtime.h>
@@ -42,7 +47,7 @@ double MedianSeconds(int repeats, F&& f)
   return Median(times);
 }
 
-void Require(bool ok, const ffd::cuda::GridDeformer& gpu, const char* what)
+void Require(bool ok, const ffd::cuda::ResidentPoints& gpu, const char* what)
 {
   if (!ok)
   {
@@ -136,11 +141,203 @@ std::vector<double> RandomDisplacements(const Case& c, std::mt19937& rng)
   }
   return v;
 }
+// Kernel times of `evaluate` (median of 20 after a warm-up): the whole call, the lattice's kernels, the points'.
+struct Times
+{
+  double Call, Lattice, Points;
+};
+
+template <typename Evaluate>
+Times TimeEvaluations(const ffd::cuda::ResidentPoints& gpu, Evaluate&& evaluate)
+{
+  evaluate();
+  std::vector<double> lattice, points;
+  const double call = MedianSeconds(20, [&] {
+    evaluate();
+    lattice.push_back(gpu.GetCounters().LastLatticeKernelMilliseconds * 1e-3);
+    points.push_back(gpu.GetCounters().LastKernelMilliseconds * 1e-3);
+  });
+  return { call, Median(lattice), Median(points) };
+}
+
+template <typename Real>
+const char* PrecisionName()
+{
+  return sizeof(Real) == sizeof(float) ? "float32" : "float64";
+}
+
+// One row of the tetrahedral table. Bytes a point must move: the point and its 4-byte binding in, the point out.
+template <typename Real>
+void PrintRow(const char* lattice, std::int64_t n, const Times& t, double bandwidth)
+{
+  const double bytes = double(n) * (2 * 3 * sizeof(Real) + 4);
+  std::printf("| %s | %s | %lld | %.3f | %.3f | %.3f | %.2f | %.0f %% | %.2f |\n", lattice, PrecisionName<Real>(),
+    static_cast<long long>(n), t.Call * 1e3, t.Lattice * 1e3, t.Points * 1e3, n / t.Points * 1e-9,
+    100.0 * bytes / t.Points / bandwidth, n / (t.Lattice + t.Points) * 1e-9);
+}
+
+// Trilinear over 32^3 voxels and tetrahedral lattices of 10 368 and 105 456 tetrahedra (jittered cubes, 6 each)
+// on the same points count and precision; points in voxel / mesh order.
+template <typename Real>
+void TetrahedraSection(const std::vector<std::int64_t>& sizes, double bandwidth, std::mt19937& rng)
+{
+  const int cubes[] = { 12, 26 };
+  std::vector<ffdtest::TetrahedralMesh> meshes;
+  for (int n : cubes)
+  {
+    meshes.push_back(ffdtest::JitteredTetrahedra(n, rng));
+  }
+  for (std::int64_t n : sizes)
+  {
+    {
+      const Case c = { ffd::GridBasis::Trilinear, "TRILINEAR 32^3 vox", 32 };
+      const std::vector<double> points64 = RandomPoints(n, rng);
+      const std::vector<Real> points(points64.begin(), points64.end());
+      const std::vector<double> displacements = RandomDisplacements(c, rng);
+      const int divisions[3] = { c.Divisions, c.Divisions, c.Divisions };
+      ffd::cuda::GridDeformer gpu;
+      Require(gpu.SetPoints(points.data(), n) && gpu.Bind(Frame, int(c.Basis), divisions, false), gpu, "Bind");
+      const Times t = TimeEvaluations(gpu, [&] {
+        Require(gpu.Evaluate(displacements.data(), std::int64_t(displacements.size() / 3), false, false), gpu,
+          "Evaluate");
+      });
+      PrintRow<Real>(c.Name, n, t, bandwidth);
+    }
+    for (const ffdtest::TetrahedralMesh& mesh : meshes)
+    {
+      std::vector<double> points64;
+      std::vector<int> cells;
+      ffdtest::PointsInTetrahedra(mesh, n, true, rng, points64, cells);
+      const std::vector<Real> points(points64.begin(), points64.end());
+      points64 = std::vector<double>();
+      const std::vector<ffd::Frame<double>> frames = mesh.RestFrames();
+      std::uniform_real_distribution<double> d(-0.02, 0.02);
+      std::vector<double> displacements(mesh.Nodes.size());
+      for (double& v : displacements)
+      {
+        v = d(rng);
+      }
+      ffd::cuda::TetrahedralDeformer gpu;
+      Require(gpu.SetPoints(points.data(), n) &&
+          gpu.Bind(cells.data(), frames.data(), mesh.Tetrahedra.data(), mesh.NumberOfTetrahedra(),
+            mesh.NumberOfNodes()),
+        gpu, "Bind");
+      const Times t = TimeEvaluations(gpu, [&] {
+        Require(gpu.Evaluate(displacements.data(), mesh.NumberOfNodes(), false, false), gpu, "Evaluate");
+      });
+      const std::string name = "TETRAHEDRA " + std::to_string(mesh.NumberOfTetrahedra());
+      PrintRow<Real>(name.c_str(), n, t, bandwidth);
+    }
+  }
+}
+
+// What an update uploads: the nodes' displacements (the maps are built on the device), against the maps
+// computed on the host (one thread) and uploaded from pageable memory, as the CPU path holds them.
+template <typename Real>
+void UpdateCostSection(std::mt19937& rng)
+{
+  for (int cubes : { 12, 26 })
+  {
+    const ffdtest::TetrahedralMesh mesh = ffdtest::JitteredTetrahedra(cubes, rng);
+    const std::vector<ffd::Frame<double>> frames = mesh.RestFrames();
+    std::uniform_real_distribution<double> d(-0.02, 0.02);
+    std::vector<double> displacements(mesh.Nodes.size());
+    for (double& v : displacements)
+    {
+      v = d(rng);
+    }
+    const std::int64_t tetrahedra = mesh.NumberOfTetrahedra();
+    std::vector<int> cells(1024, 0);
+    std::vector<Real> points(3 * cells.size(), Real(0));
+    ffd::cuda::TetrahedralDeformer gpu;
+    Require(gpu.SetPoints(points.data(), std::int64_t(cells.size())) &&
+        gpu.Bind(cells.data(), frames.data(), mesh.Tetrahedra.data(), tetrahedra, mesh.NumberOfNodes()),
+      gpu, "Bind");
+    const Times t = TimeEvaluations(gpu, [&] {
+      Require(gpu.Evaluate(displacements.data(), mesh.NumberOfNodes(), false, false), gpu, "Evaluate");
+    });
+
+    std::vector<ffd::TetrahedronMap<Real>> maps(tetrahedra);
+    const double host = MedianSeconds(20, [&] {
+      for (std::int64_t k = 0; k < tetrahedra; ++k)
+      {
+        auto node = [&](int corner) {
+          return ffd::Vec3<double>::From(displacements.data() + 3 * mesh.Tetrahedra[4 * k + corner]);
+        };
+        maps[k] = ffd::MakeTetrahedronMap(frames[k], node(0), node(1), node(2), node(3)).template As<Real>();
+      }
+    });
+    const std::size_t mapBytes = maps.size() * sizeof(ffd::TetrahedronMap<Real>);
+    void* device = nullptr;
+    RequireCuda(cudaMalloc(&device, mapBytes), "cudaMalloc");
+    const double upload = MedianSeconds(20, [&] {
+      RequireCuda(cudaMemcpy(device, maps.data(), mapBytes, cudaMemcpyHostToDevice), "cudaMemcpy");
+    });
+    cudaFree(device);
+    std::printf("| %lld | %lld | %s | %.0f | %.3f (maps kernel %.3f) | %.0f | %.3f + %.3f = %.3f |\n",
+      static_cast<long long>(tetrahedra), static_cast<long long>(mesh.NumberOfNodes()), PrecisionName<Real>(),
+      mesh.NumberOfNodes() * 24 / 1024.0, t.Call * 1e3, t.Lattice * 1e3, mapBytes / 1024.0, host * 1e3,
+      upload * 1e3, (host + upload) * 1e3);
+  }
+}
+
+void Tetrahedra(const std::vector<std::int64_t>& sizes, double bandwidth, std::mt19937& rng)
+{
+  std::printf("\nTetrahedral lattices beside the trilinear grid, same device and run, points in mesh (voxel) order, "
+              "median of 20: the whole Evaluate() call (nodes' upload, maps kernel, points kernel, synchronize), "
+              "each kernel (CUDA events); rates from the points kernel, the last column from both kernels\n");
+  std::printf("| lattice | precision | points | Evaluate() ms | maps kernel ms | points kernel ms | G points/s | "
+              "%% of copy roofline | G points/s with maps |\n"
+              "|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
+  TetrahedraSection<float>(sizes, bandwidth, rng);
+  TetrahedraSection<double>(sizes, bandwidth, rng);
+
+  std::printf("\nAn update's lattice: the nodes' displacements uploaded and the maps built on the device (Evaluate() "
+              "of 1024 points, median of 20), against the maps built on the host (1 thread) and uploaded from "
+              "pageable memory (cudaMemcpy)\n");
+  std::printf("| tetrahedra | nodes | precision | nodes KiB | Evaluate() ms | maps KiB | host maps + upload ms |\n"
+              "|---:|---:|---|---:|---:|---:|---:|\n");
+  UpdateCostSection<float>(rng);
+  UpdateCostSection<double>(rng);
+
+  // End to end: evaluation and download of 1 M float32 points in 10 368 tetrahedra, against the bare download.
+  const std::int64_t n = std::int64_t(1) << 20;
+  const ffdtest::TetrahedralMesh mesh = ffdtest::JitteredTetrahedra(12, rng);
+  std::vector<double> points64;
+  std::vector<int> cells;
+  ffdtest::PointsInTetrahedra(mesh, n, true, rng, points64, cells);
+  const std::vector<float> points(points64.begin(), points64.end());
+  const std::vector<ffd::Frame<double>> frames = mesh.RestFrames();
+  const std::vector<double> displacements(mesh.Nodes.size(), 0.01);
+  ffd::cuda::TetrahedralDeformer gpu;
+  Require(gpu.SetPoints(points.data(), n) &&
+      gpu.Bind(cells.data(), frames.data(), mesh.Tetrahedra.data(), mesh.NumberOfTetrahedra(), mesh.NumberOfNodes()),
+    gpu, "Bind");
+  std::vector<float> out(points.size());
+  Require(gpu.Evaluate(displacements.data(), mesh.NumberOfNodes(), false, false), gpu, "Evaluate");
+  const double endToEnd = MedianSeconds(20, [&] {
+    Require(gpu.Evaluate(displacements.data(), mesh.NumberOfNodes(), false, false) &&
+        gpu.Download(out.data(), nullptr, nullptr),
+      gpu, "Evaluate");
+  });
+  void* device = nullptr;
+  RequireCuda(cudaMalloc(&device, points.size() * sizeof(float)), "cudaMalloc");
+  const double bare = MedianSeconds(20, [&] {
+    RequireCuda(cudaMemcpy(out.data(), device, points.size() * sizeof(float), cudaMemcpyDeviceToHost), "cudaMemcpy");
+  });
+  cudaFree(device);
+  std::printf("\nEnd-to-end update of %lld float32 points in %lld tetrahedra (nodes' upload + maps + evaluation + "
+              "download into pageable memory) against the bare download, median of 20: %.3f ms vs %.3f ms, "
+              "ratio %.2f\n",
+    static_cast<long long>(n), static_cast<long long>(mesh.NumberOfTetrahedra()), endToEnd * 1e3, bare * 1e3,
+    endToEnd / bare);
+}
 } // namespace
 
 int main(int argc, char* argv[])
 {
   const bool quick = argc > 1 && std::string(argv[1]) == "--quick";
+  const bool tetrahedraOnly = argc > 1 && std::string(argv[1]) == "--tetrahedra";
   std::string why;
   if (!ffd::cuda::DeviceAvailable(&why))
   {
@@ -165,8 +362,15 @@ int main(int argc, char* argv[])
   {
     sizes.resize(1);
   }
+  const std::vector<std::int64_t> tetrahedraSizes(
+    sizes.begin(), sizes.begin() + std::min<std::size_t>(2, sizes.size())); // 1 M and 16 M
 
   std::mt19937 rng(2026);
+  if (tetrahedraOnly)
+  {
+    Tetrahedra(tetrahedraSizes, bandwidth, rng);
+    return 0;
+  }
   std::printf("Evaluation of float32 points in voxel order, median of 20: the whole Evaluate() call (lattice "
               "upload, kernel, synchronize) and the kernel alone (CUDA events); rates from the kernel time\n");
   std::printf("| basis | points | Evaluate() ms | kernel ms | G points/s | GB/s moved | %% of copy roofline |\n"
@@ -271,5 +475,6 @@ int main(int argc, char* argv[])
     }
     std::printf("BERNSTEIN 11^3 float32 vs float64: max error %.2e relative to the frame's scale\n", worst / 3.0);
   }
+  Tetrahedra(tetrahedraSizes, bandwidth, rng);
   return 0;
 }
