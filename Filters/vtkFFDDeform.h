@@ -42,7 +42,8 @@
  * four nodes, an affine map per tetrahedron, so normals follow that map. Tetrahedra without volume are
  * reported (a warning at binding) and skipped. Points outside every tetrahedron keep their position, take the
  * displacement of the nearest point of the control mesh (CLAMP_TO_EDGE), or follow the affine map of the
- * nearest tetrahedron (EXTRAPOLATE, tetrahedral lattices only). They are evaluated on the CPU.
+ * nearest tetrahedron (EXTRAPOLATE, tetrahedral lattices only). The binding runs on the CPU (it needs VTK's
+ * locator); the evaluation on either backend, as for grids.
  *
  * A lattice without the contract's arrays, with a flat or non-finite frame, an unknown basis, non-finite
  * points, or a point count that does not match its divisions and basis is an error, as is a tetrahedral

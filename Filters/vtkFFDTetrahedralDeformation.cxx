@@ -470,7 +470,11 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
   // VTK's locators over the rest tetrahedra, built only when a walk leaves a point undecided or the outside
   // policy needs nearest points.
   vtkNew<vtkPoints> restPoints;
-  restPoints->SetData(this->RestPositions);
+  // vtkPoints::SetData() may rename or otherwise touch the array it is given: give it a copy that shares the
+  // lattice's memory, so the user's RestPosition keeps its modification time.
+  const auto restCopy = vtk::TakeSmartPointer(this->RestPositions->NewInstance());
+  restCopy->ShallowCopy(this->RestPositions);
+  restPoints->SetData(restCopy);
   vtkNew<vtkUnstructuredGrid> rest;
   rest->SetPoints(restPoints);
   rest->SetCells(this->Lattice->GetCellTypesArray(), this->Lattice->GetCells());

@@ -556,7 +556,9 @@ TEST(vtkFFDDeformTetrahedral, BindingIsCachedAcrossNodeMoves)
   vtkNew<vtkFFDDeform> deform;
   deform->SetInputData(mesh);
   deform->SetLatticeData(lattice);
+  const vtkMTimeType restMTime = lattice->GetPointData()->GetArray("RestPosition")->GetMTime();
   deform->Update();
+  EXPECT_EQ(lattice->GetPointData()->GetArray("RestPosition")->GetMTime(), restMTime); // the input is not touched
   for (unsigned step = 0; step < 3; ++step)
   {
     DisplaceNodes(lattice, 0.05, 59 + step);
