@@ -5,6 +5,7 @@
 #include "vtkFFDCudaBackend.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDForInChunks.h"
+#include "vtkFFDLatticeDisplacements.h"
 #include "vtkFFDTetrahedralDeformation.h"
 
 #include "vtkAOSDataArrayTemplate.h"
@@ -108,21 +109,10 @@ std::string ReadLattice(vtkPointSet* lattice, LatticeView& view)
   {
     return "The lattice has no RestPosition point array of 3 components per point." + fix;
   }
-  view.Displacements.resize(3 * count);
-  for (vtkIdType p = 0; p < count; ++p)
+  const vtkIdType notFinite = vtkFFDReadLatticeDisplacements(lattice, rest, view.Displacements, nullptr);
+  if (notFinite >= 0)
   {
-    double x[3], x0[3];
-    lattice->GetPoint(p, x);
-    rest->GetTuple(p, x0);
-    for (int c = 0; c < 3; ++c)
-    {
-      const double d = x[c] - x0[c];
-      if (!std::isfinite(d))
-      {
-        return "Lattice point " + std::to_string(p) + " or its RestPosition is not finite.";
-      }
-      view.Displacements[3 * p + c] = d;
-    }
+    return "Lattice point " + std::to_string(notFinite) + " or its RestPosition is not finite.";
   }
   return std::string();
 }

@@ -3,6 +3,7 @@
 
 #include "vtkFFDDataContract.h"
 #include "vtkFFDForInChunks.h"
+#include "vtkFFDLatticeDisplacements.h"
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkArrayDispatch.h"
@@ -383,23 +384,11 @@ std::string vtkFFDTetrahedralDeformation::SetLattice(vtkUnstructuredGrid* lattic
     return "The tetrahedral lattice has no RestPosition point array of 3 components per point." + fix;
   }
   this->RestPositions = rest;
-  this->RestValues.resize(3 * numberOfNodes);
-  this->Displacements.resize(3 * numberOfNodes);
-  for (vtkIdType p = 0; p < numberOfNodes; ++p)
+  const vtkIdType notFinite =
+    vtkFFDReadLatticeDisplacements(lattice, rest, this->Displacements, &this->RestValues);
+  if (notFinite >= 0)
   {
-    double x[3], x0[3];
-    lattice->GetPoint(p, x);
-    rest->GetTuple(p, x0);
-    for (int c = 0; c < 3; ++c)
-    {
-      const double d = x[c] - x0[c];
-      if (!std::isfinite(d))
-      {
-        return "Tetrahedral lattice point " + std::to_string(p) + " or its RestPosition is not finite.";
-      }
-      this->RestValues[3 * p + c] = x0[c];
-      this->Displacements[3 * p + c] = d;
-    }
+    return "Tetrahedral lattice point " + std::to_string(notFinite) + " or its RestPosition is not finite.";
   }
   // The connectivity is read again only when its array changed (an update usually moves nodes only).
   vtkCellArray* cells = lattice->GetCells();

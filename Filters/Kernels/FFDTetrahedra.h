@@ -24,32 +24,33 @@
 namespace ffd
 {
 
-/// Whether a tetrahedron (rest corners A, B, C, D, 3 doubles each) has a volume: CheckFrame() of its frame.
+/// The 12 numbers of a tetrahedron's frame, X0 = A, S = B - A, T = C - A, U = D - A (corners of 3 doubles).
+inline void TetrahedronFrameArray(
+  const double a[3], const double b[3], const double c[3], const double d[3], double frame[12])
+{
+  for (int i = 0; i < 3; ++i)
+  {
+    frame[i] = a[i];
+    frame[3 + i] = b[i] - a[i];
+    frame[6 + i] = c[i] - a[i];
+    frame[9 + i] = d[i] - a[i];
+  }
+}
+
+/// Whether a tetrahedron (rest corners A, B, C, D) has a volume: CheckFrame() of its frame.
 inline FrameStatus CheckTetrahedron(const double a[3], const double b[3], const double c[3], const double d[3])
 {
   double frame[12];
-  for (int i = 0; i < 3; ++i)
-  {
-    frame[i] = a[i];
-    frame[3 + i] = b[i] - a[i];
-    frame[6 + i] = c[i] - a[i];
-    frame[9 + i] = d[i] - a[i];
-  }
+  TetrahedronFrameArray(a, b, c, d, frame);
   return CheckFrame(frame);
 }
 
-/// The frame of a tetrahedron (A, B - A, C - A, D - A), whose parameters are its weights (equation 5). The
-/// caller has checked it with CheckTetrahedron().
+/// The frame of a tetrahedron, whose parameters are its weights (equation 5). The caller has checked it with
+/// CheckTetrahedron().
 inline Frame<double> TetrahedronFrame(const double a[3], const double b[3], const double c[3], const double d[3])
 {
   double frame[12];
-  for (int i = 0; i < 3; ++i)
-  {
-    frame[i] = a[i];
-    frame[3 + i] = b[i] - a[i];
-    frame[6 + i] = c[i] - a[i];
-    frame[9 + i] = d[i] - a[i];
-  }
+  TetrahedronFrameArray(a, b, c, d, frame);
   return Frame<double>::FromArray(frame);
 }
 

@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file vtkFFDLatticeDisplacements.h
+ * @brief Reads a lattice's deformation, its points minus `RestPosition` (private to the Filters module).
+ */
+#ifndef vtkFFDLatticeDisplacements_h
+#define vtkFFDLatticeDisplacements_h
+
+#include "vtkDataArray.h"
+#include "vtkPointSet.h"
+
+#include <cmath>
+#include <vector>
+
+/**
+ * The deformation of `lattice`, its points minus `rest` (3 components, a tuple per point), 3 doubles per point
+ * into `displacements`, and the rest positions into `restValues` when not null. Returns the first point whose
+ * position or rest position is not finite (the outputs are then incomplete), or -1.
+ */
+inline vtkIdType vtkFFDReadLatticeDisplacements(
+  vtkPointSet* lattice, vtkDataArray* rest, std::vector<double>& displacements, std::vector<double>* restValues)
+{
+  const vtkIdType count = lattice->GetNumberOfPoints();
+  displacements.resize(3 * count);
+  if (restValues)
+  {
+    restValues->resize(3 * count);
+  }
+  for (vtkIdType p = 0; p < count; ++p)
+  {
+    double x[3], x0[3];
+    lattice->GetPoint(p, x);
+    rest->GetTuple(p, x0);
+    for (int c = 0; c < 3; ++c)
+    {
+      const double d = x[c] - x0[c];
+      if (!std::isfinite(d))
+      {
+        return p;
+      }
+      displacements[3 * p + c] = d;
+      if (restValues)
+      {
+        (*restValues)[3 * p + c] = x0[c];
+      }
+    }
+  }
+  return -1;
+}
+
+#endif
