@@ -8,10 +8,13 @@
  * that every index the kernels compute and every control point they read is the same for all lanes (a control
  * point is read once and broadcast). The arithmetic is GCC/Clang vector extensions rather than intrinsics: a
  * function compiled for AVX-512 gets zmm instructions, one for AVX2 ymm, and a plain x86-64 build SSE2
- * (FFDGridLanes.h picks the widest at run time), from the same source.
+ * (FFDGridLanes.h picks the widest at run time), from the same source. The exceptions, a broadcast and a
+ * mask to bits, are one intrinsic per width (detail::Splat(), detail::LaneBits()).
  */
 #ifndef FFDLanes_h
 #define FFDLanes_h
+
+#include <immintrin.h>
 
 #include <cstdint>
 #include <cstring>
@@ -20,6 +23,79 @@
 
 namespace ffd
 {
+
+namespace detail
+{
+// What vector extensions do not give in one instruction, one overload per width: each is compiled for the
+// instruction set of its width and inlined only into the functions of FFDGridLanes.h compiled for that set (the
+// 16-byte ones are SSE2, which every x86-64 has). GCC 12 builds a splat of a scalar (`Vector{} + s`,
+// `s - Vector{}`, an initializer list) with two to sixteen instructions, or through the stack where
+// neighbouring scalars are splatted; the intrinsics give one broadcast.
+typedef float Float32x16 __attribute__((vector_size(64)));
+typedef double Float64x8 __attribute__((vector_size(64)));
+typedef float Float32x8 __attribute__((vector_size(32)));
+typedef double Float64x4 __attribute__((vector_size(32)));
+typedef float Float32x4 __attribute__((vector_size(16)));
+typedef double Float64x2 __attribute__((vector_size(16)));
+typedef std::int32_t Int32x16 __attribute__((vector_size(64)));
+typedef std::int64_t Int64x8 __attribute__((vector_size(64)));
+typedef std::int32_t Int32x8 __attribute__((vector_size(32)));
+typedef std::int64_t Int64x4 __attribute__((vector_size(32)));
+typedef std::int32_t Int32x4 __attribute__((vector_size(16)));
+typedef std::int64_t Int64x2 __attribute__((vector_size(16)));
+
+/// v = s in every lane.
+__attribute__((target("avx512f"))) inline void Splat(float s, Float32x16& v)
+{
+  v = reinterpret_cast<Float32x16>(_mm512_set1_ps(s));
+}
+__attribute__((target("avx512f"))) inline void Splat(double s, Float64x8& v)
+{
+  v = reinterpret_cast<Float64x8>(_mm512_set1_pd(s));
+}
+__attribute__((target("avx"))) inline void Splat(float s, Float32x8& v)
+{
+  v = reinterpret_cast<Float32x8>(_mm256_set1_ps(s));
+}
+__attribute__((target("avx"))) inline void Splat(double s, Float64x4& v)
+{
+  v = reinterpret_cast<Float64x4>(_mm256_set1_pd(s));
+}
+inline void Splat(float s, Float32x4& v)
+{
+  v = reinterpret_cast<Float32x4>(_mm_set1_ps(s));
+}
+inline void Splat(double s, Float64x2& v)
+{
+  v = reinterpret_cast<Float64x2>(_mm_set1_pd(s));
+}
+
+/// Bit l set where lane l of m is -1 (lanes are -1 or 0).
+__attribute__((target("avx512f,avx512dq"))) inline unsigned LaneBits(const Int32x16& m)
+{
+  return _mm512_movepi32_mask(reinterpret_cast<__m512i>(m));
+}
+__attribute__((target("avx512f,avx512dq"))) inline unsigned LaneBits(const Int64x8& m)
+{
+  return _mm512_movepi64_mask(reinterpret_cast<__m512i>(m));
+}
+__attribute__((target("avx"))) inline unsigned LaneBits(const Int32x8& m)
+{
+  return unsigned(_mm256_movemask_ps(reinterpret_cast<__m256>(m)));
+}
+__attribute__((target("avx"))) inline unsigned LaneBits(const Int64x4& m)
+{
+  return unsigned(_mm256_movemask_pd(reinterpret_cast<__m256d>(m)));
+}
+inline unsigned LaneBits(const Int32x4& m)
+{
+  return unsigned(_mm_movemask_ps(reinterpret_cast<__m128>(m)));
+}
+inline unsigned LaneBits(const Int64x2& m)
+{
+  return unsigned(_mm_movemask_pd(reinterpret_cast<__m128d>(m)));
+}
+} // namespace detail
 
 template <typename T, int W>
 struct Lanes
@@ -37,8 +113,8 @@ struct Lanes
   /// Every lane s (also from ints and doubles, as the kernels' Real(1) and Real(cell) need).
   template <typename S, typename = std::enable_if_t<std::is_arithmetic<S>::value>>
   Lanes(S s)
-    : V(Vector{} + T(s))
   {
+    detail::Splat(T(s), this->V);
   }
   explicit Lanes(const Vector& v)
     : V(v)
@@ -50,8 +126,16 @@ struct Lanes
   friend Lanes operator*(const Lanes& a, const Lanes& b) { return Lanes(a.V * b.V); }
   friend Lanes operator/(const Lanes& a, const Lanes& b) { return Lanes(a.V / b.V); }
   friend Lanes operator-(const Lanes& a) { return Lanes(-a.V); }
-  /// a in the lanes where mask is -1, b where it is 0.
-  friend Lanes Select(const IndexVector& mask, const Lanes& a, const Lanes& b) { return Lanes(mask ? a.V : b.V); }
+  /// a in the lanes where mask is -1, b where it is 0. Written with bitwise operations: GCC 12 compiles
+  /// `mask ? a : b` lane by lane, with branches, where the mask is not a comparison in the same expression.
+  friend Lanes Select(const IndexVector& mask, const Lanes& a, const Lanes& b)
+  {
+    return Lanes(reinterpret_cast<Vector>((reinterpret_cast<IndexVector>(a.V) & mask) |
+      (reinterpret_cast<IndexVector>(b.V) & ~mask)));
+  }
+
+  /// Bit l set where lane l of mask is -1 (mask lanes are -1 or 0).
+  static unsigned Bits(const IndexVector& mask) { return detail::LaneBits(mask); }
   friend Lanes Clamp01(const Lanes& a)
   {
     const Vector zero = Vector{}, one = zero + T(1);
