@@ -123,71 +123,13 @@ struct AxisWeights
   Real D[MaxCount];
 };
 
-/**
- * Fills `a` for the parameter s in [0, 1] of a point bound to `cell` along an axis of `voxels` voxels.
- * The local coordinate is clamped to [0, 1], so a point evaluated in a precision lower than that of its
- * binding stays in its cell. Derivatives are computed only when withDerivative is true. With MaxCount <= 4
- * (every local basis) the global basis is limited to degree 3 (one cubic voxel).
- */
-template <int MaxCount, typename Real>
-FFD_INLINE void ComputeAxisWeights(
-  GridBasis basis, int voxels, int cell, Real s, bool withDerivative, AxisWeights<MaxCount, Real>& a)
+namespace detail
 {
-  static_assert(MaxCount >= 4, "a local basis has up to 4 weights per axis");
-  const Real n = Real(voxels);
-  if (basis == GridBasis::CubicBSpline)
-  {
-    // Uniform cubic B-spline: (1-r)^3/6, (3r^3 - 6r^2 + 4)/6, (-3r^3 + 3r^2 + 3r + 1)/6, r^3/6.
-    const Real r = Clamp01(s * n - Real(cell));
-    const Real q = Real(1) - r, r2 = r * r, r3 = r2 * r, sixth = Real(1) / Real(6);
-    a.First = cell;
-    a.Count = 4;
-    a.W[0] = q * q * q * sixth;
-    a.W[1] = (Real(3) * r3 - Real(6) * r2 + Real(4)) * sixth;
-    a.W[2] = (Real(-3) * r3 + Real(3) * r2 + Real(3) * r + Real(1)) * sixth;
-    a.W[3] = r3 * sixth;
-    if (withDerivative)
-    {
-      const Real h = n * Real(0.5); // d/ds = n d/dr
-      a.D[0] = -q * q * h;
-      a.D[1] = (Real(3) * r2 - Real(4) * r) * h;
-      a.D[2] = (Real(-3) * r2 + Real(2) * r + Real(1)) * h;
-      a.D[3] = r2 * h;
-    }
-    return;
-  }
-
-  // Bernstein polynomials: of degree `voxels` in s for the global basis, of degree 1, 2 or 3 in the local
-  // coordinate r for a Bezier voxel (d/ds = n d/dr there).
-  const bool global = basis == GridBasis::Bernstein;
-  const int degree = global ? voxels : BezierDegree(basis);
-  Real r = s;
-  Real scale = Real(1);
-  a.First = 0;
-  if (!global)
-  {
-    r = Clamp01(s * n - Real(cell));
-    scale = n;
-    a.First = degree * cell;
-  }
-  a.Count = degree + 1;
-  if constexpr (MaxCount > 4)
-  {
-    if (degree > 3) // the de Casteljau triangle for any degree
-    {
-      if (withDerivative)
-      {
-        BernsteinBasisAndDerivative(degree, r, a.W, a.D);
-      }
-      else
-      {
-        BernsteinBasis(degree, r, a.W);
-      }
-      return;
-    }
-  }
-  // Degrees 1 to 3 written out, so that every array index is a constant (on a GPU a run-time index would put
-  // the arrays in local memory).
+/// Bernstein weights of degree 1 to 3 at r, and their derivatives times `scale` (d/ds = scale d/dr), written
+/// out so that every array index is a constant (on a GPU a run-time index would put the arrays in local memory).
+template <int MaxCount, typename Real>
+FFD_INLINE void LowDegreeBernstein(int degree, Real r, Real scale, bool withDerivative, AxisWeights<MaxCount, Real>& a)
+{
   const Real q = Real(1) - r;
   if (degree == 1)
   {
@@ -228,6 +170,84 @@ FFD_INLINE void ComputeAxisWeights(
       a.D[3] = Real(3) * r * r * scale;
     }
   }
+}
+} // namespace detail
+
+/**
+ * Count, W (and D when withDerivative) of a local basis at local coordinate r in [0, 1] of a voxel along an
+ * axis of n voxels; First is the caller's. The derivatives are with respect to the frame parameter s (n d/dr).
+ * Real may be a Lanes type whose lanes lie in different voxels (FFDGridLanes.h): r and n are per lane.
+ */
+template <int MaxCount, typename Real>
+FFD_INLINE void ComputeLocalAxisWeights(
+  GridBasis basis, Real n, Real r, bool withDerivative, AxisWeights<MaxCount, Real>& a)
+{
+  static_assert(MaxCount >= 4, "a local basis has up to 4 weights per axis");
+  if (basis == GridBasis::CubicBSpline)
+  {
+    // Uniform cubic B-spline: (1-r)^3/6, (3r^3 - 6r^2 + 4)/6, (-3r^3 + 3r^2 + 3r + 1)/6, r^3/6.
+    const Real q = Real(1) - r, r2 = r * r, r3 = r2 * r, sixth = Real(1) / Real(6);
+    a.Count = 4;
+    a.W[0] = q * q * q * sixth;
+    a.W[1] = (Real(3) * r3 - Real(6) * r2 + Real(4)) * sixth;
+    a.W[2] = (Real(-3) * r3 + Real(3) * r2 + Real(3) * r + Real(1)) * sixth;
+    a.W[3] = r3 * sixth;
+    if (withDerivative)
+    {
+      const Real h = n * Real(0.5); // d/ds = n d/dr
+      a.D[0] = -q * q * h;
+      a.D[1] = (Real(3) * r2 - Real(4) * r) * h;
+      a.D[2] = (Real(-3) * r2 + Real(2) * r + Real(1)) * h;
+      a.D[3] = r2 * h;
+    }
+    return;
+  }
+  // A Bezier voxel: Bernstein polynomials of degree 1, 2 or 3 in r.
+  const int degree = BezierDegree(basis);
+  a.Count = degree + 1;
+  detail::LowDegreeBernstein(degree, r, n, withDerivative, a);
+}
+
+/**
+ * Fills `a` for the parameter s of a point bound to `cell` along an axis of `voxels` voxels; s outside [0, 1]
+ * (a point clamped to the frame) counts as the nearest face. The local coordinate is clamped to [0, 1], so a
+ * point evaluated in a precision lower than that of its binding stays in its cell. Derivatives are computed
+ * only when withDerivative is true. With MaxCount <= 4 (every local basis) the global basis is limited to
+ * degree 3 (one cubic voxel).
+ */
+template <int MaxCount, typename Real>
+FFD_INLINE void ComputeAxisWeights(
+  GridBasis basis, int voxels, int cell, Real s, bool withDerivative, AxisWeights<MaxCount, Real>& a)
+{
+  static_assert(MaxCount >= 4, "a local basis has up to 4 weights per axis");
+  if (basis != GridBasis::Bernstein)
+  {
+    // The bound cell is the clamped parameter's, so clamping r alone gives what clamping s first would.
+    const Real n = Real(voxels);
+    a.First = basis == GridBasis::CubicBSpline ? cell : BezierDegree(basis) * cell;
+    ComputeLocalAxisWeights(basis, n, Clamp01(s * n - Real(cell)), withDerivative, a);
+    return;
+  }
+  // The global basis: Bernstein polynomials of degree `voxels` in s.
+  const Real r = Clamp01(s);
+  a.First = 0;
+  a.Count = voxels + 1;
+  if constexpr (MaxCount > 4)
+  {
+    if (voxels > 3) // the de Casteljau triangle for any degree
+    {
+      if (withDerivative)
+      {
+        BernsteinBasisAndDerivative(voxels, r, a.W, a.D);
+      }
+      else
+      {
+        BernsteinBasis(voxels, r, a.W);
+      }
+      return;
+    }
+  }
+  detail::LowDegreeBernstein(voxels, r, Real(1), withDerivative, a);
 }
 
 namespace detail

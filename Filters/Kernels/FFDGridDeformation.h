@@ -90,6 +90,8 @@ FFD_INLINE Mat3<Real> DeformationJacobian(const Mat3<Real>& displacementGradient
 template <int MaxCount, typename Real, int StaticBasis = -1, typename Lane = Real>
 struct GridDeformation
 {
+  using Value = Real; ///< the displacements' type
+
   GridBasis Basis;
   int Voxels[3];             ///< the lattice's divisions
   int Dims[3];               ///< control points per axis
@@ -103,6 +105,12 @@ struct GridDeformation
     return { this->Basis, { this->Voxels[0], this->Voxels[1], this->Voxels[2] },
       { this->Dims[0], this->Dims[1], this->Dims[2] }, this->Displacements,
       this->Frame.template As<OtherLane>() };
+  }
+
+  /// The basis: StaticBasis where it is known at compile time (constant-folded), else Basis.
+  FFD_INLINE GridBasis BasisOf() const
+  {
+    return StaticBasis >= 0 ? static_cast<GridBasis>(StaticBasis) : this->Basis;
   }
 
   /// X + D(s, t, u) for a point bound to `cell` (not -1); with lanes, every lane is bound to `cell`.
@@ -122,10 +130,35 @@ struct GridDeformation
     return x + SumTensorProduct(this->Displacements, this->Dims, axes);
   }
 
+  /**
+   * Deform() for lanes bound to different cells of a local basis (host only, Lane a Lanes type): `cell` holds
+   * each lane's cell index along each axis (CellIndices(), as numbers), and `values` reads each lane's control
+   * points as LatticeValues<Values>: for a control point given relative to its cell's first one
+   * (i + Dims[0] (j + Dims[1] k)), its value in every lane (FFDGridLanes.h). The same weights and sum as
+   * Deform(), so a lane's result is bit for bit the one it gets when all lanes share its cell.
+   */
+  template <typename Values>
+  Vec3<Lane> DeformInLaneCells(const Vec3<Lane>& x, const Vec3<Lane>& cell, const Values* values) const
+  {
+    const GridBasis basis = this->BasisOf();
+    const Vec3<Lane> stu = this->Frame.ToParametric(x);
+    const Lane p[3] = { stu.x, stu.y, stu.z };
+    const Lane c[3] = { cell.x, cell.y, cell.z };
+    AxisWeights<MaxCount, Lane> axes[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      // As ComputeAxisWeights() does for one cell.
+      const Lane n = Lane(this->Voxels[a]);
+      axes[a].First = 0;
+      ComputeLocalAxisWeights(basis, n, Clamp01(p[a] * n - c[a]), false, axes[a]);
+    }
+    return x + SumTensorProduct(values, this->Dims, axes);
+  }
+
   /// The index along each axis of a bound cell: BindToGrid()'s flat index ci + cx (cj + cy ck) taken apart.
   FFD_INLINE void CellIndices(int cell, int c[3]) const
   {
-    const GridBasis basis = StaticBasis >= 0 ? static_cast<GridBasis>(StaticBasis) : this->Basis;
+    const GridBasis basis = this->BasisOf();
     FFD_UNROLL
     for (int a = 0; a < 2; ++a)
     {
@@ -159,16 +192,17 @@ struct GridDeformation
   }
 
 private:
-  /// The weights along each axis at parameters stu (clamped to the frame) of a point in cell (ci, cj, ck).
+  /// The weights along each axis at parameters stu (ComputeAxisWeights() clamps them to the frame) of a point
+  /// in cell (ci, cj, ck).
   FFD_INLINE void Weights(
     const Vec3<Lane>& stu, const int cell[3], bool withDerivative, AxisWeights<MaxCount, Lane>* axes) const
   {
     const Lane p[3] = { stu.x, stu.y, stu.z };
-    const GridBasis basis = StaticBasis >= 0 ? static_cast<GridBasis>(StaticBasis) : this->Basis;
+    const GridBasis basis = this->BasisOf();
     FFD_UNROLL
     for (int a = 0; a < 3; ++a)
     {
-      ComputeAxisWeights(basis, this->Voxels[a], cell[a], Clamp01(p[a]), withDerivative, axes[a]);
+      ComputeAxisWeights(basis, this->Voxels[a], cell[a], p[a], withDerivative, axes[a]);
     }
   }
 };
