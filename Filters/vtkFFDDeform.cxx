@@ -211,8 +211,8 @@ struct EvaluateFunctor
 };
 
 // Evaluation of the points alone (no normals, no determinants) from points of the output's precision, W at a
-// time in SIMD lanes (FFDGridLanes.h): first the blocks whose points share a cell, in place, then the points of
-// the other blocks, gathered by cell at binding.
+// time in SIMD lanes (FFDGridLanes.h): first the blocks deformed in place, then the points of the other blocks,
+// gathered by cell at binding.
 template <typename Deformer, typename Real>
 struct LanesFunctor
 {
@@ -221,6 +221,7 @@ struct LanesFunctor
   const int* Cells;
   vtkIdType NumberOfPoints;
   const int* Gathered; // ffd::GatherByCell()
+  int MaxCellsInPlace; // what Gathered was listed for
   Deformer Deformation;
   bool GatheredPass; // false: over blocks, true: over Gathered
 
@@ -233,8 +234,8 @@ struct LanesFunctor
     }
     else
     {
-      ffd::DeformBlocksInPlace(
-        level, this->Deformation, this->InPoints, this->Cells, this->OutPoints, this->NumberOfPoints, begin, end);
+      ffd::DeformBlocksInPlace(level, this->Deformation, this->InPoints, this->Cells, this->OutPoints,
+        this->NumberOfPoints, begin, end, this->MaxCellsInPlace);
     }
   }
 };
@@ -244,7 +245,7 @@ struct EvaluateWorker
 {
   template <typename PointArrayT>
   void operator()(PointArrayT* inPoints, const LatticeView& lattice, const int* cells,
-    const std::vector<int>& gathered, vtkDataArray* inNormals,
+    const std::vector<int>& gathered, int maxCellsInPlace, vtkDataArray* inNormals,
     vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outPoints,
     vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self, double progressBegin, bool& completed)
   {
@@ -253,7 +254,7 @@ struct EvaluateWorker
     // control point of an axis, a local one over at most 4.
     auto run = [&](auto maxCount, auto basis) {
       this->Run<decltype(maxCount)::value, decltype(basis)::value>(inPoints, lattice, displacements.data(), cells,
-        gathered, inNormals, outNormals, outPoints, determinants, self, progressBegin, completed);
+        gathered, maxCellsInPlace, inNormals, outNormals, outPoints, determinants, self, progressBegin, completed);
     };
     using ffd::GridBasis;
     using Local = std::integral_constant<int, 4>;
@@ -280,7 +281,7 @@ struct EvaluateWorker
 
   template <int MaxCount, int StaticBasis, typename PointArrayT>
   void Run(PointArrayT* inPoints, const LatticeView& lattice, const Real* displacements, const int* cells,
-    const std::vector<int>& gathered, vtkDataArray* inNormals, vtkDataArray* outNormals,
+    const std::vector<int>& gathered, int maxCellsInPlace, vtkDataArray* inNormals, vtkDataArray* outNormals,
     vtkAOSDataArrayTemplate<Real>* outPoints, vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self,
     double progressBegin, bool& completed)
   {
@@ -295,7 +296,7 @@ struct EvaluateWorker
       if (!outNormals && !determinants)
       {
         LanesFunctor<Deformation, Real> lanes{ inPoints->GetPointer(0), outPoints->GetPointer(0), cells, n,
-          gathered.data(), deformation, false };
+          gathered.data(), maxCellsInPlace, deformation, false };
         const vtkIdType blocks = (n + ffd::BlockSize - 1) / ffd::BlockSize;
         const double middle = progressBegin + (1.0 - progressBegin) * double(n - vtkIdType(gathered.size())) / double(n);
         completed = vtkFFDForInChunks(self, blocks, lanes, progressBegin, middle);
@@ -338,7 +339,8 @@ vtkSmartPointer<vtkDataArray> OutputArray(
 struct vtkFFDDeform::vtkInternals
 {
   std::vector<int> Cells;    // per input point: its cell (ffd::BindToGrid), -1 where it keeps its position
-  std::vector<int> Gathered; // the points of blocks not in one cell, sorted by cell (ffd::GatherByCell)
+  std::vector<int> Gathered; // the points of blocks not deformed in place, sorted by cell (ffd::GatherByCell)
+  int MaxCellsInPlace = ffd::BlockSize; // the cell limit of the blocks deformed in place (ffd::MaxCellsInPlace)
   vtkFFDBindingKey Bound;    // what Cells and Gathered are for
   vtkFFDCudaBackend Cuda;
   vtkFFDTetrahedralDeformation Tetrahedra; // the binding and evaluation of tetrahedral lattices
@@ -537,7 +539,10 @@ int vtkFFDDeform::RequestData(
       {
         cellCount *= ffd::BindingCells(view.Basis, view.Divisions[a]);
       }
-      internals.Gathered = ffd::GatherByCell(internals.Cells.data(), numberOfPoints, cellCount);
+      internals.MaxCellsInPlace = ffd::MaxCellsInPlace(
+        view.Basis, ffd::MeanCellsPerBlock(internals.Cells.data(), numberOfPoints));
+      internals.Gathered =
+        ffd::GatherByCell(internals.Cells.data(), numberOfPoints, cellCount, internals.MaxCellsInPlace);
       internals.Bound = key;
       ++this->NumberOfBindings;
     }
@@ -551,11 +556,11 @@ int vtkFFDDeform::RequestData(
       auto* points = static_cast<RealArray*>(pointsArray.Get());
       auto* det = static_cast<RealArray*>(determinants.Get());
       if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(inPoints->GetData(), worker, view,
-            internals.Cells.data(), internals.Gathered, inNormals, outNormals.Get(), points, det, this, 0.5,
-            completed))
+            internals.Cells.data(), internals.Gathered, internals.MaxCellsInPlace, inNormals, outNormals.Get(),
+            points, det, this, 0.5, completed))
       {
-        worker(inPoints->GetData(), view, internals.Cells.data(), internals.Gathered, inNormals, outNormals.Get(),
-          points, det, this, 0.5, completed);
+        worker(inPoints->GetData(), view, internals.Cells.data(), internals.Gathered, internals.MaxCellsInPlace,
+          inNormals, outNormals.Get(), points, det, this, 0.5, completed);
       }
     };
     if (useDouble)

@@ -3,16 +3,23 @@
  * @file FFDGridLanes.h
  * @brief Deforms points W at a time on the CPU, with the widest SIMD the CPU has (host only).
  *
- * GridDeformation::Deform() instantiated on Lanes<Real, W> (FFDLanes.h) deforms W points bound to one cell at
- * once, each control point read once for all of them. The points are taken in blocks of BlockSize
- * consecutive points: a mesh whose vertices come in a spatially coherent order has most of its blocks in one
- * cell or a few (always one, for the global basis), and DeformBlocksInPlace() deforms those in place, once
- * per cell, each lane keeping the result of its own cell. The points of the other blocks are listed once, at
- * binding, sorted by cell (GatherByCell()), and DeformGathered() deforms them W at a time from that list: a
- * mesh in random vertex order costs a gather and a scatter per point, not one evaluation per cell of a block.
+ * GridDeformation's functions instantiated on Lanes<Real, W> (FFDLanes.h) deform W points at once. The points
+ * are taken in blocks of BlockSize consecutive points, and a binding chooses how (MaxCellsInPlace(), from its
+ * mean number of cells a block):
+ * - In place (DeformBlocksInPlace()), reading and writing memory in order. A lane group in one cell reads each
+ *   control point once for all lanes. A group in several cells reads each control point once per cell, kept in
+ *   the lanes of that cell (LaneCells), and then computes the weights and their sum once for all lanes
+ *   (GridDeformation::DeformInLaneCells()).
+ * - Gathered (DeformGathered()): the points of the blocks in more than MaxCellsInPlace() cells are listed once,
+ *   at binding, tile by tile, each tile's sorted by cell (GatherByCell()), and deformed W of one cell at a
+ *   time: a gather and a scatter per point, at random but within a tile that stays in cache.
+ * A mesh whose vertices come in a spatially coherent order has most of its groups in one cell and a few in two
+ * or three: it is deformed in place. A mesh in random vertex order (the 0.4 M-point armadillo of BENCHMARKS.md,
+ * 4.8 cells a block on average) would read its control points several times a group: its blocks in several
+ * cells are gathered.
  * Every lane's result depends only on its own point and cell, so a point is deformed the same whichever pass
- * takes it and however the work is split among threads. The one-point code (SimdLevel::None) computes the same function; it may differ in the last
- * bit, where the wide code fuses a multiply and an add.
+ * takes it and however the work is split among threads. The one-point code (SimdLevel::None) computes the same
+ * function; it may differ in the last bit, where the wide code fuses a multiply and an add.
  *
  * The default build must run on any x86-64, so the wide variants are compiled with GCC's target attribute
  * (AVX-512: 16 floats or 8 doubles a lane group; AVX2 and FMA: 8 or 4) and chosen at run time by
@@ -72,56 +79,109 @@ inline SimdLevel SimdLevelOfCpu()
 /// Consecutive points that DeformBlocksInPlace() takes together: a multiple of every level's lanes (16 floats).
 constexpr int BlockSize = 16;
 
-/// Blocks whose points lie in at most this many cells (-1 counts as one) are deformed in place, once per
-/// cell, with each lane taking its own cell's result; the points of the others are gathered by cell. In place
-/// reads and writes memory in order; a gather and a scatter per point cost less than more evaluations only
-/// when a block's points are scattered over many cells, as in a mesh in random vertex order (with 4, the
-/// 6.7 M-point armadillo of BENCHMARKS.md ran 2 times slower, its memory accessed at random).
-constexpr int MaxCellsInPlace = 8;
+/// The number of cells (-1 counts as one) that the points of block b (a whole one) lie in.
+inline int CellsOfBlock(const int* cells, std::int64_t b)
+{
+  const int* block = cells + b * BlockSize;
+  int count = 0;
+  for (int l = 0; l < BlockSize; ++l)
+  {
+    bool seen = false;
+    for (int k = 0; k < l; ++k)
+    {
+      seen |= block[k] == block[l];
+    }
+    count += seen ? 0 : 1;
+  }
+  return count;
+}
 
-/// True when block b (of n points) is deformed in place: it is whole and its points lie in at most
-/// MaxCellsInPlace cells.
-inline bool BlockInPlace(const int* cells, std::int64_t n, std::int64_t b)
+/// The mean of CellsOfBlock() over the whole blocks of n points (1 where there is none).
+inline double MeanCellsPerBlock(const int* cells, std::int64_t n)
+{
+  const std::int64_t blocks = n / BlockSize;
+  std::int64_t sum = 0;
+  for (std::int64_t b = 0; b < blocks; ++b)
+  {
+    sum += CellsOfBlock(cells, b);
+  }
+  return blocks > 0 ? double(sum) / double(blocks) : 1.0;
+}
+
+/**
+ * The most cells a block's points may lie in for the block to be deformed in place (BlockInPlace(),
+ * GatherByCell()), chosen for a binding from its mean number of cells per block. In place reads and writes
+ * memory in order, but a lane group in several cells reads its control points once per cell; gathering costs
+ * a gather and a scatter per point, at random within a tile of points (GatherTile), and then reads the control
+ * points once per W points. With few cells a block on average (a mesh in a spatially coherent vertex order:
+ * 1.45 for the 6.7 M-point armadillo of BENCHMARKS.md over 9^3 voxels) every block is deformed in place; with
+ * more (4.8 for the 0.4 M-point one, whose vertex order is random) only the blocks in one cell are, and the
+ * others gathered. The crossovers were measured on that mesh reordered to every mean in between (2026-11-23,
+ * BENCHMARKS.md): lower for the bases that read more control points a cell.
+ */
+inline int MaxCellsInPlace(GridBasis basis, double meanCellsPerBlock)
+{
+  double crossover = 1.5; // tricubic Bezier and cubic B-spline: 64 control points a cell
+  if (basis == GridBasis::Bernstein)
+  {
+    return BlockSize; // one cell
+  }
+  if (basis == GridBasis::Trilinear)
+  {
+    crossover = 2.2; // 8 control points a cell
+  }
+  else if (basis == GridBasis::TriquadraticBezier)
+  {
+    crossover = 1.7; // 27
+  }
+  return meanCellsPerBlock <= crossover ? BlockSize : 1;
+}
+
+/// True when block b (of n points) is deformed in place: it is whole and its points lie in at most maxCells
+/// cells (MaxCellsInPlace()).
+inline bool BlockInPlace(const int* cells, std::int64_t n, std::int64_t b, int maxCells)
 {
   const std::int64_t first = b * BlockSize;
   if (first + BlockSize > n)
   {
     return false; // the last, partial block goes to the gathered points
   }
-  int seen[MaxCellsInPlace];
-  int count = 0;
-  for (int l = 0; l < BlockSize; ++l)
+  if (maxCells >= BlockSize)
   {
-    const int cell = cells[first + l];
-    bool known = false;
-    for (int k = 0; k < count; ++k)
-    {
-      known |= seen[k] == cell;
-    }
-    if (!known)
-    {
-      if (count == MaxCellsInPlace)
-      {
-        return false;
-      }
-      seen[count++] = cell;
-    }
+    return true;
   }
-  return true;
+  if (maxCells == 1)
+  {
+    bool one = true;
+    for (int l = 1; l < BlockSize; ++l)
+    {
+      one &= cells[first + l] == cells[first];
+    }
+    return one;
+  }
+  return CellsOfBlock(cells, b) <= maxCells;
 }
 
+/// Consecutive points among which GatherByCell() sorts by cell: the gathered pass reads and writes at random
+/// only within such a tile, whose points (192 KB in and out in float32) stay in a core's L2 cache, instead of
+/// across the whole mesh (from DRAM where the mesh is larger than the caches).
+constexpr int GatherTile = 8192;
+
 /**
- * The points of the blocks not deformed in place (BlockInPlace()), sorted by cell (a stable counting sort:
- * cell -1 first, then by cell, each cell's points in input order), for DeformGathered(). `cellCount` is the
- * number of cells of the binding.
+ * The points of the blocks not deformed in place (BlockInPlace() with maxCells), tile by tile (GatherTile),
+ * each tile's sorted by cell: cell -1 first, then by cell, each cell's points in input order (two stable
+ * counting sorts: by cell, then by tile). For DeformGathered(); `cellCount` is the number of cells of the
+ * binding.
  */
-inline std::vector<int> GatherByCell(const int* cells, std::int64_t n, int cellCount)
+inline std::vector<int> GatherByCell(const int* cells, std::int64_t n, int cellCount, int maxCells)
 {
   std::vector<std::int64_t> offsets(std::size_t(cellCount) + 2, 0);
   const std::int64_t blocks = (n + BlockSize - 1) / BlockSize;
+  std::vector<bool> gather(std::size_t(blocks), false);
   for (std::int64_t b = 0; b < blocks; ++b)
   {
-    if (!BlockInPlace(cells, n, b))
+    gather[std::size_t(b)] = !BlockInPlace(cells, n, b, maxCells);
+    if (gather[std::size_t(b)])
     {
       for (std::int64_t i = b * BlockSize; i < n && i < (b + 1) * BlockSize; ++i)
       {
@@ -133,16 +193,30 @@ inline std::vector<int> GatherByCell(const int* cells, std::int64_t n, int cellC
   {
     offsets[c] += offsets[c - 1];
   }
-  std::vector<int> gathered(std::size_t(offsets.back()));
+  std::vector<int> byCell(std::size_t(offsets.back()));
   for (std::int64_t b = 0; b < blocks; ++b)
   {
-    if (!BlockInPlace(cells, n, b))
+    if (gather[std::size_t(b)])
     {
       for (std::int64_t i = b * BlockSize; i < n && i < (b + 1) * BlockSize; ++i)
       {
-        gathered[std::size_t(offsets[std::size_t(cells[i] + 1)]++)] = int(i);
+        byCell[std::size_t(offsets[std::size_t(cells[i] + 1)]++)] = int(i);
       }
     }
+  }
+  std::vector<std::int64_t> tiles(std::size_t((n + GatherTile - 1) / GatherTile) + 1, 0);
+  for (int i : byCell)
+  {
+    ++tiles[std::size_t(i / GatherTile) + 1];
+  }
+  for (std::size_t t = 1; t < tiles.size(); ++t)
+  {
+    tiles[t] += tiles[t - 1];
+  }
+  std::vector<int> gathered(byCell.size());
+  for (int i : byCell)
+  {
+    gathered[std::size_t(tiles[std::size_t(i / GatherTile)]++)] = i;
   }
   return gathered;
 }
@@ -161,98 +235,296 @@ inline void DeformOnePoint(const Deformation& deformation, const Real* in, const
 }
 
 #if FFD_HAVE_LANES
+/**
+ * The cells of a lane group, for GridDeformation::DeformInLaneCells(): each one's first control point and lanes
+ * (a mask). Count cells, or with Count 0 RuntimeCount of at most W: a count known at compile time unrolls the
+ * reading of each control point, which otherwise costs as much as the rest of the evaluation. Lanes bound to no
+ * cell take the first cell's values (and keep their position).
+ */
+template <typename Lane, typename Value, int Count>
+struct LaneCells
+{
+  static constexpr int Capacity = Count > 0 ? Count : Lane::Width;
+  int RuntimeCount;
+  const Value* Values[Capacity];
+  typename Lane::IndexVector Lanes[Capacity];
+
+  int Size() const { return Count > 0 ? Count : this->RuntimeCount; }
+};
+} // namespace detail
+
+/// Control point `index` (relative to its cell's first one) in every lane: one broadcast per cell.
+template <typename Lane, typename Value, int Count>
+struct LatticeValues<detail::LaneCells<Lane, Value, Count>>
+{
+  template <typename Real>
+  static Vec3<Real> Get(const detail::LaneCells<Lane, Value, Count>* cells, int index)
+  {
+    const Value* v = cells->Values[0] + 3 * index;
+    Vec3<Real> value = { Real(v[0]), Real(v[1]), Real(v[2]) };
+    for (int c = 1; c < cells->Size(); ++c)
+    {
+      v = cells->Values[c] + 3 * index;
+      const typename Lane::IndexVector& lanes = cells->Lanes[c];
+      value = { Select(lanes, Real(v[0]), value.x), Select(lanes, Real(v[1]), value.y),
+        Select(lanes, Real(v[2]), value.z) };
+    }
+    return value;
+  }
+};
+
+namespace detail
+{
+/**
+ * BindToGrid()'s flat cell index taken apart as GridDeformation::CellIndices() does, by multiplications: the
+ * two integer divisions by run-time divisors cost as much as the rest of the set-up of a lane group. For a
+ * divisor d in [1, 2^31), q = floor(n M / 2^63) with M = floor(2^63 / d) + 1 is floor(n / d) for every n in
+ * [0, 2^31): n M / 2^63 exceeds n / d by less than 2^-32, less than the 1/d by which n / d stays below the next
+ * integer.
+ */
+class CellSplit
+{
+public:
+  template <typename Deformation>
+  explicit CellSplit(const Deformation& deformation)
+  {
+    for (int a = 0; a < 2; ++a)
+    {
+      this->Cells[a] = BindingCells(deformation.BasisOf(), deformation.Voxels[a]);
+      this->Inverse[a] = (std::uint64_t(1) << 63) / std::uint64_t(this->Cells[a]) + 1;
+    }
+  }
+
+  void Split(int cell, int c[3]) const
+  {
+    for (int a = 0; a < 2; ++a)
+    {
+      const int q = int((unsigned __int128)std::uint64_t(cell) * this->Inverse[a] >> 63);
+      c[a] = cell - q * this->Cells[a];
+      cell = q;
+    }
+    c[2] = cell;
+  }
+
+private:
+  int Cells[2];
+  std::uint64_t Inverse[2];
+};
+
+/// The flat index of the first control point of a cell (not -1) of a local basis, and the cell's index along
+/// each axis in every lane.
+template <typename Deformation, typename Lane>
+inline int FirstOfCell(const Deformation& deformation, const CellSplit& split, int cell, Vec3<Lane>& index)
+{
+  int c[3], first[3], count;
+  split.Split(cell, c);
+  for (int a = 0; a < 3; ++a)
+  {
+    VoxelSupport(deformation.BasisOf(), deformation.Voxels[a], c[a], first[a], count);
+  }
+  index = { Lane(c[0]), Lane(c[1]), Lane(c[2]) };
+  return first[0] + deformation.Dims[0] * (first[1] + deformation.Dims[1] * first[2]);
+}
+
+/**
+ * A lane group whose lanes lie in `count` (Count, where not 0) cells of a local basis: cells[k] is the k-th
+ * cell, lanes[k] its lanes.
+ */
+template <int Count, typename Deformation, typename Wide, typename Lane>
+inline Vec3<Lane> DeformInCells(const Deformation& deformation, const Wide& wide, const CellSplit& split,
+  const int* cells, const typename Lane::IndexVector* lanes, int count, const Vec3<Lane>& x)
+{
+  LaneCells<Lane, typename Deformation::Value, Count> values;
+  values.RuntimeCount = count;
+  Vec3<Lane> index;
+  for (int k = 0; k < values.Size(); ++k)
+  {
+    Vec3<Lane> ci;
+    values.Values[k] = deformation.Displacements + 3 * FirstOfCell(deformation, split, cells[k], ci);
+    values.Lanes[k] = lanes[k];
+    index = k == 0 ? ci
+                   : Vec3<Lane>{ Select(lanes[k], ci.x, index.x), Select(lanes[k], ci.y, index.y),
+                       Select(lanes[k], ci.z, index.z) };
+  }
+  return wide.DeformInLaneCells(x, index, &values);
+}
+
+template <typename Lane>
+inline typename Lane::IndexVector LaneCellsOf(const int* cells)
+{
+  typedef int CellVector __attribute__((vector_size(Lane::Width * sizeof(int))));
+  CellVector narrow;
+  std::memcpy(&narrow, cells, sizeof(narrow));
+  return __builtin_convertvector(narrow, typename Lane::IndexVector);
+}
+
+/// Lane groups of the in-place pass (of a local basis) whose lanes are not all in one cell.
+template <typename Lane, typename Deformation, typename Wide, typename Real>
+inline void DeformInSeveralCells(const Deformation& deformation, const Wide& wide, const CellSplit& split,
+  const Real* in, const int* cells, Real* out, const std::int64_t* groups, int groupCount)
+{
+  using Mask = typename Lane::IndexVector;
+  for (int g = 0; g < groupCount; ++g)
+  {
+    const std::int64_t i = groups[g];
+    Vec3<Lane> x;
+    Lane::Deinterleave3(in + 3 * i, x.x, x.y, x.z);
+    const Mask cell = LaneCellsOf<Lane>(cells + i);
+    const Mask bound = cell >= Mask{};
+    int distinct[Lane::Width];
+    Mask lanes[Lane::Width];
+    int count = 0;
+    for (unsigned todo = Lane::Bits(bound); todo != 0; ++count)
+    {
+      distinct[count] = cells[i + __builtin_ctz(todo)];
+      lanes[count] = cell == Mask{} + typename Lane::Index(distinct[count]);
+      todo &= ~Lane::Bits(lanes[count]);
+    }
+    Vec3<Lane> yc = x;
+    if (count == 1)
+    {
+      int c[3];
+      split.Split(distinct[0], c);
+      yc = wide.DeformInCell(x, c);
+    }
+    else if (count == 2)
+    {
+      yc = DeformInCells<2>(deformation, wide, split, distinct, lanes, count, x);
+    }
+    else if (count == 3)
+    {
+      yc = DeformInCells<3>(deformation, wide, split, distinct, lanes, count, x);
+    }
+    else if (count > 3)
+    {
+      yc = DeformInCells<0>(deformation, wide, split, distinct, lanes, count, x);
+    }
+    const Vec3<Lane> y = { Select(bound, yc.x, x.x), Select(bound, yc.y, x.y), Select(bound, yc.z, x.z) };
+    Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
+  }
+}
+
 template <int W, typename Deformation, typename Real>
 inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in, const int* cells, Real* out,
-  std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd)
+  std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd, int maxCells)
 {
   static_assert(BlockSize % W == 0, "a block is a whole number of lane groups");
   using Lane = Lanes<Real, W>;
   using Mask = typename Lane::IndexVector;
   const auto wide = deformation.template WithLanes<Lane>();
-  for (std::int64_t b = blockBegin; b < blockEnd; ++b)
+  const bool global = deformation.BasisOf() == GridBasis::Bernstein;
+  const CellSplit split(deformation);
+  // Lane groups in several cells (or with lanes bound to no cell) are deformed after the others of a window of
+  // blocks, still in cache: kept out of the loop over the window, their code leaves that loop's registers to
+  // the common case.
+  constexpr int Window = 64;
+  std::int64_t several[Window * BlockSize / W];
+  for (std::int64_t window = blockBegin; window < blockEnd; window += Window)
   {
-    if (!BlockInPlace(cells, n, b))
+    int severalCount = 0;
+    for (std::int64_t b = window; b < blockEnd && b < window + Window; ++b)
     {
-      continue;
-    }
-    for (std::int64_t i = b * BlockSize; i < (b + 1) * BlockSize; i += W)
-    {
-      Vec3<Lane> x;
-      Lane::Deinterleave3(in + 3 * i, x.x, x.y, x.z);
-      bool one = cells[i] >= 0; // the common case first: the W points in one cell
-      for (int l = 1; l < W; ++l)
+      if (!BlockInPlace(cells, n, b, maxCells))
       {
-        one &= cells[i + l] == cells[i];
-      }
-      if (one)
-      {
-        const Vec3<Lane> y = wide.Deform(x, int(cells[i]));
-        Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
         continue;
       }
-      Vec3<Lane> y = x; // lanes of cell -1 keep their position
-      bool done[W] = {};
-      for (int first = 0; first < W; ++first)
+      for (std::int64_t i = b * BlockSize; i < (b + 1) * BlockSize; i += W)
       {
-        const int cell = cells[i + first];
-        if (done[first] || cell < 0)
+        const int first = cells[i];
+        const Mask cell = LaneCellsOf<Lane>(cells + i);
+        if (!global && Lane::Bits(cell == Mask{} + typename Lane::Index(first)) != (1u << W) - 1)
         {
+          several[severalCount++] = i;
           continue;
         }
-        Mask mine;
-        for (int l = 0; l < W; ++l)
+        Vec3<Lane> x;
+        Lane::Deinterleave3(in + 3 * i, x.x, x.y, x.z);
+        Vec3<Lane> y = x; // lanes of cell -1 keep their position
+        if (global)
         {
-          const bool same = cells[i + l] == cell;
-          mine[l] = same ? -1 : 0;
-          done[l] = done[l] || same;
+          // The global basis has one cell, 0.
+          const Mask bound = cell >= Mask{};
+          const Vec3<Lane> yc = wide.Deform(x, 0);
+          y = { Select(bound, yc.x, x.x), Select(bound, yc.y, x.y), Select(bound, yc.z, x.z) };
         }
-        const Vec3<Lane> yc = wide.Deform(x, cell);
-        y = { Select(mine, yc.x, y.x), Select(mine, yc.y, y.y), Select(mine, yc.z, y.z) };
+        else if (first >= 0)
+        {
+          // One cell: each control point read once for all lanes.
+          int c[3];
+          split.Split(first, c);
+          y = wide.DeformInCell(x, c);
+        }
+        Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
       }
-      Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
     }
+    DeformInSeveralCells<Lane>(deformation, wide, split, in, cells, out, several, severalCount);
   }
 }
+
+/// Lanes that the gathered pass stages at once: up to this many points, in groups of W of one cell.
+constexpr int GatherStage = 512;
 
 template <int W, typename Deformation, typename Real>
 inline void GatheredInLanes(const Deformation& deformation, const Real* in, const int* cells, const int* gathered,
   Real* out, std::int64_t begin, std::int64_t end)
 {
+  static_assert(GatherStage % W == 0, "whole lane groups");
   using Lane = Lanes<Real, W>;
   const auto wide = deformation.template WithLanes<Lane>();
-  Real staged[3 * W] = {};
+  // Points are copied into `staged` a batch of lane groups at a time, deformed there, and copied out: a lane
+  // group loaded right after its points were stored one by one would wait for the stores (no store-to-load
+  // forwarding from several stores into one load), for longer than its deformation takes.
+  alignas(64) Real staged[3 * GatherStage];
+  int groupCell[GatherStage / W], groupSize[GatherStage / W];
   std::int64_t g = begin;
   while (g < end)
   {
-    // Up to W listed points of one cell; unused lanes repeat the first point and are not written back.
-    const int cell = cells[gathered[g]];
-    int count = 1;
-    while (count < W && g + count < end && cells[gathered[g + count]] == cell)
+    const std::int64_t batch = g;
+    int groups = 0;
+    while (g < end && groups < GatherStage / W)
     {
-      ++count;
+      // Up to W listed points of one cell; unused lanes repeat the first point and are not written back.
+      const int cell = cells[gathered[g]];
+      int count = 1;
+      while (count < W && g + count < end && cells[gathered[g + count]] == cell)
+      {
+        ++count;
+      }
+      Real* lanes = staged + 3 * W * groups;
+      for (int l = 0; l < W; ++l)
+      {
+        const std::int64_t i = gathered[g + (l < count ? l : 0)];
+        lanes[3 * l] = in[3 * i];
+        lanes[3 * l + 1] = in[3 * i + 1];
+        lanes[3 * l + 2] = in[3 * i + 2];
+      }
+      groupCell[groups] = cell;
+      groupSize[groups++] = count;
+      g += count;
     }
-    for (int l = 0; l < W; ++l)
+    for (int k = 0; k < groups; ++k)
     {
-      const std::int64_t i = gathered[g + (l < count ? l : 0)];
-      staged[3 * l] = in[3 * i];
-      staged[3 * l + 1] = in[3 * i + 1];
-      staged[3 * l + 2] = in[3 * i + 2];
+      if (groupCell[k] >= 0)
+      {
+        Real* lanes = staged + 3 * W * k;
+        Vec3<Lane> x;
+        Lane::Deinterleave3(lanes, x.x, x.y, x.z);
+        const Vec3<Lane> y = wide.Deform(x, groupCell[k]);
+        Lane::Interleave3(y.x, y.y, y.z, lanes);
+      }
     }
-    if (cell >= 0)
+    std::int64_t listed = batch;
+    for (int k = 0; k < groups; ++k)
     {
-      Vec3<Lane> x;
-      Lane::Deinterleave3(staged, x.x, x.y, x.z);
-      const Vec3<Lane> y = wide.Deform(x, cell);
-      Lane::Interleave3(y.x, y.y, y.z, staged);
+      const Real* lanes = staged + 3 * W * k;
+      for (int l = 0; l < groupSize[k]; ++l)
+      {
+        const std::int64_t i = gathered[listed++];
+        out[3 * i] = lanes[3 * l];
+        out[3 * i + 1] = lanes[3 * l + 1];
+        out[3 * i + 2] = lanes[3 * l + 2];
+      }
     }
-    for (int l = 0; l < count; ++l)
-    {
-      const std::int64_t i = gathered[g + l];
-      out[3 * i] = staged[3 * l];
-      out[3 * i + 1] = staged[3 * l + 1];
-      out[3 * i + 2] = staged[3 * l + 2];
-    }
-    g += count;
   }
 }
 
@@ -260,9 +532,9 @@ inline void GatheredInLanes(const Deformation& deformation, const Real* in, cons
 #define FFD_LANE_VARIANTS(Suffix, Target, Bytes)                                                              \
   template <typename Deformation, typename Real>                                                              \
   Target void BlocksInPlace##Suffix(const Deformation& deformation, const Real* in, const int* cells, Real* out, \
-    std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd)                                           \
+    std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd, int maxCells)                             \
   {                                                                                                           \
-    BlocksInPlaceInLanes<Bytes / sizeof(Real)>(deformation, in, cells, out, n, blockBegin, blockEnd);         \
+    BlocksInPlaceInLanes<Bytes / sizeof(Real)>(deformation, in, cells, out, n, blockBegin, blockEnd, maxCells); \
   }                                                                                                           \
   template <typename Deformation, typename Real>                                                              \
   Target void Gathered##Suffix(const Deformation& deformation, const Real* in, const int* cells,              \
@@ -279,30 +551,30 @@ FFD_LANE_VARIANTS(SSE2, FFD_TARGET_SSE2, 16)
 
 /**
  * First pass: out = the deformation of in for the points of blocks [blockBegin, blockEnd) that are deformed in
- * place (BlockInPlace()); the others are left to DeformGathered(). 3 values per point
- * (x y z), n points, cells[i] from BindToGrid() (-1: the point keeps its position). `level` at most
- * SimdLevelOfCpu().
+ * place (BlockInPlace() with maxCells, the value given to GatherByCell()); the others are left to
+ * DeformGathered(). 3 values per point (x y z), n points, cells[i] from BindToGrid() (-1: the point keeps its
+ * position). `level` at most SimdLevelOfCpu().
  */
 template <typename Deformation, typename Real>
 inline void DeformBlocksInPlace(SimdLevel level, const Deformation& deformation, const Real* in, const int* cells,
-  Real* out, std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd)
+  Real* out, std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd, int maxCells)
 {
 #if FFD_HAVE_LANES
   switch (level)
   {
     case SimdLevel::AVX512:
-      return detail::BlocksInPlaceAVX512(deformation, in, cells, out, n, blockBegin, blockEnd);
+      return detail::BlocksInPlaceAVX512(deformation, in, cells, out, n, blockBegin, blockEnd, maxCells);
     case SimdLevel::AVX2:
-      return detail::BlocksInPlaceAVX2(deformation, in, cells, out, n, blockBegin, blockEnd);
+      return detail::BlocksInPlaceAVX2(deformation, in, cells, out, n, blockBegin, blockEnd, maxCells);
     case SimdLevel::SSE2:
-      return detail::BlocksInPlaceSSE2(deformation, in, cells, out, n, blockBegin, blockEnd);
+      return detail::BlocksInPlaceSSE2(deformation, in, cells, out, n, blockBegin, blockEnd, maxCells);
     case SimdLevel::None:
       break;
   }
 #endif
   for (std::int64_t b = blockBegin; b < blockEnd; ++b)
   {
-    if (BlockInPlace(cells, n, b))
+    if (BlockInPlace(cells, n, b, maxCells))
     {
       for (std::int64_t i = b * BlockSize; i < (b + 1) * BlockSize; ++i)
       {

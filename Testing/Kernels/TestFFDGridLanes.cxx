@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Deformation of many points at once in SIMD lanes (FFDGridLanes.h, FFDLanes.h), at every instruction-set level
-// this CPU runs, for every basis: against the float64 reference ffdref::DeformLocal; a point's result the same
-// bit for bit whichever pass deforms it, whatever its neighbours and however the range is split; the list of
-// gathered points.
+// this CPU runs, for every basis, with lane groups in one cell and in many: against the float64 reference
+// ffdref::DeformLocal; a point's result the same bit for bit whichever pass deforms it, whatever its neighbours
+// and however the range is split; the list of gathered points.
 
 #include "FFDGridLanes.h"
 #include "FFDKernelTestUtilities.h"
@@ -99,10 +99,11 @@ PointSet<Real> MeshLikePoints(ffdtest::Rng& rng, const GridLattice& lat, const K
   return set;
 }
 
-/// Both passes over the whole set, the ranges cut at the given points (sorted, within the ranges).
+/// Both passes over the whole set with blocks in at most maxCells cells in place, the ranges cut at the given
+/// points (sorted, within the ranges).
 template <typename D, typename Real>
 std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Real>& set,
-  const std::vector<int>& gathered, const std::vector<std::int64_t>& blockCuts = {},
+  const std::vector<int>& gathered, int maxCells, const std::vector<std::int64_t>& blockCuts = {},
   const std::vector<std::int64_t>& gatheredCuts = {})
 {
   std::vector<Real> out(set.Values.size(), std::numeric_limits<Real>::quiet_NaN()); // poisoned
@@ -110,10 +111,12 @@ std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Rea
   std::int64_t begin = 0;
   for (std::int64_t cut : blockCuts)
   {
-    ffd::DeformBlocksInPlace(level, d, set.Values.data(), set.Cells.data(), out.data(), set.Size(), begin, cut);
+    ffd::DeformBlocksInPlace(
+      level, d, set.Values.data(), set.Cells.data(), out.data(), set.Size(), begin, cut, maxCells);
     begin = cut;
   }
-  ffd::DeformBlocksInPlace(level, d, set.Values.data(), set.Cells.data(), out.data(), set.Size(), begin, blocks);
+  ffd::DeformBlocksInPlace(
+    level, d, set.Values.data(), set.Cells.data(), out.data(), set.Size(), begin, blocks, maxCells);
   begin = 0;
   for (std::int64_t cut : gatheredCuts)
   {
@@ -123,6 +126,14 @@ std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Rea
   ffd::DeformGathered(level, d, set.Values.data(), set.Cells.data(), gathered.data(), out.data(), begin,
     std::int64_t(gathered.size()));
   return out;
+}
+
+/// The cell limits of the in-place pass that the tests try: every block gathered but those in one cell (what
+/// the filter chooses for a mesh in random order), at most 4 cells, and every block in place (lane groups of up
+/// to W cells: what the filter chooses for a mesh in a coherent order).
+std::vector<int> MaxCellsToTry()
+{
+  return { 1, 4, ffd::BlockSize };
 }
 
 int CellCount(const GridLattice& lat)
@@ -139,9 +150,10 @@ TYPED_TEST_SUITE(FFDGridLanesTest, RealTypes);
 
 TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
 {
-  // Every basis and level, random lattices, 1001 mesh-like points into a NaN-poisoned output: every point is
-  // written, points outside keep their position exactly, the others match ffdref::DeformLocal within
-  // ffdtest::PositionTolerance() (1e-12 in double, 1e-6 in float, relative to the lattice's scale).
+  // Every basis, level and in-place cell limit, random lattices, 1001 mesh-like points into a NaN-poisoned
+  // output: every point is written, points outside keep their position exactly, the others match
+  // ffdref::DeformLocal within ffdtest::PositionTolerance() (1e-12 in double, 1e-6 in float, relative to the
+  // lattice's scale).
   using Real = TypeParam;
   ffdtest::Rng rng(601);
   ffdtest::WorstRatio worst("worst_error_over_tolerance");
@@ -153,27 +165,32 @@ TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
       const double scale = ffdtest::LatticeScale(lat.Points);
       ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
         const PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 1001);
-        const std::vector<int> gathered = ffd::GatherByCell(set.Cells.data(), set.Size(), CellCount(lat));
-        for (ffd::SimdLevel level : Levels())
+        for (int maxCells : MaxCellsToTry())
         {
-          const std::vector<Real> out = DeformAll(level, k.D, set, gathered);
-          for (std::int64_t i = 0; i < set.Size(); ++i)
+          const std::vector<int> gathered =
+            ffd::GatherByCell(set.Cells.data(), set.Size(), CellCount(lat), maxCells);
+          for (ffd::SimdLevel level : Levels())
           {
-            const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&set.Values[3 * i]);
-            const ffd::Vec3<Real> y = ffd::Vec3<Real>::From(&out[3 * i]);
-            const std::string where = lat.Name() + " level " + LevelName(level) + " point " + std::to_string(i);
-            if (set.Cells[i] < 0)
+            const std::vector<Real> out = DeformAll(level, k.D, set, gathered, maxCells);
+            for (std::int64_t i = 0; i < set.Size(); ++i)
             {
-              ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
-              continue;
+              const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&set.Values[3 * i]);
+              const ffd::Vec3<Real> y = ffd::Vec3<Real>::From(&out[3 * i]);
+              const std::string where = lat.Name() + " level " + LevelName(level) + " in place up to " +
+                std::to_string(maxCells) + " cells, point " + std::to_string(i);
+              if (set.Cells[i] < 0)
+              {
+                ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
+                continue;
+              }
+              ffd::Mat3<Real> j;
+              k.D.Deform(x, set.Cells[i], j);
+              const Vec xd = ffdtest::ToRef(x);
+              const Vec want = ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, xd);
+              const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
+              worst.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
+              ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
             }
-            ffd::Mat3<Real> j;
-            k.D.Deform(x, set.Cells[i], j);
-            const Vec xd = ffdtest::ToRef(x);
-            const Vec want = ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, xd);
-            const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
-            worst.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
-            ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
           }
         }
       });
@@ -184,20 +201,19 @@ TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
 TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
 {
   // At each level, a point's result is the same bit for bit: in its mesh order, split into random sub-ranges
-  // (as threads split it), and in a shuffled order, where most points are gathered rather than deformed in
-  // place.
+  // (as threads split it), in a shuffled order (lane groups of many cells), and whichever pass takes it: with
+  // every block gathered but those in one cell, with the filter's cell limit, and with every block in place.
   using Real = TypeParam;
   ffdtest::Rng rng(602);
   for (Basis b : ffdtest::AllBases)
   {
     GridLattice lat;
-    do // enough cells that shuffled blocks span more than MaxCellsInPlace of them
+    do // enough cells that shuffled blocks span more than a few of them
     {
       lat = ffdtest::RandomGridLattice(rng, b, 5);
     } while (b != Basis::Bernstein && CellCount(lat) < 16);
     ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
       const PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 2003);
-      const std::vector<int> gathered = ffd::GatherByCell(set.Cells.data(), set.Size(), CellCount(lat));
       std::vector<std::int64_t> order(std::size_t(set.Size()));
       std::iota(order.begin(), order.end(), 0);
       std::shuffle(order.begin(), order.end(), rng);
@@ -206,12 +222,6 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
       {
         shuffled.Values.insert(shuffled.Values.end(), &set.Values[3 * i], &set.Values[3 * i] + 3);
         shuffled.Cells.push_back(set.Cells[i]);
-      }
-      const std::vector<int> shuffledGathered =
-        ffd::GatherByCell(shuffled.Cells.data(), shuffled.Size(), CellCount(lat));
-      if (b != Basis::Bernstein) // its points lie in one cell, or outside
-      {
-        ASSERT_GT(shuffledGathered.size(), gathered.size()) << lat.Name();
       }
 
       auto cuts = [&](std::int64_t n) {
@@ -225,18 +235,36 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
       };
       for (ffd::SimdLevel level : Levels())
       {
-        const std::vector<Real> whole = DeformAll(level, k.D, set, gathered);
-        const std::vector<Real> split = DeformAll(level, k.D, set, gathered,
-          cuts((set.Size() + ffd::BlockSize - 1) / ffd::BlockSize), cuts(std::int64_t(gathered.size())));
-        const std::vector<Real> reordered = DeformAll(level, k.D, shuffled, shuffledGathered);
-        for (std::size_t p = 0; p < order.size(); ++p)
+        std::vector<Real> first; // the result of the first cell limit, which the others must give
+        for (int maxCells : MaxCellsToTry())
         {
-          const std::size_t i = std::size_t(order[p]);
-          for (int c = 0; c < 3; ++c)
+          const std::vector<int> gathered =
+            ffd::GatherByCell(set.Cells.data(), set.Size(), CellCount(lat), maxCells);
+          const std::vector<int> shuffledGathered =
+            ffd::GatherByCell(shuffled.Cells.data(), shuffled.Size(), CellCount(lat), maxCells);
+          if (b != Basis::Bernstein && maxCells < ffd::BlockSize) // its points lie in one cell, or outside
           {
-            ASSERT_EQ(split[3 * i + c], whole[3 * i + c]) << lat.Name() << " " << LevelName(level) << " point " << i;
-            ASSERT_EQ(reordered[3 * p + c], whole[3 * i + c])
-              << lat.Name() << " " << LevelName(level) << " point " << i;
+            ASSERT_GT(shuffledGathered.size(), gathered.size()) << lat.Name();
+          }
+          const std::vector<Real> whole = DeformAll(level, k.D, set, gathered, maxCells);
+          const std::vector<Real> split = DeformAll(level, k.D, set, gathered, maxCells,
+            cuts((set.Size() + ffd::BlockSize - 1) / ffd::BlockSize), cuts(std::int64_t(gathered.size())));
+          const std::vector<Real> reordered = DeformAll(level, k.D, shuffled, shuffledGathered, maxCells);
+          if (first.empty())
+          {
+            first = whole;
+          }
+          for (std::size_t p = 0; p < order.size(); ++p)
+          {
+            const std::size_t i = std::size_t(order[p]);
+            const std::string where = lat.Name() + " " + LevelName(level) + " in place up to " +
+              std::to_string(maxCells) + " cells, point " + std::to_string(i);
+            for (int c = 0; c < 3; ++c)
+            {
+              ASSERT_EQ(whole[3 * i + c], first[3 * i + c]) << where;
+              ASSERT_EQ(split[3 * i + c], whole[3 * i + c]) << where;
+              ASSERT_EQ(reordered[3 * p + c], whole[3 * i + c]) << where;
+            }
           }
         }
       }
@@ -246,14 +274,15 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
 
 TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
 {
-  // 3 full blocks and a partial one: block 0 in cell 5 and block 2 in cells -1 and 3 are deformed in place;
-  // block 1 spans MaxCellsInPlace + 2 cells (-1 included) and the partial tail are gathered: their points,
-  // stably sorted by cell with -1 first.
+  // 3 full blocks and a partial one, at most 8 cells a block in place: block 0 in cell 5 and block 2 in cells -1
+  // and 3 are deformed in place; block 1 spans 10 cells (-1 included) and the partial tail are gathered: their
+  // points, stably sorted by cell with -1 first. With a limit of BlockSize every full block is in place.
+  const int maxCells = 8;
   const int n = 3 * ffd::BlockSize + 5;
   std::vector<int> cells(n, 5);
   for (int i = ffd::BlockSize; i < 2 * ffd::BlockSize; ++i)
   {
-    cells[i] = i % (ffd::MaxCellsInPlace + 2) - 1;
+    cells[i] = i % (maxCells + 2) - 1;
   }
   for (int i = 2 * ffd::BlockSize; i < 3 * ffd::BlockSize; ++i)
   {
@@ -262,7 +291,7 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
   const int tail[5] = { 7, 2, 7, -1, 0 };
   std::copy(tail, tail + 5, cells.begin() + 3 * ffd::BlockSize);
 
-  std::vector<int> expected;
+  std::vector<int> expected, expectedTail;
   for (int cell = -1; cell < 8; ++cell)
   {
     for (int i = 0; i < n; ++i)
@@ -272,13 +301,62 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
       {
         expected.push_back(i);
       }
+      if (i >= 3 * ffd::BlockSize && cells[i] == cell)
+      {
+        expectedTail.push_back(i);
+      }
     }
   }
-  EXPECT_EQ(ffd::GatherByCell(cells.data(), n, 8), expected);
-  EXPECT_TRUE(ffd::BlockInPlace(cells.data(), n, 0));
-  EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 1));
-  EXPECT_TRUE(ffd::BlockInPlace(cells.data(), n, 2));
-  EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 3));
+  EXPECT_EQ(ffd::GatherByCell(cells.data(), n, 8, maxCells), expected);
+  EXPECT_TRUE(ffd::BlockInPlace(cells.data(), n, 0, maxCells));
+  EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 1, maxCells));
+  EXPECT_TRUE(ffd::BlockInPlace(cells.data(), n, 2, maxCells));
+  EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 3, maxCells));
+  EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 1, 9));
+  EXPECT_TRUE(ffd::BlockInPlace(cells.data(), n, 1, 10));
+  EXPECT_EQ(ffd::GatherByCell(cells.data(), n, 8, ffd::BlockSize), expectedTail);
+
+  // The mean over the whole blocks, and the limits it gives: every block in place for a trilinear lattice at
+  // a mean of 2 or less, only the blocks in one cell above it (and never for the global basis).
+  EXPECT_EQ(ffd::CellsOfBlock(cells.data(), 1), maxCells + 2);
+  EXPECT_DOUBLE_EQ(ffd::MeanCellsPerBlock(cells.data(), n), (1.0 + (maxCells + 2) + 2.0) / 3.0);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 2.0), ffd::BlockSize);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 4.8), 1);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::CubicBSpline, 2.0), 1);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Bernstein, 16.0), ffd::BlockSize);
+}
+
+TEST(FFDGridLanes, CellSplitTakesTheFlatIndexApart)
+{
+  // The in-place pass takes a cell index apart by multiplications (detail::CellSplit): the same indices as
+  // GridDeformation::CellIndices()'s divisions, for small, prime and large divisors, at the ends of the range.
+  ffdtest::Rng rng(603);
+  for (int dx : { 1, 2, 3, 7, 9, 255, 1000, 46340 })
+  {
+    for (int dy : { 1, 5, 64, 46339 })
+    {
+      ffd::GridDeformation<4, double> d{};
+      d.Basis = ffd::GridBasis::Trilinear;
+      d.Voxels[0] = dx;
+      d.Voxels[1] = dy;
+      d.Voxels[2] = 1;
+      const ffd::detail::CellSplit split(d);
+      std::vector<int> cells = { 0, 1, dx - 1, dx, dx * dy - 1, std::numeric_limits<int>::max(),
+        std::numeric_limits<int>::max() - 1 };
+      for (int k = 0; k < 1000; ++k)
+      {
+        cells.push_back(std::uniform_int_distribution<int>(0, std::numeric_limits<int>::max())(rng));
+      }
+      for (int cell : cells)
+      {
+        int want[3], got[3];
+        d.CellIndices(cell, want);
+        split.Split(cell, got);
+        ASSERT_TRUE(want[0] == got[0] && want[1] == got[1] && want[2] == got[2])
+          << "cell " << cell << " divisors " << dx << " " << dy;
+      }
+    }
+  }
 }
 
 } // namespace
