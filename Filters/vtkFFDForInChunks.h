@@ -13,12 +13,14 @@
 
 /**
  * Runs functor(begin, end) over [0, n) as a few vtkSMPTools::For calls, so that progress is reported and abort
- * honoured between them (never from inside an SMP body). `self` may be null. Returns false when aborted.
+ * honoured between them (never from inside an SMP body). `self` may be null. Returns false when aborted. A
+ * chunk is at least 2^20 items (points, or blocks of 16): each call starts and joins the threads, which cost a
+ * tenth of an evaluation of 0.4 M points split into 6 calls.
  */
 template <typename Functor>
 bool vtkFFDForInChunks(vtkAlgorithm* self, vtkIdType n, Functor& functor, double progressBegin, double progressEnd)
 {
-  const vtkIdType chunks = std::max<vtkIdType>(1, std::min<vtkIdType>(10, n / 65536));
+  const vtkIdType chunks = std::max<vtkIdType>(1, std::min<vtkIdType>(10, n >> 20));
   for (vtkIdType c = 0; c < chunks; ++c)
   {
     if (self && self->GetAbortExecute())
