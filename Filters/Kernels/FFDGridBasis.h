@@ -321,9 +321,9 @@ FFD_INLINE Vec3<Real> SumTensorProduct(const Value* values, const int dims[3], c
 }
 
 /// SumTensorProduct() and its derivatives with respect to (s, t, u): gradient's columns are d/ds, d/dt, d/du.
-template <int MaxCount, typename Real>
+template <int MaxCount, typename Real, typename Value>
 FFD_INLINE Vec3<Real> SumTensorProductWithGradient(
-  const Real* values, const int dims[3], const AxisWeights<MaxCount, Real>* axes, Mat3<Real>& gradient)
+  const Value* values, const int dims[3], const AxisWeights<MaxCount, Real>* axes, Mat3<Real>& gradient)
 {
   const Vec3<Real> zero = { 0, 0, 0 };
   Vec3<Real> sum = zero, sumS = zero, sumT = zero, sumU = zero;
@@ -342,7 +342,7 @@ FFD_INLINE Vec3<Real> SumTensorProductWithGradient(
       {
         break;
       }
-      const Real* v = values + 3 * (axes[0].First + dims[0] * ((axes[1].First + j) + dims[1] * (axes[2].First + k)));
+      const int row = axes[0].First + dims[0] * ((axes[1].First + j) + dims[1] * (axes[2].First + k));
       Vec3<Real> valI = zero, valIS = zero;
       FFD_UNROLL
       for (int i = 0; i < detail::LoopCount(axes[0]); ++i)
@@ -351,7 +351,7 @@ FFD_INLINE Vec3<Real> SumTensorProductWithGradient(
         {
           break;
         }
-        const Vec3<Real> p = { v[3 * i], v[3 * i + 1], v[3 * i + 2] };
+        const Vec3<Real> p = LatticeValues<Value>::template Get<Real>(values, row + i);
         valI = valI + axes[0].W[i] * p;
         valIS = valIS + axes[0].D[i] * p;
       }

@@ -140,18 +140,8 @@ struct GridDeformation
   template <typename Values>
   Vec3<Lane> DeformInLaneCells(const Vec3<Lane>& x, const Vec3<Lane>& cell, const Values* values) const
   {
-    const GridBasis basis = this->BasisOf();
-    const Vec3<Lane> stu = this->Frame.ToParametric(x);
-    const Lane p[3] = { stu.x, stu.y, stu.z };
-    const Lane c[3] = { cell.x, cell.y, cell.z };
     AxisWeights<MaxCount, Lane> axes[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      // As ComputeAxisWeights() does for one cell.
-      const Lane n = Lane(this->Voxels[a]);
-      axes[a].First = 0;
-      ComputeLocalAxisWeights(basis, n, Clamp01(p[a] * n - c[a]), false, axes[a]);
-    }
+    this->LaneCellWeights(this->Frame.ToParametric(x), cell, false, axes);
     return x + SumTensorProduct(values, this->Dims, axes);
   }
 
@@ -169,7 +159,7 @@ struct GridDeformation
     c[2] = cell; // the last axis takes what is left: no division
   }
 
-  /// Deform() and the Jacobian dX_ffd/dX there (one lane: Lane = Real).
+  /// Deform() and the Jacobian dX_ffd/dX there.
   FFD_INLINE Vec3<Lane> Deform(const Vec3<Lane>& x, int cell, Mat3<Lane>& jacobian) const
   {
     const Vec3<Lane> stu = this->Frame.ToParametric(x);
@@ -179,19 +169,57 @@ struct GridDeformation
     this->Weights(stu, c, true, axes);
     Mat3<Lane> gradient;
     const Vec3<Lane> d = SumTensorProductWithGradient(this->Displacements, this->Dims, axes, gradient);
-    const Lane lo = -ParametricTolerance<Lane>(), hi = Lane(1) + ParametricTolerance<Lane>();
-    for (int a = 0; a < 3; ++a)
-    {
-      if (!(stu[a] >= lo && stu[a] <= hi)) // clamped: the displacement does not change along this direction
-      {
-        gradient.M[0][a] = gradient.M[1][a] = gradient.M[2][a] = Lane(0);
-      }
-    }
-    jacobian = DeformationJacobian(gradient, this->Frame);
+    jacobian = this->JacobianAt(stu, gradient);
+    return x + d;
+  }
+
+  /// DeformInLaneCells() and the Jacobian dX_ffd/dX there.
+  template <typename Values>
+  Vec3<Lane> DeformInLaneCells(
+    const Vec3<Lane>& x, const Vec3<Lane>& cell, const Values* values, Mat3<Lane>& jacobian) const
+  {
+    const Vec3<Lane> stu = this->Frame.ToParametric(x);
+    AxisWeights<MaxCount, Lane> axes[3];
+    this->LaneCellWeights(stu, cell, true, axes);
+    Mat3<Lane> gradient;
+    const Vec3<Lane> d = SumTensorProductWithGradient(values, this->Dims, axes, gradient);
+    jacobian = this->JacobianAt(stu, gradient);
     return x + d;
   }
 
 private:
+  /// The Jacobian from the displacement's gradient at parameters stu: a clamped direction (outside the frame)
+  /// loses its column, the displacement not changing along it.
+  FFD_INLINE Mat3<Lane> JacobianAt(const Vec3<Lane>& stu, Mat3<Lane> gradient) const
+  {
+    using Scalar = typename ScalarOf<Lane>::Type;
+    const Lane lo = -ParametricTolerance<Scalar>(), hi = Lane(1) + ParametricTolerance<Scalar>();
+    for (int a = 0; a < 3; ++a)
+    {
+      const auto inside = InRange(stu[a], lo, hi);
+      for (int r = 0; r < 3; ++r)
+      {
+        gradient.M[r][a] = KeepWhere(inside, gradient.M[r][a]);
+      }
+    }
+    return DeformationJacobian(gradient, this->Frame);
+  }
+
+  /// The weights along each axis at parameters stu of lanes in the cells of indices `cell` (DeformInLaneCells()),
+  /// as ComputeAxisWeights() computes them for one cell.
+  void LaneCellWeights(
+    const Vec3<Lane>& stu, const Vec3<Lane>& cell, bool withDerivative, AxisWeights<MaxCount, Lane>* axes) const
+  {
+    const Lane p[3] = { stu.x, stu.y, stu.z };
+    const Lane c[3] = { cell.x, cell.y, cell.z };
+    for (int a = 0; a < 3; ++a)
+    {
+      const Lane n = Lane(this->Voxels[a]);
+      axes[a].First = 0;
+      ComputeLocalAxisWeights(this->BasisOf(), n, Clamp01(p[a] * n - c[a]), withDerivative, axes[a]);
+    }
+  }
+
   /// The weights along each axis at parameters stu (ComputeAxisWeights() clamps them to the frame) of a point
   /// in cell (ci, cj, ck).
   FFD_INLINE void Weights(

@@ -234,6 +234,26 @@ inline void DeformOnePoint(const Deformation& deformation, const Real* in, const
   out[3 * i + 2] = y.z;
 }
 
+/// Where `outNormals` (or `determinants`) is not null: point i's transformed normal (its Jacobian's determinant)
+/// from its Jacobian, as the filter's one-point code computes them (a point that keeps its position has the
+/// identity).
+template <typename Real>
+inline void FinishOnePoint(const Mat3<Real>& jacobian, const Real* inNormals, Real* outNormals, Real* determinants,
+  std::int64_t i)
+{
+  if (outNormals)
+  {
+    const Vec3<Real> m = TransformNormal(jacobian, Vec3<Real>::From(inNormals + 3 * i));
+    outNormals[3 * i] = m.x;
+    outNormals[3 * i + 1] = m.y;
+    outNormals[3 * i + 2] = m.z;
+  }
+  if (determinants)
+  {
+    determinants[i] = Determinant(jacobian);
+  }
+}
+
 #if FFD_HAVE_LANES
 /**
  * The cells of a lane group, for GridDeformation::DeformInLaneCells(): each one's first control point and lanes
@@ -461,6 +481,91 @@ inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in,
   }
 }
 
+template <int W, typename Deformation, typename Real>
+inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, const int* cells,
+  const Real* inNormals, Real* out, Real* outNormals, Real* determinants, std::int64_t begin, std::int64_t end)
+{
+  using Lane = Lanes<Real, W>;
+  using Mask = typename Lane::IndexVector;
+  const auto wide = deformation.template WithLanes<Lane>();
+  const bool global = deformation.BasisOf() == GridBasis::Bernstein;
+  const CellSplit split(deformation);
+  const Mat3<Lane> identity = Mat3<Lane>::Identity();
+  std::int64_t i = begin;
+  for (; i + W <= end; i += W)
+  {
+    Vec3<Lane> x;
+    Lane::Deinterleave3(in + 3 * i, x.x, x.y, x.z);
+    const Mask cell = LaneCellsOf<Lane>(cells + i);
+    const Mask bound = cell >= Mask{};
+    Vec3<Lane> y = x; // lanes of cell -1 keep their position, their Jacobian is the identity
+    Mat3<Lane> jacobian = identity;
+    unsigned todo = Lane::Bits(bound);
+    if (todo != 0)
+    {
+      Vec3<Lane> yc;
+      Mat3<Lane> jc;
+      if (global)
+      {
+        yc = wide.Deform(x, 0, jc);
+      }
+      else
+      {
+        // Every cell of the group (as DeformInSeveralCells() finds them), its control points read into its
+        // lanes: one evaluation of the weights, their derivatives and the sums for all lanes.
+        LaneCells<Lane, typename Deformation::Value, 0> values;
+        Vec3<Lane> index;
+        int count = 0;
+        for (; todo != 0; ++count)
+        {
+          const int c = cells[i + __builtin_ctz(todo)];
+          const Mask mine = cell == Mask{} + typename Lane::Index(c);
+          todo &= ~Lane::Bits(mine);
+          Vec3<Lane> ci;
+          values.Values[count] = deformation.Displacements + 3 * FirstOfCell(deformation, split, c, ci);
+          values.Lanes[count] = mine;
+          index = count == 0 ? ci
+                             : Vec3<Lane>{ Select(mine, ci.x, index.x), Select(mine, ci.y, index.y),
+                                 Select(mine, ci.z, index.z) };
+        }
+        values.RuntimeCount = count;
+        yc = wide.DeformInLaneCells(x, index, &values, jc);
+      }
+      y = { Select(bound, yc.x, x.x), Select(bound, yc.y, x.y), Select(bound, yc.z, x.z) };
+      for (int r = 0; r < 3; ++r)
+      {
+        for (int c = 0; c < 3; ++c)
+        {
+          jacobian.M[r][c] = Select(bound, jc.M[r][c], identity.M[r][c]);
+        }
+      }
+    }
+    Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
+    if (outNormals)
+    {
+      Vec3<Lane> normal;
+      Lane::Deinterleave3(inNormals + 3 * i, normal.x, normal.y, normal.z);
+      const Vec3<Lane> m = TransformNormal(jacobian, normal);
+      Lane::Interleave3(m.x, m.y, m.z, outNormals + 3 * i);
+    }
+    if (determinants)
+    {
+      const Lane det = Determinant(jacobian);
+      std::memcpy(determinants + i, &det.V, sizeof(det.V));
+    }
+  }
+  for (; i < end; ++i) // the last points, fewer than W
+  {
+    const Vec3<Real> x = Vec3<Real>::From(in + 3 * i);
+    Mat3<Real> jacobian = Mat3<Real>::Identity();
+    const Vec3<Real> y = cells[i] >= 0 ? deformation.Deform(x, cells[i], jacobian) : x;
+    out[3 * i] = y.x;
+    out[3 * i + 1] = y.y;
+    out[3 * i + 2] = y.z;
+    FinishOnePoint(jacobian, inNormals, outNormals, determinants, i);
+  }
+}
+
 /// Lanes that the gathered pass stages at once: up to this many points, in groups of W of one cell.
 constexpr int GatherStage = 512;
 
@@ -537,6 +642,13 @@ inline void GatheredInLanes(const Deformation& deformation, const Real* in, cons
     BlocksInPlaceInLanes<Bytes / sizeof(Real)>(deformation, in, cells, out, n, blockBegin, blockEnd, maxCells); \
   }                                                                                                           \
   template <typename Deformation, typename Real>                                                              \
+  Target void WithJacobian##Suffix(const Deformation& deformation, const Real* in, const int* cells,          \
+    const Real* inNormals, Real* out, Real* outNormals, Real* determinants, std::int64_t begin, std::int64_t end) \
+  {                                                                                                           \
+    WithJacobianInLanes<Bytes / sizeof(Real)>(                                                                \
+      deformation, in, cells, inNormals, out, outNormals, determinants, begin, end);                         \
+  }                                                                                                           \
+  template <typename Deformation, typename Real>                                                              \
   Target void Gathered##Suffix(const Deformation& deformation, const Real* in, const int* cells,              \
     const int* gathered, Real* out, std::int64_t begin, std::int64_t end)                                     \
   {                                                                                                           \
@@ -581,6 +693,41 @@ inline void DeformBlocksInPlace(SimdLevel level, const Deformation& deformation,
         detail::DeformOnePoint(deformation, in, cells, out, i);
       }
     }
+  }
+}
+
+/**
+ * Points [begin, end) with their Jacobians, in order (no gathering): out as DeformBlocksInPlace() and
+ * DeformGathered() write it, and, where not null, outNormals (the normals inNormals transformed, TransformNormal())
+ * and determinants (of the Jacobians). Every array holds Real values, 3 per point but determinants.
+ */
+template <typename Deformation, typename Real>
+inline void DeformWithJacobian(SimdLevel level, const Deformation& deformation, const Real* in, const int* cells,
+  const Real* inNormals, Real* out, Real* outNormals, Real* determinants, std::int64_t begin, std::int64_t end)
+{
+#if FFD_HAVE_LANES
+  switch (level)
+  {
+    case SimdLevel::AVX512:
+      return detail::WithJacobianAVX512(
+        deformation, in, cells, inNormals, out, outNormals, determinants, begin, end);
+    case SimdLevel::AVX2:
+      return detail::WithJacobianAVX2(deformation, in, cells, inNormals, out, outNormals, determinants, begin, end);
+    case SimdLevel::SSE2:
+      return detail::WithJacobianSSE2(deformation, in, cells, inNormals, out, outNormals, determinants, begin, end);
+    case SimdLevel::None:
+      break;
+  }
+#endif
+  for (std::int64_t i = begin; i < end; ++i)
+  {
+    const Vec3<Real> x = Vec3<Real>::From(in + 3 * i);
+    Mat3<Real> jacobian = Mat3<Real>::Identity();
+    const Vec3<Real> y = cells[i] >= 0 ? deformation.Deform(x, cells[i], jacobian) : x;
+    out[3 * i] = y.x;
+    out[3 * i + 1] = y.y;
+    out[3 * i + 2] = y.z;
+    detail::FinishOnePoint(jacobian, inNormals, outNormals, determinants, i);
   }
 }
 

@@ -8,11 +8,13 @@
  * that every index the kernels compute and every control point they read is the same for all lanes (a control
  * point is read once and broadcast). The arithmetic is GCC/Clang vector extensions rather than intrinsics: a
  * function compiled for AVX-512 gets zmm instructions, one for AVX2 ymm, and a plain x86-64 build SSE2
- * (FFDGridLanes.h picks the widest at run time), from the same source. The exceptions, a broadcast and a
- * mask to bits, are one intrinsic per width (detail::Splat(), detail::LaneBits()).
+ * (FFDGridLanes.h picks the widest at run time), from the same source. The exceptions, a broadcast, a square
+ * root and a mask to bits, are one intrinsic per width (detail::Splat(), detail::Sqrt(), detail::LaneBits()).
  */
 #ifndef FFDLanes_h
 #define FFDLanes_h
+
+#include "FFDVector.h"
 
 #include <immintrin.h>
 
@@ -68,6 +70,32 @@ inline void Splat(float s, Float32x4& v)
 inline void Splat(double s, Float64x2& v)
 {
   v = reinterpret_cast<Float64x2>(_mm_set1_pd(s));
+}
+
+/// r = the square root of v in every lane.
+__attribute__((target("avx512f"))) inline void Sqrt(const Float32x16& v, Float32x16& r)
+{
+  r = reinterpret_cast<Float32x16>(_mm512_sqrt_ps(reinterpret_cast<__m512>(v)));
+}
+__attribute__((target("avx512f"))) inline void Sqrt(const Float64x8& v, Float64x8& r)
+{
+  r = reinterpret_cast<Float64x8>(_mm512_sqrt_pd(reinterpret_cast<__m512d>(v)));
+}
+__attribute__((target("avx"))) inline void Sqrt(const Float32x8& v, Float32x8& r)
+{
+  r = reinterpret_cast<Float32x8>(_mm256_sqrt_ps(reinterpret_cast<__m256>(v)));
+}
+__attribute__((target("avx"))) inline void Sqrt(const Float64x4& v, Float64x4& r)
+{
+  r = reinterpret_cast<Float64x4>(_mm256_sqrt_pd(reinterpret_cast<__m256d>(v)));
+}
+inline void Sqrt(const Float32x4& v, Float32x4& r)
+{
+  r = reinterpret_cast<Float32x4>(_mm_sqrt_ps(reinterpret_cast<__m128>(v)));
+}
+inline void Sqrt(const Float64x2& v, Float64x2& r)
+{
+  r = reinterpret_cast<Float64x2>(_mm_sqrt_pd(reinterpret_cast<__m128d>(v)));
 }
 
 /// Bit l set where lane l of m is -1 (lanes are -1 or 0).
@@ -134,6 +162,30 @@ struct Lanes
       (reinterpret_cast<IndexVector>(b.V) & ~mask)));
   }
 
+  Lanes& operator+=(const Lanes& a)
+  {
+    this->V += a.V;
+    return *this;
+  }
+
+  // The conditions of the kernels (FFDVector.h), lane by lane.
+  friend IndexVector InRange(const Lanes& v, const Lanes& lo, const Lanes& hi)
+  {
+    return (v.V >= lo.V) & (v.V <= hi.V);
+  }
+  friend Lanes KeepWhere(const IndexVector& keep, const Lanes& v)
+  {
+    return Lanes(reinterpret_cast<Vector>(reinterpret_cast<IndexVector>(v.V) & keep));
+  }
+  friend IndexVector IsPositive(const Lanes& v) { return v.V > Vector{}; }
+  friend Lanes Choose(const IndexVector& condition, const Lanes& a, const Lanes& b) { return Select(condition, a, b); }
+  friend Lanes sqrt(const Lanes& v)
+  {
+    Lanes r;
+    detail::Sqrt(v.V, r.V);
+    return r;
+  }
+
   /// Bit l set where lane l of mask is -1 (mask lanes are -1 or 0).
   static unsigned Bits(const IndexVector& mask) { return detail::LaneBits(mask); }
   friend Lanes Clamp01(const Lanes& a)
@@ -186,6 +238,12 @@ private:
     const Vector v = __builtin_shuffle(__builtin_shuffle(x, y, fromXY), z, withZ);
     std::memcpy(p, &v, sizeof(Vector));
   }
+};
+
+template <typename T, int W>
+struct ScalarOf<Lanes<T, W>>
+{
+  using Type = T;
 };
 
 } // namespace ffd

@@ -20,6 +20,42 @@ FFD_INLINE Real Clamp01(Real v)
   return v < Real(0) ? Real(0) : (v > Real(1) ? Real(1) : v);
 }
 
+/// True where lo <= v <= hi (false for NaN). Number types of several lanes overload it with a lane mask, and
+/// KeepWhere() and Choose() with it, so that the kernels branch on such conditions the same way in every lane.
+template <typename Real>
+FFD_INLINE bool InRange(Real v, Real lo, Real hi)
+{
+  return v >= lo && v <= hi;
+}
+
+/// v where `keep`, else 0.
+template <typename Real>
+FFD_INLINE Real KeepWhere(bool keep, Real v)
+{
+  return keep ? v : Real(0);
+}
+
+/// True where v > 0.
+template <typename Real>
+FFD_INLINE bool IsPositive(Real v)
+{
+  return v > Real(0);
+}
+
+/// a where `condition`, else b.
+template <typename Real>
+FFD_INLINE Real Choose(bool condition, Real a, Real b)
+{
+  return condition ? a : b;
+}
+
+/// The number type of one lane of Real (Real itself, but for the Lanes types of FFDLanes.h).
+template <typename Real>
+struct ScalarOf
+{
+  using Type = Real;
+};
+
 template <typename Real>
 struct Vec3
 {
@@ -135,9 +171,13 @@ FFD_INLINE Mat3<Real> Cofactor(const Mat3<Real>& a)
 template <typename Real>
 FFD_INLINE Vec3<Real> TransformNormal(const Mat3<Real>& jacobian, const Vec3<Real>& normal)
 {
+  using std::sqrt; // or the Lanes overload
   const Vec3<Real> m = Cofactor(jacobian) * normal;
-  const Real length = std::sqrt(Dot(m, m));
-  return length > Real(0) ? (Real(1) / length) * m : normal;
+  const Real length = sqrt(Dot(m, m));
+  const auto positive = IsPositive(length);
+  const Real scale = Real(1) / length;
+  return { Choose(positive, scale * m.x, normal.x), Choose(positive, scale * m.y, normal.y),
+    Choose(positive, scale * m.z, normal.z) };
 }
 
 } // namespace ffd

@@ -185,8 +185,16 @@ TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
               }
               ffd::Mat3<Real> j;
               k.D.Deform(x, set.Cells[i], j);
+              // X plus the reference's displacement at the nearest point of the frame (X itself inside).
               const Vec xd = ffdtest::ToRef(x);
-              const Vec want = ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, xd);
+              Vec stu = ffdref::Parameters(lat.F, xd);
+              for (double& p : stu)
+              {
+                p = std::min(1.0, std::max(0.0, p));
+              }
+              const Vec edge = ffdtest::ToWorld(lat.F, stu);
+              const Vec moved = ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, edge);
+              const Vec want = { xd[0] + moved[0] - edge[0], xd[1] + moved[1] - edge[1], xd[2] + moved[2] - edge[2] };
               const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
               worst.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
               ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
@@ -269,6 +277,126 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
         }
       }
     });
+  }
+}
+
+TYPED_TEST(FFDGridLanesTest, JacobianInLanesMatchesOnePoint)
+{
+  // DeformWithJacobian() at every level, every basis, random lattices, 1001 mesh-like points in their order and
+  // shuffled (lane groups in one cell and in many, points outside kept or clamped), split into ranges at random multiples of
+  // BlockSize: positions against ffdref::DeformLocal (at the nearest point of the frame for points clamped to
+  // it) within PositionTolerance() (points outside exactly kept);
+  // the transformed normal and the Jacobian's determinant against the one-point kernel's in Real, which the
+  // tests of TestFFDGridDeformation.cxx check against the reference: within 10 EvaluationTolerance() |J|max^2 /
+  // |cof(J) n| per normal component (points where that length is under 0.1 skipped: the normal is
+  // ill-defined) and 10 EvaluationTolerance() |J|max^3 for the determinant (the two differ by the rounding of
+  // fused multiply-adds).
+  using Real = TypeParam;
+  ffdtest::Rng rng(604);
+  ffdtest::WorstRatio worst("worst_error_over_tolerance");
+  for (Basis b : ffdtest::AllBases)
+  {
+    for (int trial = 0; trial < 4; ++trial)
+    {
+      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 5);
+      const double scale = ffdtest::LatticeScale(lat.Points);
+      ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
+        PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 1001);
+        if (trial >= 2) // clamped to the frame: the points outside lose the Jacobian's columns along which
+        {               // they are clamped
+          for (std::int64_t i = 0; i < set.Size(); ++i)
+          {
+            set.Cells[i] = k.Bind(ffd::Vec3<Real>::From(&set.Values[3 * i]), true);
+          }
+        }
+        if (trial % 2 == 1)
+        {
+          std::vector<std::int64_t> order(std::size_t(set.Size()));
+          std::iota(order.begin(), order.end(), 0);
+          std::shuffle(order.begin(), order.end(), rng);
+          PointSet<Real> shuffled;
+          for (std::int64_t i : order)
+          {
+            shuffled.Values.insert(shuffled.Values.end(), &set.Values[3 * i], &set.Values[3 * i] + 3);
+            shuffled.Cells.push_back(set.Cells[i]);
+          }
+          set = shuffled;
+        }
+        std::vector<Real> normals;
+        for (std::int64_t i = 0; i < set.Size(); ++i)
+        {
+          const Vec n = ffdtest::RandomVec(rng, -1.0, 1.0);
+          const double length = std::max(ffdtest::Norm(n), 1e-3);
+          normals.insert(normals.end(), { Real(n[0] / length), Real(n[1] / length), Real(n[2] / length) });
+        }
+        for (ffd::SimdLevel level : Levels())
+        {
+          const Real nan = std::numeric_limits<Real>::quiet_NaN(); // poisoned outputs
+          std::vector<Real> out(set.Values.size(), nan), outNormals(normals.size(), nan),
+            determinants(std::size_t(set.Size()), nan);
+          std::vector<std::int64_t> cuts = { 0, set.Size() };
+          for (int c = 0; c < 4; ++c)
+          {
+            cuts.push_back(ffd::BlockSize *
+              std::uniform_int_distribution<std::int64_t>(0, set.Size() / ffd::BlockSize)(rng));
+          }
+          std::sort(cuts.begin(), cuts.end());
+          for (std::size_t c = 0; c + 1 < cuts.size(); ++c)
+          {
+            ffd::DeformWithJacobian(level, k.D, set.Values.data(), set.Cells.data(), normals.data(), out.data(),
+              outNormals.data(), determinants.data(), cuts[c], cuts[c + 1]);
+          }
+          for (std::int64_t i = 0; i < set.Size(); ++i)
+          {
+            const std::string where = lat.Name() + " level " + LevelName(level) + " point " + std::to_string(i);
+            const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&set.Values[3 * i]);
+            const ffd::Vec3<Real> y = ffd::Vec3<Real>::From(&out[3 * i]);
+            ffd::Mat3<Real> j = ffd::Mat3<Real>::Identity();
+            if (set.Cells[i] < 0)
+            {
+              ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
+            }
+            else
+            {
+              k.D.Deform(x, set.Cells[i], j);
+              // X plus the reference's displacement at the nearest point of the frame (X itself inside).
+              const Vec xd = ffdtest::ToRef(x);
+              Vec stu = ffdref::Parameters(lat.F, xd);
+              for (double& p : stu)
+              {
+                p = std::min(1.0, std::max(0.0, p));
+              }
+              const Vec edge = ffdtest::ToWorld(lat.F, stu);
+              const Vec moved = ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, edge);
+              const Vec want = { xd[0] + moved[0] - edge[0], xd[1] + moved[1] - edge[1], xd[2] + moved[2] - edge[2] };
+              const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
+              worst.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
+              ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
+            }
+            double jmax = 1.0;
+            for (int r = 0; r < 3; ++r)
+            {
+              for (int c = 0; c < 3; ++c)
+              {
+                jmax = std::max(jmax, std::fabs(double(j.M[r][c])));
+              }
+            }
+            const double detTol = 10.0 * ffdtest::EvaluationTolerance<Real>() * jmax * jmax * jmax;
+            worst.Add(std::fabs(double(determinants[i]) - double(ffd::Determinant(j))), detTol);
+            ASSERT_LE(std::fabs(double(determinants[i]) - double(ffd::Determinant(j))), detTol) << where;
+            const ffd::Vec3<Real> n = ffd::Vec3<Real>::From(&normals[3 * i]);
+            const double mm = ffdtest::Norm(ffdtest::ToRef(ffd::Cofactor(j) * n));
+            if (mm >= 0.1)
+            {
+              const Vec got = ffdtest::ToRef(ffd::Vec3<Real>::From(&outNormals[3 * i]));
+              const double normalTol = 10.0 * ffdtest::EvaluationTolerance<Real>() * jmax * jmax / mm;
+              worst.Add(ffdtest::MaxDiff(got, ffdtest::ToRef(ffd::TransformNormal(j, n))), normalTol);
+              ASSERT_LE(ffdtest::MaxDiff(got, ffdtest::ToRef(ffd::TransformNormal(j, n))), normalTol) << where;
+            }
+          }
+        }
+      });
+    }
   }
 }
 
