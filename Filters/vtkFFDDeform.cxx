@@ -158,7 +158,8 @@ struct BindWorker
 };
 
 //------------------------------------------------------------------------------------------------------------
-// Evaluation in the precision Real of the output points, by a ffd::GridDeformation.
+// Evaluation in the precision Real of the output points, by a ffd::GridDeformation, one point at a time: for
+// points of another type than the output's, or normals of another type than the points'.
 template <typename Deformer, typename Real, typename PointArrayT>
 struct EvaluateFunctor
 {
@@ -240,6 +241,30 @@ struct LanesFunctor
   }
 };
 
+// Evaluation with the Jacobian (normals to transform, determinants), W points at a time in SIMD lanes
+// (ffd::DeformWithJacobian), over blocks of ffd::BlockSize points: the last points, fewer than a lane group, are
+// deformed one at a time, whatever the split among threads.
+template <typename Deformer, typename Real>
+struct JacobianFunctor
+{
+  const Real* InPoints;
+  Real* OutPoints;
+  const int* Cells;
+  vtkIdType NumberOfPoints;
+  const Real* InNormals; // nullptr: no normals to transform
+  Real* OutNormals;
+  Real* Determinants; // nullptr: not asked for
+  Deformer Deformation;
+
+  void operator()(vtkIdType begin, vtkIdType end)
+  {
+    static const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
+    ffd::DeformWithJacobian(level, this->Deformation, this->InPoints, this->Cells, this->InNormals,
+      this->OutPoints, this->OutNormals, this->Determinants, begin * ffd::BlockSize,
+      std::min(this->NumberOfPoints, end * ffd::BlockSize));
+  }
+};
+
 template <typename Real>
 struct EvaluateWorker
 {
@@ -302,6 +327,17 @@ struct EvaluateWorker
         completed = vtkFFDForInChunks(self, blocks, lanes, progressBegin, middle);
         lanes.GatheredPass = true;
         completed = completed && vtkFFDForInChunks(self, vtkIdType(gathered.size()), lanes, middle, 1.0);
+        return;
+      }
+      using NormalArray = vtkAOSDataArrayTemplate<Real>;
+      NormalArray* normalsIn = NormalArray::FastDownCast(inNormals);
+      NormalArray* normalsOut = NormalArray::FastDownCast(outNormals);
+      if (!inNormals || (normalsIn && normalsOut))
+      {
+        JacobianFunctor<Deformation, Real> jacobian{ inPoints->GetPointer(0), outPoints->GetPointer(0), cells, n,
+          normalsIn ? normalsIn->GetPointer(0) : nullptr, normalsOut ? normalsOut->GetPointer(0) : nullptr,
+          determinants ? determinants->GetPointer(0) : nullptr, deformation };
+        completed = vtkFFDForInChunks(self, (n + ffd::BlockSize - 1) / ffd::BlockSize, jacobian, progressBegin, 1.0);
         return;
       }
     }
