@@ -551,6 +551,22 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
     this->Clamped.push_back({ id, static_cast<int>(tetrahedron), c,
       ffd::ClosestPointGradient(frame, frame.ToParametric(c), 1e-9) });
   }
+  std::vector<unsigned char> used(numberOfTetrahedra, 0);
+  for (const int tetrahedron : this->Cells)
+  {
+    if (tetrahedron >= 0)
+    {
+      used[tetrahedron] = 1;
+    }
+  }
+  this->Used.clear();
+  for (vtkIdType t = 0; t < numberOfTetrahedra; ++t)
+  {
+    if (used[t])
+    {
+      this->Used.push_back(static_cast<int>(t));
+    }
+  }
   this->Bound = key;
   this->BoundRest = this->RestValues;
   this->BoundNodes = this->Nodes;
@@ -577,11 +593,12 @@ ffd::TetrahedronMap<double> vtkFFDTetrahedralDeformation::Map(vtkIdType tetrahed
 template <typename Real>
 void vtkFFDTetrahedralDeformation::ComputeMaps(std::vector<ffd::TetrahedronMap<Real>>& maps) const
 {
+  // Only the tetrahedra some point is bound to: the others' maps are never read.
   maps.resize(this->Frames.size());
-  vtkSMPTools::For(0, static_cast<vtkIdType>(maps.size()), [&](vtkIdType begin, vtkIdType end) {
-    for (vtkIdType t = begin; t < end; ++t)
+  vtkSMPTools::For(0, static_cast<vtkIdType>(this->Used.size()), [&](vtkIdType begin, vtkIdType end) {
+    for (vtkIdType u = begin; u < end; ++u)
     {
-      maps[t] = this->Map(t).template As<Real>();
+      maps[this->Used[u]] = this->Map(this->Used[u]).template As<Real>();
     }
   });
 }

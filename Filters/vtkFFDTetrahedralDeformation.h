@@ -170,6 +170,7 @@ private:
   vtkIdType NumberOfDegenerate = 0;
   vtkIdType FirstDegenerate = -1;
   std::vector<int> Cells;
+  std::vector<int> Used; // the tetrahedra some point is bound to (not a clamped one: those use Map())
   std::vector<ClampedPoint> Clamped;
   vtkIdType NumberOfOutsideBound = 0;
 
