@@ -158,6 +158,7 @@ private:
   std::vector<vtkIdType> Nodes;      // 4 per tetrahedron
   const void* NodesSource = nullptr; // the cell array Nodes was read from, and its modification time
   vtkMTimeType NodesSourceMTime = 0;
+  bool NodesRead = false; // Nodes were read again since the last Bind()
 
   // The binding and what it is for.
   Key Bound;

@@ -70,7 +70,7 @@ FFD_INLINE Real InsideMargin(const Vec3<Real>& stu)
 
 /// The displacement of the points of one tetrahedron, D(X) = Offset + Gradient (X - Corner).
 template <typename Real>
-struct TetrahedronMap
+struct alignas(16 * sizeof(Real)) TetrahedronMap
 {
   Vec3<Real> Corner;  ///< rest position of node A
   Vec3<Real> Offset;  ///< displacement of node A
