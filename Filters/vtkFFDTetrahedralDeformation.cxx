@@ -19,7 +19,6 @@
 #include "vtkSMPThreadLocalObject.h"
 #include "vtkSMPTools.h"
 #include "vtkStaticCellLocator.h"
-#include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
 
 #include <algorithm>
@@ -521,7 +520,6 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
 
   // The outside policy, for the (usually few) points outside every tetrahedron.
   this->Clamped.clear();
-  this->NumberOfOutsideBound = 0;
   vtkNew<vtkGenericCell> cell;
   for (vtkIdType id = 0; id < numberOfPoints; ++id)
   {
@@ -544,7 +542,6 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
     {
       continue; // its nearest tetrahedron has no map: it keeps its position
     }
-    ++this->NumberOfOutsideBound;
     if (outsidePolicy == EXTRAPOLATE)
     {
       this->Cells[id] = static_cast<int>(tetrahedron);

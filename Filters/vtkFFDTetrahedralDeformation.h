@@ -120,8 +120,6 @@ public:
   vtkIdType GetFirstDegenerateTetrahedron() const { return this->FirstDegenerate; }
   ///@}
 
-  /// Points bound outside every tetrahedron by the policy (clamped or extrapolated) at the last binding.
-  vtkIdType GetNumberOfOutsidePointsBound() const { return this->NumberOfOutsideBound; }
 
 private:
   /// What a binding is for: the points (identity, modification time, count) and the policy; the rest
@@ -173,7 +171,6 @@ private:
   std::vector<int> Cells;
   std::vector<int> Used; // the tetrahedra some point is bound to (not a clamped one: those use Map())
   std::vector<ClampedPoint> Clamped;
-  vtkIdType NumberOfOutsideBound = 0;
 
   // Every tetrahedron's map, in the precision of the last evaluation: kept, so that an update neither allocates
   // nor page-faults them again (8.5 MB for 71 k tetrahedra in double).
