@@ -348,9 +348,7 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
     const vtkIdType* nodes = mesh.Tetrahedra.data() + 4 * bound[id];
     double x[3];
     input->GetPoint(id, x);
-    const ffd::Vec3<double> stu =
-      ffd::TetrahedronFrame(mesh.Node(nodes[0]), mesh.Node(nodes[1]), mesh.Node(nodes[2]), mesh.Node(nodes[3]))
-        .ToParametric(ffd::Vec3<double>::From(x));
+    const ffd::Vec3<double> stu = binding.GetFrames()[bound[id]].ToParametric(ffd::Vec3<double>::From(x));
     const double weights[4] = { 1.0 - stu.x - stu.y - stu.z, stu.x, stu.y, stu.z };
     for (int i = 0; i < 4; ++i)
     {
