@@ -158,6 +158,17 @@ struct BindWorker
 };
 
 //------------------------------------------------------------------------------------------------------------
+// The CPU binding of the input's points to a grid lattice: kept while the points and the lattice's rest state
+// stay the same (vtkFFDBindingKey).
+struct GridBinding
+{
+  std::vector<int> Cells;    // per input point: its cell (ffd::BindToGrid), -1 where it keeps its position
+  ffd::BlockCells Blocks;    // the cells of each block of points (ffd::ListBlockCells)
+  std::vector<int> Gathered; // the points of blocks not deformed in place, sorted by cell (ffd::GatherByCell)
+  bool CellTable = false;    // trilinear evaluation from ffd::FillTrilinearCellTable (ffd::WorthTrilinearCellTable)
+};
+
+//------------------------------------------------------------------------------------------------------------
 // Evaluation in the precision Real of the output points, by a ffd::GridDeformation, one point at a time: for
 // points of another type than the output's, or normals of another type than the points'.
 template <typename Deformer, typename Real, typename PointArrayT>
@@ -219,24 +230,23 @@ struct LanesFunctor
 {
   const Real* InPoints;
   Real* OutPoints;
-  const int* Cells;
-  vtkIdType NumberOfPoints;
-  const int* Gathered; // ffd::GatherByCell()
-  int MaxCellsInPlace; // what Gathered was listed for
+  const GridBinding& Binding;
   Deformer Deformation;
-  bool GatheredPass; // false: over blocks, true: over Gathered
+  bool GatheredPass; // false: over blocks, true: over Binding.Gathered
 
   void operator()(vtkIdType begin, vtkIdType end)
   {
     static const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
+    const int* cells = this->Binding.Cells.data();
     if (this->GatheredPass)
     {
-      ffd::DeformGathered(level, this->Deformation, this->InPoints, this->Cells, this->Gathered, this->OutPoints, begin, end);
+      ffd::DeformGathered(level, this->Deformation, this->InPoints, cells, this->Binding.Gathered.data(),
+        this->OutPoints, begin, end);
     }
     else
     {
-      ffd::DeformBlocksInPlace(level, this->Deformation, this->InPoints, this->Cells, this->OutPoints,
-        this->NumberOfPoints, begin, end, this->MaxCellsInPlace);
+      ffd::DeformBlocksInPlace(
+        level, this->Deformation, this->InPoints, cells, this->OutPoints, this->Binding.Blocks, begin, end);
     }
   }
 };
@@ -249,7 +259,7 @@ struct JacobianFunctor
 {
   const Real* InPoints;
   Real* OutPoints;
-  const int* Cells;
+  const GridBinding& Binding;
   vtkIdType NumberOfPoints;
   const Real* InNormals; // nullptr: no normals to transform
   Real* OutNormals;
@@ -259,9 +269,9 @@ struct JacobianFunctor
   void operator()(vtkIdType begin, vtkIdType end)
   {
     static const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
-    ffd::DeformWithJacobian(level, this->Deformation, this->InPoints, this->Cells, this->InNormals,
-      this->OutPoints, this->OutNormals, this->Determinants, begin * ffd::BlockSize,
-      std::min(this->NumberOfPoints, end * ffd::BlockSize));
+    ffd::DeformWithJacobian(level, this->Deformation, this->InPoints, this->Binding.Cells.data(),
+      this->Binding.Blocks, this->InNormals, this->OutPoints, this->OutNormals, this->Determinants,
+      begin * ffd::BlockSize, std::min(this->NumberOfPoints, end * ffd::BlockSize));
   }
 };
 
@@ -269,64 +279,83 @@ template <typename Real>
 struct EvaluateWorker
 {
   template <typename PointArrayT>
-  void operator()(PointArrayT* inPoints, const LatticeView& lattice, const int* cells,
-    const std::vector<int>& gathered, int maxCellsInPlace, vtkDataArray* inNormals,
-    vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outPoints,
+  void operator()(PointArrayT* inPoints, const LatticeView& lattice, const GridBinding& binding,
+    vtkDataArray* inNormals, vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outPoints,
     vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self, double progressBegin, bool& completed)
   {
     const std::vector<Real> displacements(lattice.Displacements.begin(), lattice.Displacements.end());
+    std::vector<Real> cellTable;
+    if (binding.CellTable)
+    {
+      const int cells = lattice.Divisions[0] * lattice.Divisions[1] * lattice.Divisions[2];
+      cellTable.resize(std::size_t(cells) * ffd::TrilinearCellStride);
+      vtkSMPTools::For(0, cells, [&](int begin, int end) {
+        ffd::FillTrilinearCellTable(
+          displacements.data(), lattice.Divisions, lattice.Dims, cellTable.data(), begin, end);
+      });
+    }
     // One instantiation per basis (see ffd::GridDeformation's StaticBasis). The global basis sums over every
     // control point of an axis, a local one over at most 4.
-    auto run = [&](auto maxCount, auto basis) {
-      this->Run<decltype(maxCount)::value, decltype(basis)::value>(inPoints, lattice, displacements.data(), cells,
-        gathered, maxCellsInPlace, inNormals, outNormals, outPoints, determinants, self, progressBegin, completed);
+    auto run = [&](auto maxCount, auto basis, auto withCellTable) {
+      this->Run<decltype(maxCount)::value, decltype(basis)::value, decltype(withCellTable)::value>(inPoints,
+        lattice, displacements.data(), cellTable.data(), binding, inNormals, outNormals, outPoints, determinants,
+        self, progressBegin, completed);
     };
+    using NoTable = std::false_type;
     using ffd::GridBasis;
     using Local = std::integral_constant<int, 4>;
     switch (lattice.Basis)
     {
       case GridBasis::Bernstein:
         run(std::integral_constant<int, ffd::MaxBernsteinDegree + 1>(),
-          std::integral_constant<int, int(GridBasis::Bernstein)>());
+          std::integral_constant<int, int(GridBasis::Bernstein)>(), NoTable());
         break;
       case GridBasis::Trilinear:
-        run(Local(), std::integral_constant<int, int(GridBasis::Trilinear)>());
+        if (binding.CellTable)
+        {
+          run(Local(), std::integral_constant<int, int(GridBasis::Trilinear)>(), std::true_type());
+        }
+        else
+        {
+          run(Local(), std::integral_constant<int, int(GridBasis::Trilinear)>(), NoTable());
+        }
         break;
       case GridBasis::TriquadraticBezier:
-        run(Local(), std::integral_constant<int, int(GridBasis::TriquadraticBezier)>());
+        run(Local(), std::integral_constant<int, int(GridBasis::TriquadraticBezier)>(), NoTable());
         break;
       case GridBasis::TricubicBezier:
-        run(Local(), std::integral_constant<int, int(GridBasis::TricubicBezier)>());
+        run(Local(), std::integral_constant<int, int(GridBasis::TricubicBezier)>(), NoTable());
         break;
       case GridBasis::CubicBSpline:
-        run(Local(), std::integral_constant<int, int(GridBasis::CubicBSpline)>());
+        run(Local(), std::integral_constant<int, int(GridBasis::CubicBSpline)>(), NoTable());
         break;
     }
   }
 
-  template <int MaxCount, int StaticBasis, typename PointArrayT>
-  void Run(PointArrayT* inPoints, const LatticeView& lattice, const Real* displacements, const int* cells,
-    const std::vector<int>& gathered, int maxCellsInPlace, vtkDataArray* inNormals, vtkDataArray* outNormals,
+  template <int MaxCount, int StaticBasis, bool WithCellTable, typename PointArrayT>
+  void Run(PointArrayT* inPoints, const LatticeView& lattice, const Real* displacements, const Real* cellTable,
+    const GridBinding& binding, vtkDataArray* inNormals, vtkDataArray* outNormals,
     vtkAOSDataArrayTemplate<Real>* outPoints, vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self,
     double progressBegin, bool& completed)
   {
-    using Deformation = ffd::GridDeformation<MaxCount, Real, StaticBasis>;
+    using Deformation = ffd::GridDeformation<MaxCount, Real, StaticBasis, Real, WithCellTable>;
     const Deformation deformation{ lattice.Basis,
       { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] },
       { lattice.Dims[0], lattice.Dims[1], lattice.Dims[2] }, displacements,
-      ffd::Frame<Real>::FromArray(lattice.Frame) };
+      ffd::Frame<Real>::FromArray(lattice.Frame), cellTable };
     const vtkIdType n = inPoints->GetNumberOfTuples();
     if constexpr (std::is_same<PointArrayT, vtkAOSDataArrayTemplate<Real>>::value)
     {
       if (!outNormals && !determinants)
       {
-        LanesFunctor<Deformation, Real> lanes{ inPoints->GetPointer(0), outPoints->GetPointer(0), cells, n,
-          gathered.data(), maxCellsInPlace, deformation, false };
+        LanesFunctor<Deformation, Real> lanes{ inPoints->GetPointer(0), outPoints->GetPointer(0), binding,
+          deformation, false };
         const vtkIdType blocks = (n + ffd::BlockSize - 1) / ffd::BlockSize;
-        const double middle = progressBegin + (1.0 - progressBegin) * double(n - vtkIdType(gathered.size())) / double(n);
+        const vtkIdType gathered = vtkIdType(binding.Gathered.size());
+        const double middle = progressBegin + (1.0 - progressBegin) * double(n - gathered) / double(n);
         completed = vtkFFDForInChunks(self, blocks, lanes, progressBegin, middle);
         lanes.GatheredPass = true;
-        completed = completed && vtkFFDForInChunks(self, vtkIdType(gathered.size()), lanes, middle, 1.0);
+        completed = completed && vtkFFDForInChunks(self, gathered, lanes, middle, 1.0);
         return;
       }
       using NormalArray = vtkAOSDataArrayTemplate<Real>;
@@ -334,15 +363,15 @@ struct EvaluateWorker
       NormalArray* normalsOut = NormalArray::FastDownCast(outNormals);
       if (!inNormals || (normalsIn && normalsOut))
       {
-        JacobianFunctor<Deformation, Real> jacobian{ inPoints->GetPointer(0), outPoints->GetPointer(0), cells, n,
-          normalsIn ? normalsIn->GetPointer(0) : nullptr, normalsOut ? normalsOut->GetPointer(0) : nullptr,
+        JacobianFunctor<Deformation, Real> jacobian{ inPoints->GetPointer(0), outPoints->GetPointer(0), binding,
+          n, normalsIn ? normalsIn->GetPointer(0) : nullptr, normalsOut ? normalsOut->GetPointer(0) : nullptr,
           determinants ? determinants->GetPointer(0) : nullptr, deformation };
         completed = vtkFFDForInChunks(self, (n + ffd::BlockSize - 1) / ffd::BlockSize, jacobian, progressBegin, 1.0);
         return;
       }
     }
-    EvaluateFunctor<Deformation, Real, PointArrayT> functor{ inPoints, outPoints->GetPointer(0), cells,
-      deformation, inNormals, outNormals, determinants ? determinants->GetPointer(0) : nullptr };
+    EvaluateFunctor<Deformation, Real, PointArrayT> functor{ inPoints, outPoints->GetPointer(0),
+      binding.Cells.data(), deformation, inNormals, outNormals, determinants ? determinants->GetPointer(0) : nullptr };
     completed = vtkFFDForInChunks(self, inPoints->GetNumberOfTuples(), functor, progressBegin, 1.0);
   }
 };
@@ -374,10 +403,8 @@ vtkSmartPointer<vtkDataArray> OutputArray(
 // The CPU binding and what it was computed for, and the CUDA backend's state.
 struct vtkFFDDeform::vtkInternals
 {
-  std::vector<int> Cells;    // per input point: its cell (ffd::BindToGrid), -1 where it keeps its position
-  std::vector<int> Gathered; // the points of blocks not deformed in place, sorted by cell (ffd::GatherByCell)
-  int MaxCellsInPlace = ffd::BlockSize; // the cell limit of the blocks deformed in place (ffd::MaxCellsInPlace)
-  vtkFFDBindingKey Bound;    // what Cells and Gathered are for
+  GridBinding Grid;          // the binding to a grid lattice
+  vtkFFDBindingKey Bound;    // what Grid is for
   vtkFFDCudaBackend Cuda;
   vtkFFDTetrahedralDeformation Tetrahedra; // the binding and evaluation of tetrahedral lattices
   // The last output's arrays (the executive empties the output before RequestData): the next update writes
@@ -556,15 +583,15 @@ int vtkFFDDeform::RequestData(
     if (key != internals.Bound)
     {
       internals.Bound = vtkFFDBindingKey();
-      internals.Cells.resize(numberOfPoints);
+      internals.Grid.Cells.resize(numberOfPoints);
       const BindSettings settings{ ffd::Frame<double>::FromArray(view.Frame), view.Basis,
         { view.Divisions[0], view.Divisions[1], view.Divisions[2] }, this->OutsidePolicy == CLAMP_TO_EDGE };
       bool completed = false;
       BindWorker bind;
       if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(
-            inPoints->GetData(), bind, settings, internals.Cells.data(), this, completed))
+            inPoints->GetData(), bind, settings, internals.Grid.Cells.data(), this, completed))
       {
-        bind(inPoints->GetData(), settings, internals.Cells.data(), this, completed);
+        bind(inPoints->GetData(), settings, internals.Grid.Cells.data(), this, completed);
       }
       if (!completed)
       {
@@ -575,10 +602,12 @@ int vtkFFDDeform::RequestData(
       {
         cellCount *= ffd::BindingCells(view.Basis, view.Divisions[a]);
       }
-      internals.MaxCellsInPlace = ffd::MaxCellsInPlace(
-        view.Basis, ffd::MeanCellsPerBlock(internals.Cells.data(), numberOfPoints));
-      internals.Gathered =
-        ffd::GatherByCell(internals.Cells.data(), numberOfPoints, cellCount, internals.MaxCellsInPlace);
+      GridBinding& grid = internals.Grid;
+      grid.CellTable = ffd::WorthTrilinearCellTable(view.Basis, cellCount, numberOfPoints);
+      const int maxCellsInPlace = ffd::MaxCellsInPlace(
+        view.Basis, ffd::MeanCellsPerBlock(grid.Cells.data(), numberOfPoints), grid.CellTable);
+      grid.Blocks = ffd::ListBlockCells(grid.Cells.data(), numberOfPoints, maxCellsInPlace);
+      grid.Gathered = ffd::GatherByCell(grid.Cells.data(), numberOfPoints, cellCount, maxCellsInPlace);
       internals.Bound = key;
       ++this->NumberOfBindings;
     }
@@ -592,11 +621,10 @@ int vtkFFDDeform::RequestData(
       auto* points = static_cast<RealArray*>(pointsArray.Get());
       auto* det = static_cast<RealArray*>(determinants.Get());
       if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(inPoints->GetData(), worker, view,
-            internals.Cells.data(), internals.Gathered, internals.MaxCellsInPlace, inNormals, outNormals.Get(),
-            points, det, this, 0.5, completed))
+            internals.Grid, inNormals, outNormals.Get(), points, det, this, 0.5, completed))
       {
-        worker(inPoints->GetData(), view, internals.Cells.data(), internals.Gathered, internals.MaxCellsInPlace,
-          inNormals, outNormals.Get(), points, det, this, 0.5, completed);
+        worker(inPoints->GetData(), view, internals.Grid, inNormals, outNormals.Get(), points, det, this, 0.5,
+          completed);
       }
     };
     if (useDouble)

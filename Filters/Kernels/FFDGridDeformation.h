@@ -18,6 +18,7 @@
 #include "FFDGridBasis.h"
 
 #include <cmath>
+#include <cstddef>
 
 namespace ffd
 {
@@ -78,6 +79,85 @@ FFD_INLINE Mat3<Real> DeformationJacobian(const Mat3<Real>& displacementGradient
   return j;
 }
 
+/// Reals per cell in a TrilinearCellTable: the cell's indices along the three axes, 5 unused (so that the
+/// coefficients start 32 bytes in), then the 8 coefficients of FillTrilinearCellTable(), x y z each.
+constexpr int TrilinearCellStride = 32;
+
+/**
+ * A trilinear lattice's displacement in each of its cells [cellBegin, cellEnd) (flat indices, as BindToGrid()
+ * numbers them) in power form: at local coordinates (a, b, c) in [0, 1]^3 of the cell,
+ * D = C000 + a C100 + b (C010 + a C110) + c (C001 + a C101 + b (C011 + a C111)), where the C are sums and
+ * differences of the cell's 8 corner displacements (computed in double). That is 7 multiply-adds a component,
+ * against 14 and the weights (1 - a and so on) for the weighted sum of the corners, which bounded the CPU's
+ * trilinear evaluation (BENCHMARKS.md). The rest lattice's coefficients are all 0, so it stays exactly the
+ * identity. `displacements` as GridDeformation::Displacements; `table` holds TrilinearCellStride Reals per cell.
+ */
+template <typename Real>
+inline void FillTrilinearCellTable(
+  const Real* displacements, const int voxels[3], const int dims[3], Real* table, int cellBegin, int cellEnd)
+{
+  for (int cell = cellBegin; cell < cellEnd; ++cell)
+  {
+    const int ci = cell % voxels[0], cj = (cell / voxels[0]) % voxels[1], ck = cell / (voxels[0] * voxels[1]);
+    Real* entry = table + std::size_t(cell) * TrilinearCellStride;
+    entry[0] = Real(ci);
+    entry[1] = Real(cj);
+    entry[2] = Real(ck);
+    for (int u = 3; u < 8; ++u)
+    {
+      entry[u] = Real(0);
+    }
+    for (int k = 0; k < 3; ++k)
+    {
+      double p[2][2][2]; // p[c][b][a]: the corner (ci + a, cj + b, ck + c)
+      for (int corner = 0; corner < 8; ++corner)
+      {
+        const int a = corner & 1, b = (corner >> 1) & 1, c = corner >> 2;
+        p[c][b][a] = double(displacements[3 * ((ci + a) + dims[0] * ((cj + b) + dims[1] * (ck + c))) + k]);
+      }
+      const double c000 = p[0][0][0], c100 = p[0][0][1] - p[0][0][0], c010 = p[0][1][0] - p[0][0][0];
+      const double c110 = p[0][1][1] - p[0][1][0] - p[0][0][1] + p[0][0][0];
+      const double c001 = p[1][0][0] - p[0][0][0], c101 = p[1][0][1] - p[1][0][0] - p[0][0][1] + p[0][0][0];
+      const double c011 = p[1][1][0] - p[1][0][0] - p[0][1][0] + p[0][0][0];
+      const double c111 = p[1][1][1] - p[1][1][0] - p[1][0][1] - p[0][1][1] + p[1][0][0] + p[0][1][0] +
+        p[0][0][1] - p[0][0][0];
+      const double coefficients[8] = { c000, c100, c010, c110, c001, c101, c011, c111 };
+      for (int m = 0; m < 8; ++m)
+      {
+        entry[8 + 3 * m + k] = Real(coefficients[m]);
+      }
+    }
+  }
+}
+
+/**
+ * D of FillTrilinearCellTable() at local coordinates r of the cell whose entry is `entry`, and, where dDdr is not
+ * null, its derivatives: column a is dD/dr[a].
+ */
+template <typename Lane, typename Real>
+FFD_INLINE Vec3<Lane> TrilinearPowerForm(const Real* entry, const Lane r[3], Mat3<Lane>* dDdr)
+{
+  const Real* c = entry + 8;
+  Lane d[3];
+  FFD_UNROLL
+  for (int k = 0; k < 3; ++k)
+  {
+    const Lane a = Lane(c[k]) + r[0] * Lane(c[3 + k]);       // C000 + a C100
+    const Lane b = Lane(c[6 + k]) + r[0] * Lane(c[9 + k]);   // C010 + a C110
+    const Lane e = Lane(c[12 + k]) + r[0] * Lane(c[15 + k]); // C001 + a C101
+    const Lane f = Lane(c[18 + k]) + r[0] * Lane(c[21 + k]); // C011 + a C111
+    const Lane g = e + r[1] * f;
+    d[k] = (a + r[1] * b) + r[2] * g;
+    if (dDdr)
+    {
+      dDdr->M[k][0] = (Lane(c[3 + k]) + r[1] * Lane(c[9 + k])) + r[2] * (Lane(c[15 + k]) + r[1] * Lane(c[21 + k]));
+      dDdr->M[k][1] = b + r[2] * f;
+      dDdr->M[k][2] = g;
+    }
+  }
+  return { d[0], d[1], d[2] };
+}
+
 /**
  * A grid lattice's deformation, as plain data that host and device code evaluate alike. MaxCount bounds the
  * control points per axis that influence a point: 4 covers every local basis (and global ones up to degree 3),
@@ -86,10 +166,17 @@ FFD_INLINE Mat3<Real> DeformationJacobian(const Mat3<Real>& displacementGradient
  * the other bases' branches and unrolls the fixed-size sums, which made the local bases 2-3 times faster.
  * Real is the displacements' type; Lane, the arithmetic's, is Real too, or on the host a Lanes type
  * (FFDLanes.h) that deforms several points of one cell at once through these same functions (WithLanes()).
+ * A trilinear deformation WithCellTable evaluates each cell in power form from CellTable (FillTrilinearCellTable()
+ * of its displacements): the same function, rounded differently. That is a compile-time choice, so that no
+ * code path holds both evaluations, whose common subexpressions the compiler would otherwise share and round
+ * differently (a multiply no longer fused into its add) from one caller to another.
  */
-template <int MaxCount, typename Real, int StaticBasis = -1, typename Lane = Real>
+template <int MaxCount, typename Real, int StaticBasis = -1, typename Lane = Real, bool WithCellTable = false>
 struct GridDeformation
 {
+  static_assert(!WithCellTable || StaticBasis == -1 || StaticBasis == int(GridBasis::Trilinear),
+    "a cell table is for the trilinear basis");
+
   using Value = Real; ///< the displacements' type
 
   GridBasis Basis;
@@ -97,15 +184,19 @@ struct GridDeformation
   int Dims[3];               ///< control points per axis
   const Real* Displacements; ///< 3 per control point, VTK order: the lattice's points minus RestPosition
   ffd::Frame<Lane> Frame;
+  const Real* CellTable = nullptr; ///< WithCellTable: FillTrilinearCellTable() of Displacements
 
   /// This deformation evaluated in lanes of type OtherLane (its frame converted once, host only).
   template <typename OtherLane>
-  GridDeformation<MaxCount, Real, StaticBasis, OtherLane> WithLanes() const
+  GridDeformation<MaxCount, Real, StaticBasis, OtherLane, WithCellTable> WithLanes() const
   {
     return { this->Basis, { this->Voxels[0], this->Voxels[1], this->Voxels[2] },
       { this->Dims[0], this->Dims[1], this->Dims[2] }, this->Displacements,
-      this->Frame.template As<OtherLane>() };
+      this->Frame.template As<OtherLane>(), this->CellTable };
   }
+
+  /// True where cells are evaluated from CellTable (a compile-time constant).
+  static constexpr bool UsesCellTable() { return WithCellTable; }
 
   /// The basis: StaticBasis where it is known at compile time (constant-folded), else Basis.
   FFD_INLINE GridBasis BasisOf() const
@@ -116,6 +207,13 @@ struct GridDeformation
   /// X + D(s, t, u) for a point bound to `cell` (not -1); with lanes, every lane is bound to `cell`.
   FFD_INLINE Vec3<Lane> Deform(const Vec3<Lane>& x, int cell) const
   {
+    if constexpr (WithCellTable)
+    {
+      const Real* entry = this->CellTable + std::size_t(cell) * TrilinearCellStride;
+      Lane r[3];
+      this->TableCoordinates(this->Frame.ToParametric(x), { Lane(entry[0]), Lane(entry[1]), Lane(entry[2]) }, r);
+      return x + TrilinearPowerForm<Lane>(entry, r, nullptr);
+    }
     int c[3];
     this->CellIndices(cell, c);
     return this->DeformInCell(x, c);
@@ -131,18 +229,18 @@ struct GridDeformation
   }
 
   /**
-   * Deform() for lanes bound to different cells of a local basis (host only, Lane a Lanes type): `cell` holds
-   * each lane's cell index along each axis (CellIndices(), as numbers), and `values` reads each lane's control
-   * points as LatticeValues<Values>: for a control point given relative to its cell's first one
-   * (i + Dims[0] (j + Dims[1] k)), its value in every lane (FFDGridLanes.h). The same weights and sum as
-   * Deform(), so a lane's result is bit for bit the one it gets when all lanes share its cell.
+   * Deform() for lanes bound to different cells of a local basis (host only, Lane a Lanes type). `group` has the
+   * Count cells of the lanes: the k-th is Cells[k] (BindToGrid()'s flat index), its lanes Lanes[k], and, read
+   * without a CellTable, its index along each axis Indices[k] and its first control point Firsts[k]
+   * (i + Dims[0] (j + Dims[1] k)) (GroupCells in FFDGridLanes.h). Each cell's sum is computed for all lanes and
+   * kept in that cell's lanes, from the same weights (or local coordinates) as Deform(), so a lane's result is
+   * bit for bit the one it gets when all lanes share its cell.
    */
-  template <typename Values>
-  Vec3<Lane> DeformInLaneCells(const Vec3<Lane>& x, const Vec3<Lane>& cell, const Values* values) const
+  template <typename Group>
+  Vec3<Lane> DeformInLaneCells(const Vec3<Lane>& x, const Group& group) const
   {
-    AxisWeights<MaxCount, Lane> axes[3];
-    this->LaneCellWeights(this->Frame.ToParametric(x), cell, false, axes);
-    return x + SumTensorProduct(values, this->Dims, axes);
+    Mat3<Lane>* noGradient = nullptr;
+    return x + this->SumInLaneCells(this->Frame.ToParametric(x), group, noGradient);
   }
 
   /// The index along each axis of a bound cell: BindToGrid()'s flat index ci + cx (cj + cy ck) taken apart.
@@ -163,6 +261,16 @@ struct GridDeformation
   FFD_INLINE Vec3<Lane> Deform(const Vec3<Lane>& x, int cell, Mat3<Lane>& jacobian) const
   {
     const Vec3<Lane> stu = this->Frame.ToParametric(x);
+    if constexpr (WithCellTable)
+    {
+      const Real* entry = this->CellTable + std::size_t(cell) * TrilinearCellStride;
+      Lane r[3];
+      this->TableCoordinates(stu, { Lane(entry[0]), Lane(entry[1]), Lane(entry[2]) }, r);
+      Mat3<Lane> gradient;
+      const Vec3<Lane> d = TrilinearPowerForm<Lane>(entry, r, &gradient);
+      jacobian = this->JacobianAt(stu, this->TableGradient(gradient));
+      return x + d;
+    }
     int c[3];
     this->CellIndices(cell, c);
     AxisWeights<MaxCount, Lane> axes[3];
@@ -174,20 +282,126 @@ struct GridDeformation
   }
 
   /// DeformInLaneCells() and the Jacobian dX_ffd/dX there.
-  template <typename Values>
-  Vec3<Lane> DeformInLaneCells(
-    const Vec3<Lane>& x, const Vec3<Lane>& cell, const Values* values, Mat3<Lane>& jacobian) const
+  template <typename Group>
+  Vec3<Lane> DeformInLaneCells(const Vec3<Lane>& x, const Group& group, Mat3<Lane>& jacobian) const
   {
     const Vec3<Lane> stu = this->Frame.ToParametric(x);
-    AxisWeights<MaxCount, Lane> axes[3];
-    this->LaneCellWeights(stu, cell, true, axes);
     Mat3<Lane> gradient;
-    const Vec3<Lane> d = SumTensorProductWithGradient(values, this->Dims, axes, gradient);
+    Mat3<Lane>* withGradient = &gradient;
+    const Vec3<Lane> d = this->SumInLaneCells(stu, group, withGradient);
     jacobian = this->JacobianAt(stu, gradient);
     return x + d;
   }
 
 private:
+  /**
+   * The displacement (and, where `gradient` is not null, dD/d(s, t, u)) at parameters stu of lanes in the cells
+   * of `group` (DeformInLaneCells()): each lane's weights (or local coordinates) from its own cell's indices,
+   * then each cell's sum in all lanes, kept in that cell's lanes.
+   */
+  template <typename Group>
+  Vec3<Lane> SumInLaneCells(const Vec3<Lane>& stu, const Group& group, Mat3<Lane>* gradient) const
+  {
+    Vec3<Lane> index;
+    for (int k = 0; k < group.Count; ++k)
+    {
+      Vec3<Lane> ck;
+      if constexpr (WithCellTable)
+      {
+        const Real* entry = this->CellTable + std::size_t(group.Cells[k]) * TrilinearCellStride;
+        ck = { Lane(entry[0]), Lane(entry[1]), Lane(entry[2]) };
+      }
+      else
+      {
+        ck = { Lane(group.Indices[k][0]), Lane(group.Indices[k][1]), Lane(group.Indices[k][2]) };
+      }
+      const auto& lanes = group.Lanes[k];
+      index = k == 0 ? ck
+                     : Vec3<Lane>{ Select(lanes, ck.x, index.x), Select(lanes, ck.y, index.y),
+                         Select(lanes, ck.z, index.z) };
+    }
+    Lane r[3];
+    AxisWeights<MaxCount, Lane> axes[3];
+    if constexpr (WithCellTable)
+    {
+      this->TableCoordinates(stu, index, r);
+    }
+    else
+    {
+      this->LaneCellWeights(stu, index, gradient != nullptr, axes);
+    }
+    Vec3<Lane> d;
+    for (int k = 0; k < group.Count; ++k)
+    {
+      Mat3<Lane> gk;
+      Vec3<Lane> dk;
+      if constexpr (WithCellTable)
+      {
+        const Real* entry = this->CellTable + std::size_t(group.Cells[k]) * TrilinearCellStride;
+        dk = TrilinearPowerForm<Lane>(entry, r, gradient ? &gk : nullptr);
+        if (gradient)
+        {
+          gk = this->TableGradient(gk);
+        }
+      }
+      else
+      {
+        const Real* values = this->Displacements + 3 * group.Firsts[k];
+        dk = gradient ? SumTensorProductWithGradient(values, this->Dims, axes, gk)
+                      : SumTensorProduct(values, this->Dims, axes);
+      }
+      if (k == 0)
+      {
+        d = dk;
+        if (gradient)
+        {
+          *gradient = gk;
+        }
+        continue;
+      }
+      const auto& lanes = group.Lanes[k];
+      d = { Select(lanes, dk.x, d.x), Select(lanes, dk.y, d.y), Select(lanes, dk.z, d.z) };
+      if (gradient)
+      {
+        for (int row = 0; row < 3; ++row)
+        {
+          for (int column = 0; column < 3; ++column)
+          {
+            gradient->M[row][column] = Select(lanes, gk.M[row][column], gradient->M[row][column]);
+          }
+        }
+      }
+    }
+    return d;
+  }
+
+  /// The local coordinates in the cells of indices `cell` (as numbers) of points at parameters stu, as
+  /// ComputeAxisWeights() computes them.
+  FFD_INLINE void TableCoordinates(const Vec3<Lane>& stu, const Vec3<Lane>& cell, Lane r[3]) const
+  {
+    FFD_UNROLL
+    for (int a = 0; a < 3; ++a)
+    {
+      const Lane n = Lane(this->Voxels[a]);
+      r[a] = Clamp01(stu[a] * n - cell[a]);
+    }
+  }
+
+  /// dD/d(s, t, u) from the dD/dr of TrilinearPowerForm(): r = s n - c along each axis.
+  FFD_INLINE Mat3<Lane> TableGradient(Mat3<Lane> dDdr) const
+  {
+    FFD_UNROLL
+    for (int a = 0; a < 3; ++a)
+    {
+      const Lane n = Lane(this->Voxels[a]);
+      for (int row = 0; row < 3; ++row)
+      {
+        dDdr.M[row][a] = dDdr.M[row][a] * n;
+      }
+    }
+    return dDdr;
+  }
+
   /// The Jacobian from the displacement's gradient at parameters stu: a clamped direction (outside the frame)
   /// loses its column, the displacement not changing along it.
   FFD_INLINE Mat3<Lane> JacobianAt(const Vec3<Lane>& stu, Mat3<Lane> gradient) const

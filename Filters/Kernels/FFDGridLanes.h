@@ -7,16 +7,16 @@
  * are taken in blocks of BlockSize consecutive points, and a binding chooses how (MaxCellsInPlace(), from its
  * mean number of cells a block):
  * - In place (DeformBlocksInPlace()), reading and writing memory in order. A lane group in one cell reads each
- *   control point once for all lanes. A group in several cells reads each control point once per cell, kept in
- *   the lanes of that cell (LaneCells), and then computes the weights and their sum once for all lanes
+ *   control point once for all lanes. A group in several cells (listed at binding, ListBlockCells()) computes
+ *   each lane's weights once, then each cell's sum in all lanes, kept in that cell's lanes
  *   (GridDeformation::DeformInLaneCells()).
  * - Gathered (DeformGathered()): the points of the blocks in more than MaxCellsInPlace() cells are listed once,
  *   at binding, tile by tile, each tile's sorted by cell (GatherByCell()), and deformed W of one cell at a
  *   time: a gather and a scatter per point, at random but within a tile that stays in cache.
  * A mesh whose vertices come in a spatially coherent order has most of its groups in one cell and a few in two
  * or three: it is deformed in place. A mesh in random vertex order (the 0.4 M-point armadillo of BENCHMARKS.md,
- * 4.8 cells a block on average) would read its control points several times a group: its blocks in several
- * cells are gathered.
+ * 4.5 cells a block on average) would evaluate several cells a group: its blocks in several cells are gathered,
+ * but for the trilinear basis with a cell table, whose cells cost least.
  * Every lane's result depends only on its own point and cell, so a point is deformed the same whichever pass
  * takes it and however the work is split among threads. The one-point code (SimdLevel::None) computes the same
  * function; it may differ in the last bit, where the wide code fuses a multiply and an add.
@@ -31,6 +31,7 @@
 
 #include "FFDGridDeformation.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -109,17 +110,28 @@ inline double MeanCellsPerBlock(const int* cells, std::int64_t n)
 }
 
 /**
+ * True when a trilinear deformation of `points` points over `cells` cells is worth a CellTable
+ * (FillTrilinearCellTable(), rebuilt at every update): when it has at least 8 points a cell, so that building
+ * the table (about the cost of deforming 6 points a cell) costs less than what it saves.
+ */
+inline bool WorthTrilinearCellTable(GridBasis basis, std::int64_t cells, std::int64_t points)
+{
+  return basis == GridBasis::Trilinear && cells <= points / 8;
+}
+
+/**
  * The most cells a block's points may lie in for the block to be deformed in place (BlockInPlace(),
  * GatherByCell()), chosen for a binding from its mean number of cells per block. In place reads and writes
- * memory in order, but a lane group in several cells reads its control points once per cell; gathering costs
- * a gather and a scatter per point, at random within a tile of points (GatherTile), and then reads the control
- * points once per W points. With few cells a block on average (a mesh in a spatially coherent vertex order:
- * 1.45 for the 6.7 M-point armadillo of BENCHMARKS.md over 9^3 voxels) every block is deformed in place; with
- * more (4.8 for the 0.4 M-point one, whose vertex order is random) only the blocks in one cell are, and the
- * others gathered. The crossovers were measured on that mesh reordered to every mean in between (2026-11-23,
- * BENCHMARKS.md): lower for the bases that read more control points a cell.
+ * memory in order, but a lane group in several cells evaluates each of its cells in all its lanes; gathering
+ * costs a gather and a scatter per point, at random but within a tile of points (GatherTile), and then
+ * evaluates W points of one cell at once. With few cells a block on average (a mesh in a spatially coherent
+ * vertex order: 1.45 for the 6.7 M-point armadillo of BENCHMARKS.md over 9^3 voxels) every block is deformed in
+ * place; with more (4.5 for the 0.4 M-point one, whose vertex order is random) only the blocks in one cell are,
+ * and the others gathered. The crossovers were measured on that mesh reordered to every mean in between
+ * (BENCHMARKS.md): lower for the bases whose cells cost more, 5 for the trilinear basis with a CellTable
+ * (WorthTrilinearCellTable()), whose cells cost least.
  */
-inline int MaxCellsInPlace(GridBasis basis, double meanCellsPerBlock)
+inline int MaxCellsInPlace(GridBasis basis, double meanCellsPerBlock, bool cellTable)
 {
   double crossover = 1.5; // tricubic Bezier and cubic B-spline: 64 control points a cell
   if (basis == GridBasis::Bernstein)
@@ -128,7 +140,7 @@ inline int MaxCellsInPlace(GridBasis basis, double meanCellsPerBlock)
   }
   if (basis == GridBasis::Trilinear)
   {
-    crossover = 2.2; // 8 control points a cell
+    crossover = cellTable ? 5.0 : 2.2; // 7 multiply-adds a component, or 8 control points
   }
   else if (basis == GridBasis::TriquadraticBezier)
   {
@@ -160,6 +172,74 @@ inline bool BlockInPlace(const int* cells, std::int64_t n, std::int64_t b, int m
     return one;
   }
   return CellsOfBlock(cells, b) <= maxCells;
+}
+
+/**
+ * The cells of a binding's whole blocks, listed once per binding so that deforming a block in several cells does
+ * not search them again (a chain of dependent compares per cell, which cost more than the cell's sum): Entry[b]
+ * is -1 for block b when its points all lie in the cell of its first point (-1 included), else the offset in
+ * List of: the number of its cells other than -1, its CellsOfBlock(), then each cell other than -1 and the bits
+ * of the block's points in it (bit l for point b BlockSize + l). Blocks in more than MaxCells cells are left to
+ * the gathered pass.
+ */
+struct BlockCells
+{
+  int MaxCells = BlockSize;
+  std::vector<int> Entry;
+  std::vector<int> List;
+
+  /// True when whole block b is deformed in place (BlockInPlace()).
+  bool InPlace(std::int64_t b) const
+  {
+    const int entry = this->Entry[std::size_t(b)];
+    return entry < 0 || this->List[std::size_t(entry) + 1] <= this->MaxCells;
+  }
+};
+
+/// The BlockCells of n points bound to `cells`, with blocks in more than maxCells cells gathered.
+inline BlockCells ListBlockCells(const int* cells, std::int64_t n, int maxCells)
+{
+  BlockCells blocks;
+  blocks.MaxCells = maxCells;
+  blocks.Entry.resize(std::size_t(n / BlockSize));
+  for (std::size_t b = 0; b < blocks.Entry.size(); ++b)
+  {
+    const int* block = cells + b * BlockSize;
+    unsigned others = 0;
+    for (int l = 0; l < BlockSize; ++l)
+    {
+      others |= block[l] != block[0] ? 1u << l : 0u;
+    }
+    if (others == 0)
+    {
+      blocks.Entry[b] = -1;
+      continue;
+    }
+    const std::size_t entry = blocks.List.size();
+    blocks.Entry[b] = int(entry);
+    blocks.List.push_back(0);
+    blocks.List.push_back(CellsOfBlock(cells, std::int64_t(b)));
+    for (int l = 0; l < BlockSize; ++l)
+    {
+      bool seen = block[l] < 0;
+      for (int k = 0; k < l; ++k)
+      {
+        seen |= block[k] == block[l];
+      }
+      if (!seen)
+      {
+        unsigned bits = 0;
+        for (int m = l; m < BlockSize; ++m)
+        {
+          bits |= block[m] == block[l] ? 1u << m : 0u;
+        }
+        blocks.List.push_back(block[l]);
+        blocks.List.push_back(int(bits));
+        ++blocks.List[entry];
+      }
+    }
+  }
+  return blocks;
 }
 
 /// Consecutive points among which GatherByCell() sorts by cell: the gathered pass reads and writes at random
@@ -255,43 +335,7 @@ inline void FinishOnePoint(const Mat3<Real>& jacobian, const Real* inNormals, Re
 }
 
 #if FFD_HAVE_LANES
-/**
- * The cells of a lane group, for GridDeformation::DeformInLaneCells(): each one's first control point and lanes
- * (a mask). Count cells, or with Count 0 RuntimeCount of at most W: a count known at compile time unrolls the
- * reading of each control point, which otherwise costs as much as the rest of the evaluation. Lanes bound to no
- * cell take the first cell's values (and keep their position).
- */
-template <typename Lane, typename Value, int Count>
-struct LaneCells
-{
-  static constexpr int Capacity = Count > 0 ? Count : Lane::Width;
-  int RuntimeCount;
-  const Value* Values[Capacity];
-  typename Lane::IndexVector Lanes[Capacity];
-
-  int Size() const { return Count > 0 ? Count : this->RuntimeCount; }
-};
 } // namespace detail
-
-/// Control point `index` (relative to its cell's first one) in every lane: one broadcast per cell.
-template <typename Lane, typename Value, int Count>
-struct LatticeValues<detail::LaneCells<Lane, Value, Count>>
-{
-  template <typename Real>
-  static Vec3<Real> Get(const detail::LaneCells<Lane, Value, Count>* cells, int index)
-  {
-    const Value* v = cells->Values[0] + 3 * index;
-    Vec3<Real> value = { Real(v[0]), Real(v[1]), Real(v[2]) };
-    for (int c = 1; c < cells->Size(); ++c)
-    {
-      v = cells->Values[c] + 3 * index;
-      const typename Lane::IndexVector& lanes = cells->Lanes[c];
-      value = { Select(lanes, Real(v[0]), value.x), Select(lanes, Real(v[1]), value.y),
-        Select(lanes, Real(v[2]), value.z) };
-    }
-    return value;
-  }
-};
 
 namespace detail
 {
@@ -332,42 +376,69 @@ private:
 };
 
 /// The flat index of the first control point of a cell (not -1) of a local basis, and the cell's index along
-/// each axis in every lane.
-template <typename Deformation, typename Lane>
-inline int FirstOfCell(const Deformation& deformation, const CellSplit& split, int cell, Vec3<Lane>& index)
+/// each axis.
+template <typename Deformation>
+inline int FirstOfCell(const Deformation& deformation, const CellSplit& split, int cell, int index[3])
 {
-  int c[3], first[3], count;
-  split.Split(cell, c);
+  int first[3], count;
+  split.Split(cell, index);
   for (int a = 0; a < 3; ++a)
   {
-    VoxelSupport(deformation.BasisOf(), deformation.Voxels[a], c[a], first[a], count);
+    VoxelSupport(deformation.BasisOf(), deformation.Voxels[a], index[a], first[a], count);
   }
-  index = { Lane(c[0]), Lane(c[1]), Lane(c[2]) };
   return first[0] + deformation.Dims[0] * (first[1] + deformation.Dims[1] * first[2]);
 }
 
-/**
- * A lane group whose lanes lie in `count` (Count, where not 0) cells of a local basis: cells[k] is the k-th
- * cell, lanes[k] its lanes.
- */
-template <int Count, typename Deformation, typename Wide, typename Lane>
-inline Vec3<Lane> DeformInCells(const Deformation& deformation, const Wide& wide, const CellSplit& split,
-  const int* cells, const typename Lane::IndexVector* lanes, int count, const Vec3<Lane>& x)
+/// The mask of the lanes whose bits are set.
+template <typename Lane, std::size_t... L>
+inline typename Lane::IndexVector MaskOfBits(unsigned bits, std::index_sequence<L...>)
 {
-  LaneCells<Lane, typename Deformation::Value, Count> values;
-  values.RuntimeCount = count;
-  Vec3<Lane> index;
-  for (int k = 0; k < values.Size(); ++k)
-  {
-    Vec3<Lane> ci;
-    values.Values[k] = deformation.Displacements + 3 * FirstOfCell(deformation, split, cells[k], ci);
-    values.Lanes[k] = lanes[k];
-    index = k == 0 ? ci
-                   : Vec3<Lane>{ Select(lanes[k], ci.x, index.x), Select(lanes[k], ci.y, index.y),
-                       Select(lanes[k], ci.z, index.z) };
-  }
-  return wide.DeformInLaneCells(x, index, &values);
+  using Mask = typename Lane::IndexVector;
+  using Index = typename Lane::Index;
+  const Mask lane = { Index(Index(1) << L)... };
+  return (lane & (Mask{} + Index(bits))) != Mask{};
 }
+
+/**
+ * The cells of lane group `group` (of the BlockSize / W of a block) of a local basis, from the block's entry in
+ * BlockCells::List, for GridDeformation::DeformInLaneCells(). Lanes bound to no cell take the first cell's
+ * indices (and keep their position).
+ */
+template <typename Lane>
+struct GroupCells
+{
+  using Mask = typename Lane::IndexVector;
+  int Count = 0;
+  int Cells[Lane::Width];      ///< each cell (BindToGrid()'s flat index)
+  int Firsts[Lane::Width];     ///< each cell's first control point (not with a CellTable)
+  int Indices[Lane::Width][3]; ///< each cell's index along each axis (not with a CellTable)
+  Mask Lanes[Lane::Width];     ///< each cell's lanes
+  Mask Bound = {};             ///< the lanes bound to a cell
+
+  template <typename Deformation>
+  GroupCells(const Deformation& deformation, const CellSplit& split, const int* entry, int group)
+  {
+    const unsigned lanes = unsigned((std::uint64_t(1) << Lane::Width) - 1);
+    for (int k = 0; k < entry[0]; ++k)
+    {
+      const unsigned bits = (unsigned(entry[3 + 2 * k]) >> (group * Lane::Width)) & lanes;
+      if (bits == 0)
+      {
+        continue;
+      }
+      const Mask mine = MaskOfBits<Lane>(bits, std::make_index_sequence<Lane::Width>());
+      const int cell = entry[2 + 2 * k];
+      this->Cells[this->Count] = cell;
+      if constexpr (!Deformation::UsesCellTable())
+      {
+        this->Firsts[this->Count] = FirstOfCell(deformation, split, cell, this->Indices[this->Count]);
+      }
+      this->Lanes[this->Count] = mine;
+      this->Bound |= mine;
+      ++this->Count;
+    }
+  }
+};
 
 template <typename Lane>
 inline typename Lane::IndexVector LaneCellsOf(const int* cells)
@@ -378,55 +449,34 @@ inline typename Lane::IndexVector LaneCellsOf(const int* cells)
   return __builtin_convertvector(narrow, typename Lane::IndexVector);
 }
 
-/// Lane groups of the in-place pass (of a local basis) whose lanes are not all in one cell.
+/// Blocks of the in-place pass (of a local basis) whose points are not all in one cell.
 template <typename Lane, typename Deformation, typename Wide, typename Real>
 inline void DeformInSeveralCells(const Deformation& deformation, const Wide& wide, const CellSplit& split,
-  const Real* in, const int* cells, Real* out, const std::int64_t* groups, int groupCount)
+  const BlockCells& blocks, const Real* in, Real* out, const std::int64_t* several, int severalCount)
 {
-  using Mask = typename Lane::IndexVector;
-  for (int g = 0; g < groupCount; ++g)
+  for (int s = 0; s < severalCount; ++s)
   {
-    const std::int64_t i = groups[g];
-    Vec3<Lane> x;
-    Lane::Deinterleave3(in + 3 * i, x.x, x.y, x.z);
-    const Mask cell = LaneCellsOf<Lane>(cells + i);
-    const Mask bound = cell >= Mask{};
-    int distinct[Lane::Width];
-    Mask lanes[Lane::Width];
-    int count = 0;
-    for (unsigned todo = Lane::Bits(bound); todo != 0; ++count)
+    const int* entry = blocks.List.data() + blocks.Entry[std::size_t(several[s])];
+    for (int group = 0; group < BlockSize / Lane::Width; ++group)
     {
-      distinct[count] = cells[i + __builtin_ctz(todo)];
-      lanes[count] = cell == Mask{} + typename Lane::Index(distinct[count]);
-      todo &= ~Lane::Bits(lanes[count]);
+      const std::int64_t i = several[s] * BlockSize + group * Lane::Width;
+      Vec3<Lane> x;
+      Lane::Deinterleave3(in + 3 * i, x.x, x.y, x.z);
+      const GroupCells<Lane> cells(deformation, split, entry, group);
+      Vec3<Lane> y = x;
+      if (cells.Count > 0)
+      {
+        const Vec3<Lane> yc = wide.DeformInLaneCells(x, cells);
+        y = { Select(cells.Bound, yc.x, x.x), Select(cells.Bound, yc.y, x.y), Select(cells.Bound, yc.z, x.z) };
+      }
+      Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
     }
-    Vec3<Lane> yc = x;
-    if (count == 1)
-    {
-      int c[3];
-      split.Split(distinct[0], c);
-      yc = wide.DeformInCell(x, c);
-    }
-    else if (count == 2)
-    {
-      yc = DeformInCells<2>(deformation, wide, split, distinct, lanes, count, x);
-    }
-    else if (count == 3)
-    {
-      yc = DeformInCells<3>(deformation, wide, split, distinct, lanes, count, x);
-    }
-    else if (count > 3)
-    {
-      yc = DeformInCells<0>(deformation, wide, split, distinct, lanes, count, x);
-    }
-    const Vec3<Lane> y = { Select(bound, yc.x, x.x), Select(bound, yc.y, x.y), Select(bound, yc.z, x.z) };
-    Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
   }
 }
 
 template <int W, typename Deformation, typename Real>
 inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in, const int* cells, Real* out,
-  std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd, int maxCells)
+  const BlockCells& blocks, std::int64_t blockBegin, std::int64_t blockEnd)
 {
   static_assert(BlockSize % W == 0, "a block is a whole number of lane groups");
   using Lane = Lanes<Real, W>;
@@ -434,56 +484,66 @@ inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in,
   const auto wide = deformation.template WithLanes<Lane>();
   const bool global = deformation.BasisOf() == GridBasis::Bernstein;
   const CellSplit split(deformation);
-  // Lane groups in several cells (or with lanes bound to no cell) are deformed after the others of a window of
-  // blocks, still in cache: kept out of the loop over the window, their code leaves that loop's registers to
-  // the common case.
+  blockEnd = std::min(blockEnd, std::int64_t(blocks.Entry.size())); // the last, partial block is gathered
+  // Blocks in several cells are deformed after the others of a window of blocks, still in cache: kept out of the
+  // loop over the window, their code leaves that loop's registers to the common case.
   constexpr int Window = 64;
-  std::int64_t several[Window * BlockSize / W];
+  std::int64_t several[Window];
   for (std::int64_t window = blockBegin; window < blockEnd; window += Window)
   {
     int severalCount = 0;
     for (std::int64_t b = window; b < blockEnd && b < window + Window; ++b)
     {
-      if (!BlockInPlace(cells, n, b, maxCells))
+      if (!blocks.InPlace(b))
       {
         continue;
       }
+      if (!global && blocks.Entry[std::size_t(b)] >= 0)
+      {
+        several[severalCount++] = b;
+        continue;
+      }
+      const int first = cells[b * BlockSize];
+      int c[3];
+      if constexpr (!Deformation::UsesCellTable())
+      {
+        split.Split(first < 0 ? 0 : first, c);
+      }
       for (std::int64_t i = b * BlockSize; i < (b + 1) * BlockSize; i += W)
       {
-        const int first = cells[i];
-        const Mask cell = LaneCellsOf<Lane>(cells + i);
-        if (!global && Lane::Bits(cell == Mask{} + typename Lane::Index(first)) != (1u << W) - 1)
-        {
-          several[severalCount++] = i;
-          continue;
-        }
         Vec3<Lane> x;
         Lane::Deinterleave3(in + 3 * i, x.x, x.y, x.z);
         Vec3<Lane> y = x; // lanes of cell -1 keep their position
         if (global)
         {
           // The global basis has one cell, 0.
-          const Mask bound = cell >= Mask{};
+          const Mask bound = LaneCellsOf<Lane>(cells + i) >= Mask{};
           const Vec3<Lane> yc = wide.Deform(x, 0);
           y = { Select(bound, yc.x, x.x), Select(bound, yc.y, x.y), Select(bound, yc.z, x.z) };
         }
         else if (first >= 0)
         {
-          // One cell: each control point read once for all lanes.
-          int c[3];
-          split.Split(first, c);
-          y = wide.DeformInCell(x, c);
+          // One cell: each control point (or coefficient) read once for all lanes.
+          if constexpr (Deformation::UsesCellTable())
+          {
+            y = wide.Deform(x, first);
+          }
+          else
+          {
+            y = wide.DeformInCell(x, c);
+          }
         }
         Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
       }
     }
-    DeformInSeveralCells<Lane>(deformation, wide, split, in, cells, out, several, severalCount);
+    DeformInSeveralCells<Lane>(deformation, wide, split, blocks, in, out, several, severalCount);
   }
 }
 
 template <int W, typename Deformation, typename Real>
 inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, const int* cells,
-  const Real* inNormals, Real* out, Real* outNormals, Real* determinants, std::int64_t begin, std::int64_t end)
+  const BlockCells& blocks, const Real* inNormals, Real* out, Real* outNormals, Real* determinants,
+  std::int64_t begin, std::int64_t end)
 {
   using Lane = Lanes<Real, W>;
   using Mask = typename Lane::IndexVector;
@@ -491,53 +551,49 @@ inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, 
   const bool global = deformation.BasisOf() == GridBasis::Bernstein;
   const CellSplit split(deformation);
   const Mat3<Lane> identity = Mat3<Lane>::Identity();
+  // Whole blocks in lanes (begin is a block's first point), the last points one at a time.
+  const std::int64_t whole = std::min(end, std::int64_t(blocks.Entry.size()) * BlockSize);
   std::int64_t i = begin;
-  for (; i + W <= end; i += W)
+  for (; i < whole; i += W)
   {
     Vec3<Lane> x;
     Lane::Deinterleave3(in + 3 * i, x.x, x.y, x.z);
-    const Mask cell = LaneCellsOf<Lane>(cells + i);
-    const Mask bound = cell >= Mask{};
-    Vec3<Lane> y = x; // lanes of cell -1 keep their position, their Jacobian is the identity
-    Mat3<Lane> jacobian = identity;
-    unsigned todo = Lane::Bits(bound);
-    if (todo != 0)
+    const int entry = blocks.Entry[std::size_t(i / BlockSize)];
+    Vec3<Lane> yc = x;
+    Mat3<Lane> jc = identity;
+    Mask bound = {};
+    if (global)
     {
-      Vec3<Lane> yc;
-      Mat3<Lane> jc;
-      if (global)
+      bound = LaneCellsOf<Lane>(cells + i) >= Mask{};
+      yc = wide.Deform(x, 0, jc);
+    }
+    else if (entry < 0)
+    {
+      // One cell (or none) for the whole block.
+      if (cells[i] >= 0)
       {
-        yc = wide.Deform(x, 0, jc);
+        bound = ~Mask{};
+        yc = wide.Deform(x, cells[i], jc);
       }
-      else
+    }
+    else
+    {
+      // Every cell of the group: the weights and their derivatives once for all lanes, a sum per cell.
+      const GroupCells<Lane> group(deformation, split, blocks.List.data() + entry, int(i % BlockSize) / W);
+      bound = group.Bound;
+      if (group.Count > 0)
       {
-        // Every cell of the group (as DeformInSeveralCells() finds them), its control points read into its
-        // lanes: one evaluation of the weights, their derivatives and the sums for all lanes.
-        LaneCells<Lane, typename Deformation::Value, 0> values;
-        Vec3<Lane> index;
-        int count = 0;
-        for (; todo != 0; ++count)
-        {
-          const int c = cells[i + __builtin_ctz(todo)];
-          const Mask mine = cell == Mask{} + typename Lane::Index(c);
-          todo &= ~Lane::Bits(mine);
-          Vec3<Lane> ci;
-          values.Values[count] = deformation.Displacements + 3 * FirstOfCell(deformation, split, c, ci);
-          values.Lanes[count] = mine;
-          index = count == 0 ? ci
-                             : Vec3<Lane>{ Select(mine, ci.x, index.x), Select(mine, ci.y, index.y),
-                                 Select(mine, ci.z, index.z) };
-        }
-        values.RuntimeCount = count;
-        yc = wide.DeformInLaneCells(x, index, &values, jc);
+        yc = wide.DeformInLaneCells(x, group, jc);
       }
-      y = { Select(bound, yc.x, x.x), Select(bound, yc.y, x.y), Select(bound, yc.z, x.z) };
-      for (int r = 0; r < 3; ++r)
+    }
+    // Lanes of cell -1 keep their position, their Jacobian is the identity.
+    const Vec3<Lane> y = { Select(bound, yc.x, x.x), Select(bound, yc.y, x.y), Select(bound, yc.z, x.z) };
+    Mat3<Lane> jacobian;
+    for (int r = 0; r < 3; ++r)
+    {
+      for (int c = 0; c < 3; ++c)
       {
-        for (int c = 0; c < 3; ++c)
-        {
-          jacobian.M[r][c] = Select(bound, jc.M[r][c], identity.M[r][c]);
-        }
+        jacobian.M[r][c] = Select(bound, jc.M[r][c], identity.M[r][c]);
       }
     }
     Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
@@ -554,7 +610,7 @@ inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, 
       std::memcpy(determinants + i, &det.V, sizeof(det.V));
     }
   }
-  for (; i < end; ++i) // the last points, fewer than W
+  for (; i < end; ++i) // the points of the last, partial block
   {
     const Vec3<Real> x = Vec3<Real>::From(in + 3 * i);
     Mat3<Real> jacobian = Mat3<Real>::Identity();
@@ -653,16 +709,17 @@ inline void GatheredInLanes(const Deformation& deformation, const Real* in, cons
 #define FFD_LANE_VARIANTS(Suffix, Target, Bytes)                                                              \
   template <typename Deformation, typename Real>                                                              \
   Target void BlocksInPlace##Suffix(const Deformation& deformation, const Real* in, const int* cells, Real* out, \
-    std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd, int maxCells)                             \
+    const BlockCells& blocks, std::int64_t blockBegin, std::int64_t blockEnd)                                 \
   {                                                                                                           \
-    BlocksInPlaceInLanes<Bytes / sizeof(Real)>(deformation, in, cells, out, n, blockBegin, blockEnd, maxCells); \
+    BlocksInPlaceInLanes<Bytes / sizeof(Real)>(deformation, in, cells, out, blocks, blockBegin, blockEnd);    \
   }                                                                                                           \
   template <typename Deformation, typename Real>                                                              \
   Target void WithJacobian##Suffix(const Deformation& deformation, const Real* in, const int* cells,          \
-    const Real* inNormals, Real* out, Real* outNormals, Real* determinants, std::int64_t begin, std::int64_t end) \
+    const BlockCells& blocks, const Real* inNormals, Real* out, Real* outNormals, Real* determinants,          \
+    std::int64_t begin, std::int64_t end)                                                                     \
   {                                                                                                           \
     WithJacobianInLanes<Bytes / sizeof(Real)>(                                                                \
-      deformation, in, cells, inNormals, out, outNormals, determinants, begin, end);                         \
+      deformation, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);                 \
   }                                                                                                           \
   template <typename Deformation, typename Real>                                                              \
   Target void Gathered##Suffix(const Deformation& deformation, const Real* in, const int* cells,              \
@@ -679,30 +736,30 @@ FFD_LANE_VARIANTS(SSE2, FFD_TARGET_SSE2, 16)
 
 /**
  * First pass: out = the deformation of in for the points of blocks [blockBegin, blockEnd) that are deformed in
- * place (BlockInPlace() with maxCells, the value given to GatherByCell()); the others are left to
- * DeformGathered(). 3 values per point (x y z), n points, cells[i] from BindToGrid() (-1: the point keeps its
- * position). `level` at most SimdLevelOfCpu().
+ * place (BlockCells::InPlace(); `blocks` from ListBlockCells() with the maxCells given to GatherByCell()); the
+ * others, and the last block where it is partial, are left to DeformGathered(). 3 values per point (x y z),
+ * cells[i] from BindToGrid() (-1: the point keeps its position). `level` at most SimdLevelOfCpu().
  */
 template <typename Deformation, typename Real>
 inline void DeformBlocksInPlace(SimdLevel level, const Deformation& deformation, const Real* in, const int* cells,
-  Real* out, std::int64_t n, std::int64_t blockBegin, std::int64_t blockEnd, int maxCells)
+  Real* out, const BlockCells& blocks, std::int64_t blockBegin, std::int64_t blockEnd)
 {
 #if FFD_HAVE_LANES
   switch (level)
   {
     case SimdLevel::AVX512:
-      return detail::BlocksInPlaceAVX512(deformation, in, cells, out, n, blockBegin, blockEnd, maxCells);
+      return detail::BlocksInPlaceAVX512(deformation, in, cells, out, blocks, blockBegin, blockEnd);
     case SimdLevel::AVX2:
-      return detail::BlocksInPlaceAVX2(deformation, in, cells, out, n, blockBegin, blockEnd, maxCells);
+      return detail::BlocksInPlaceAVX2(deformation, in, cells, out, blocks, blockBegin, blockEnd);
     case SimdLevel::SSE2:
-      return detail::BlocksInPlaceSSE2(deformation, in, cells, out, n, blockBegin, blockEnd, maxCells);
+      return detail::BlocksInPlaceSSE2(deformation, in, cells, out, blocks, blockBegin, blockEnd);
     case SimdLevel::None:
       break;
   }
 #endif
-  for (std::int64_t b = blockBegin; b < blockEnd; ++b)
+  for (std::int64_t b = blockBegin; b < blockEnd && b < std::int64_t(blocks.Entry.size()); ++b)
   {
-    if (BlockInPlace(cells, n, b, maxCells))
+    if (blocks.InPlace(b))
     {
       for (std::int64_t i = b * BlockSize; i < (b + 1) * BlockSize; ++i)
       {
@@ -713,24 +770,28 @@ inline void DeformBlocksInPlace(SimdLevel level, const Deformation& deformation,
 }
 
 /**
- * Points [begin, end) with their Jacobians, in order (no gathering): out as DeformBlocksInPlace() and
- * DeformGathered() write it, and, where not null, outNormals (the normals inNormals transformed, TransformNormal())
- * and determinants (of the Jacobians). Every array holds Real values, 3 per point but determinants.
+ * Points [begin, end) with their Jacobians, in order (no gathering; begin is the first point of a block, `blocks`
+ * from ListBlockCells() of all points): out as DeformBlocksInPlace() and DeformGathered() write it, and, where
+ * not null, outNormals (the normals inNormals transformed, TransformNormal()) and determinants (of the
+ * Jacobians). Every array holds Real values, 3 per point but determinants.
  */
 template <typename Deformation, typename Real>
 inline void DeformWithJacobian(SimdLevel level, const Deformation& deformation, const Real* in, const int* cells,
-  const Real* inNormals, Real* out, Real* outNormals, Real* determinants, std::int64_t begin, std::int64_t end)
+  const BlockCells& blocks, const Real* inNormals, Real* out, Real* outNormals, Real* determinants,
+  std::int64_t begin, std::int64_t end)
 {
 #if FFD_HAVE_LANES
   switch (level)
   {
     case SimdLevel::AVX512:
       return detail::WithJacobianAVX512(
-        deformation, in, cells, inNormals, out, outNormals, determinants, begin, end);
+        deformation, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
     case SimdLevel::AVX2:
-      return detail::WithJacobianAVX2(deformation, in, cells, inNormals, out, outNormals, determinants, begin, end);
+      return detail::WithJacobianAVX2(
+        deformation, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
     case SimdLevel::SSE2:
-      return detail::WithJacobianSSE2(deformation, in, cells, inNormals, out, outNormals, determinants, begin, end);
+      return detail::WithJacobianSSE2(
+        deformation, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
     case SimdLevel::None:
       break;
   }

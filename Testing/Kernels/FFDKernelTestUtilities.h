@@ -282,9 +282,10 @@ inline GridLattice RandomGridLattice(Rng& rng, ffdref::Basis basis, int maxDivis
 
 /**
  * A lattice's deformation as the filters hold it: displacements rounded to Real and an ffd::GridDeformation over
- * them. MaxCount is 4, what the local bases need, and MaxBernsteinDegree + 1 for the global basis.
+ * them, for a trilinear lattice with CellTable its ffd::FillTrilinearCellTable() too. MaxCount is 4, what the local
+ * bases need, and MaxBernsteinDegree + 1 for the global basis.
  */
-template <typename Real, int MaxCount>
+template <typename Real, int MaxCount, bool CellTable = false>
 class Kernel
 {
 public:
@@ -300,6 +301,13 @@ public:
     }
     this->D.Displacements = this->Values.data();
     this->D.Frame = KernelFrame<Real>(lat.F);
+    if (CellTable)
+    {
+      const int cells = lat.Divisions[0] * lat.Divisions[1] * lat.Divisions[2];
+      this->Table.resize(std::size_t(cells) * ffd::TrilinearCellStride);
+      ffd::FillTrilinearCellTable(this->Values.data(), this->D.Voxels, this->D.Dims, this->Table.data(), 0, cells);
+      this->D.CellTable = this->Table.data();
+    }
   }
   Kernel(const Kernel&) = delete; // D points into Values
   Kernel& operator=(const Kernel&) = delete;
@@ -310,11 +318,13 @@ public:
   }
 
   const std::vector<Real> Values;
-  ffd::GridDeformation<MaxCount, Real> D;
+  std::vector<Real> Table;
+  ffd::GridDeformation<MaxCount, Real, -1, Real, CellTable> D;
 };
 
 /// Calls f(kernel) with the Kernels of lat that the filters may build: MaxCount 4 for the local bases and for
-/// the global basis of degree <= 3 (one cubic voxel), MaxBernsteinDegree + 1 for the global basis.
+/// the global basis of degree <= 3 (one cubic voxel), MaxBernsteinDegree + 1 for the global basis, and for the
+/// trilinear basis one with a cell table too.
 template <typename Real, typename F>
 void WithKernel(const GridLattice& lat, F&& f)
 {
@@ -326,6 +336,11 @@ void WithKernel(const GridLattice& lat, F&& f)
   if (lat.Basis != ffdref::Basis::Bernstein || std::max({ lat.Divisions[0], lat.Divisions[1], lat.Divisions[2] }) <= 3)
   {
     const Kernel<Real, 4> k(lat);
+    f(k);
+  }
+  if (lat.Basis == ffdref::Basis::Trilinear)
+  {
+    const Kernel<Real, 4, true> k(lat);
     f(k);
   }
 }

