@@ -162,10 +162,33 @@ struct BindWorker
 // stay the same (vtkFFDBindingKey).
 struct GridBinding
 {
-  std::vector<int> Cells;    // per input point: its cell (ffd::BindToGrid), -1 where it keeps its position
-  ffd::BlockCells Blocks;    // the cells of each block of points (ffd::ListBlockCells)
-  std::vector<int> Gathered; // the points of blocks not deformed in place, sorted by cell (ffd::GatherByCell)
-  bool CellTable = false;    // trilinear evaluation from ffd::FillTrilinearCellTable (ffd::WorthTrilinearCellTable)
+  std::vector<int> Cells;      // per input point: its cell (ffd::BindToGrid), -1 where it keeps its position
+  ffd::BlockCells Blocks;      // the cells of each block of points (ffd::ListBlockCells)
+  ffd::GatheredPoints Gathered; // the points of blocks not deformed in place (ffd::ListGatheredPoints)
+  bool CellTable = false;      // trilinear evaluation from ffd::FillTrilinearCellTable (ffd::WorthTrilinearCellTable)
+  // The gathered points' coordinates in their listed order (ffd::CopyGatheredPoints), in the precision of the
+  // evaluations that needed them: copied from the input at the first, then read in order by every update.
+  std::vector<float> ListedFloat;
+  std::vector<double> ListedDouble;
+
+  template <typename Real>
+  const Real* Listed(const Real* inPoints)
+  {
+    std::vector<Real>& listed = this->ListedOf(Real());
+    const vtkIdType count = vtkIdType(this->Gathered.Order.size());
+    if (listed.size() != std::size_t(3 * count))
+    {
+      listed.resize(std::size_t(3 * count));
+      vtkSMPTools::For(0, count, [&](vtkIdType begin, vtkIdType end) {
+        ffd::CopyGatheredPoints(inPoints, this->Gathered, begin, end, listed.data());
+      });
+    }
+    return listed.data();
+  }
+
+private:
+  std::vector<float>& ListedOf(float) { return this->ListedFloat; }
+  std::vector<double>& ListedOf(double) { return this->ListedDouble; }
 };
 
 //------------------------------------------------------------------------------------------------------------
@@ -231,22 +254,22 @@ struct LanesFunctor
   const Real* InPoints;
   Real* OutPoints;
   const GridBinding& Binding;
+  const Real* Listed; // GridBinding::Listed()
   Deformer Deformation;
-  bool GatheredPass; // false: over blocks, true: over Binding.Gathered
+  bool GatheredPass; // false: over the blocks of points, true: over the blocks of Binding.Gathered
 
   void operator()(vtkIdType begin, vtkIdType end)
   {
     static const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
-    const int* cells = this->Binding.Cells.data();
     if (this->GatheredPass)
     {
-      ffd::DeformGathered(level, this->Deformation, this->InPoints, cells, this->Binding.Gathered.data(),
-        this->OutPoints, begin, end);
+      ffd::DeformGathered(
+        level, this->Deformation, this->Listed, this->Binding.Gathered, this->OutPoints, begin, end);
     }
     else
     {
-      ffd::DeformBlocksInPlace(
-        level, this->Deformation, this->InPoints, cells, this->OutPoints, this->Binding.Blocks, begin, end);
+      ffd::DeformBlocksInPlace(level, this->Deformation, this->InPoints, this->Binding.Cells.data(),
+        this->OutPoints, this->Binding.Blocks, begin, end);
     }
   }
 };
@@ -279,7 +302,7 @@ template <typename Real>
 struct EvaluateWorker
 {
   template <typename PointArrayT>
-  void operator()(PointArrayT* inPoints, const LatticeView& lattice, const GridBinding& binding,
+  void operator()(PointArrayT* inPoints, const LatticeView& lattice, GridBinding& binding,
     vtkDataArray* inNormals, vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outPoints,
     vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self, double progressBegin, bool& completed)
   {
@@ -334,7 +357,7 @@ struct EvaluateWorker
 
   template <int MaxCount, int StaticBasis, bool WithCellTable, typename PointArrayT>
   void Run(PointArrayT* inPoints, const LatticeView& lattice, const Real* displacements, const Real* cellTable,
-    const GridBinding& binding, vtkDataArray* inNormals, vtkDataArray* outNormals,
+    GridBinding& binding, vtkDataArray* inNormals, vtkDataArray* outNormals,
     vtkAOSDataArrayTemplate<Real>* outPoints, vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self,
     double progressBegin, bool& completed)
   {
@@ -348,14 +371,15 @@ struct EvaluateWorker
     {
       if (!outNormals && !determinants)
       {
-        LanesFunctor<Deformation, Real> lanes{ inPoints->GetPointer(0), outPoints->GetPointer(0), binding,
-          deformation, false };
+        const Real* in = inPoints->GetPointer(0);
+        LanesFunctor<Deformation, Real> lanes{ in, outPoints->GetPointer(0), binding,
+          binding.Gathered.Order.empty() ? nullptr : binding.Listed(in), deformation, false };
         const vtkIdType blocks = (n + ffd::BlockSize - 1) / ffd::BlockSize;
-        const vtkIdType gathered = vtkIdType(binding.Gathered.size());
+        const vtkIdType gathered = vtkIdType(binding.Gathered.Order.size());
         const double middle = progressBegin + (1.0 - progressBegin) * double(n - gathered) / double(n);
         completed = vtkFFDForInChunks(self, blocks, lanes, progressBegin, middle);
         lanes.GatheredPass = true;
-        completed = completed && vtkFFDForInChunks(self, gathered, lanes, middle, 1.0);
+        completed = completed && vtkFFDForInChunks(self, binding.Gathered.BlockCount(), lanes, middle, 1.0);
         return;
       }
       using NormalArray = vtkAOSDataArrayTemplate<Real>;
@@ -607,7 +631,9 @@ int vtkFFDDeform::RequestData(
       const int maxCellsInPlace = ffd::MaxCellsInPlace(
         view.Basis, ffd::MeanCellsPerBlock(grid.Cells.data(), numberOfPoints), grid.CellTable);
       grid.Blocks = ffd::ListBlockCells(grid.Cells.data(), numberOfPoints, maxCellsInPlace);
-      grid.Gathered = ffd::GatherByCell(grid.Cells.data(), numberOfPoints, cellCount, maxCellsInPlace);
+      grid.Gathered = ffd::ListGatheredPoints(grid.Cells.data(), numberOfPoints, cellCount, maxCellsInPlace);
+      grid.ListedFloat.clear();
+      grid.ListedDouble.clear();
       internals.Bound = key;
       ++this->NumberOfBindings;
     }

@@ -242,10 +242,10 @@ inline BlockCells ListBlockCells(const int* cells, std::int64_t n, int maxCells)
   return blocks;
 }
 
-/// Consecutive points among which GatherByCell() sorts by cell: the gathered pass reads and writes at random
-/// only within such a tile, whose points (192 KB in and out in float32) stay in a core's L2 cache, instead of
-/// across the whole mesh (from DRAM where the mesh is larger than the caches).
-constexpr int GatherTile = 8192;
+/// Consecutive points among which GatherByCell() sorts by cell: the gathered pass writes at random only within
+/// such a tile, whose points (384 KB in float32) stay in a core's L2 cache, instead of across the whole mesh
+/// (from DRAM where the mesh is larger than the caches). Larger tiles leave fewer lane groups in two cells.
+constexpr int GatherTile = 32768;
 
 /**
  * The points of the blocks not deformed in place (BlockInPlace() with maxCells), tile by tile (GatherTile),
@@ -301,6 +301,57 @@ inline std::vector<int> GatherByCell(const int* cells, std::int64_t n, int cellC
   return gathered;
 }
 
+/**
+ * The points that the gathered pass deforms (DeformGathered()), listed once per binding: Order, GatherByCell()'s
+ * list, its last point repeated up to a whole number of blocks (so that every listed point is deformed in lanes,
+ * as bit for bit as the in-place pass; a repeated point is written twice, the same value); Cells, their cells in
+ * that order; Blocks, the BlockCells of that order (every block in place). The pass reads the points'
+ * coordinates in that order from a copy (CopyGatheredPoints()), so that it reads memory in order and deforms
+ * whole lane groups of one cell, and writes each result to its place, at random within a tile.
+ */
+struct GatheredPoints
+{
+  std::vector<int> Order;
+  std::vector<int> Cells;
+  BlockCells Blocks;
+
+  /// The blocks of the list.
+  std::int64_t BlockCount() const { return std::int64_t(this->Order.size()) / BlockSize; }
+};
+
+/// The GatheredPoints of n points bound to `cells` (a binding of cellCount cells) with blocks in more than
+/// maxCells cells gathered.
+inline GatheredPoints ListGatheredPoints(const int* cells, std::int64_t n, int cellCount, int maxCells)
+{
+  GatheredPoints gathered;
+  gathered.Order = GatherByCell(cells, n, cellCount, maxCells);
+  while (gathered.Order.size() % BlockSize != 0)
+  {
+    gathered.Order.push_back(gathered.Order.back());
+  }
+  gathered.Cells.reserve(gathered.Order.size());
+  for (int i : gathered.Order)
+  {
+    gathered.Cells.push_back(cells[i]);
+  }
+  gathered.Blocks = ListBlockCells(gathered.Cells.data(), std::int64_t(gathered.Cells.size()), BlockSize);
+  return gathered;
+}
+
+/// copy = in[Order[g]] (3 values each) for the listed points g in [begin, end): what DeformGathered() reads.
+template <typename Real>
+inline void CopyGatheredPoints(
+  const Real* in, const GatheredPoints& gathered, std::int64_t begin, std::int64_t end, Real* copy)
+{
+  for (std::int64_t g = begin; g < end; ++g)
+  {
+    const std::int64_t i = gathered.Order[std::size_t(g)];
+    copy[3 * g] = in[3 * i];
+    copy[3 * g + 1] = in[3 * i + 1];
+    copy[3 * g + 2] = in[3 * i + 2];
+  }
+}
+
 namespace detail
 {
 /// Point i deformed alone: cell -1 keeps its position.
@@ -312,6 +363,20 @@ inline void DeformOnePoint(const Deformation& deformation, const Real* in, const
   out[3 * i] = y.x;
   out[3 * i + 1] = y.y;
   out[3 * i + 2] = y.z;
+}
+
+/// Point g of the gathered list deformed alone, written to its place.
+template <typename Deformation, typename Real>
+inline void DeformOneGathered(
+  const Deformation& deformation, const Real* listed, const GatheredPoints& gathered, Real* out, std::int64_t g)
+{
+  const Vec3<Real> x = Vec3<Real>::From(listed + 3 * g);
+  const int cell = gathered.Cells[std::size_t(g)];
+  const Vec3<Real> y = cell >= 0 ? deformation.Deform(x, cell) : x;
+  Real* to = out + 3 * std::int64_t(gathered.Order[std::size_t(g)]);
+  to[0] = y.x;
+  to[1] = y.y;
+  to[2] = y.z;
 }
 
 /// Where `outNormals` (or `determinants`) is not null: point i's transformed normal (its Jacobian's determinant)
@@ -452,7 +517,8 @@ inline typename Lane::IndexVector LaneCellsOf(const int* cells)
 /// Blocks of the in-place pass (of a local basis) whose points are not all in one cell.
 template <typename Lane, typename Deformation, typename Wide, typename Real>
 inline void DeformInSeveralCells(const Deformation& deformation, const Wide& wide, const CellSplit& split,
-  const BlockCells& blocks, const Real* in, Real* out, const std::int64_t* several, int severalCount)
+  const BlockCells& blocks, const Real* in, Real* out, std::int64_t outFirst, const std::int64_t* several,
+  int severalCount)
 {
   for (int s = 0; s < severalCount; ++s)
   {
@@ -469,14 +535,15 @@ inline void DeformInSeveralCells(const Deformation& deformation, const Wide& wid
         const Vec3<Lane> yc = wide.DeformInLaneCells(x, cells);
         y = { Select(cells.Bound, yc.x, x.x), Select(cells.Bound, yc.y, x.y), Select(cells.Bound, yc.z, x.z) };
       }
-      Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
+      Lane::Interleave3(y.x, y.y, y.z, out + 3 * (i - outFirst));
     }
   }
 }
 
+/// The in-place pass over blocks [blockBegin, blockEnd); point i's result goes to out + 3 (i - outFirst).
 template <int W, typename Deformation, typename Real>
 inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in, const int* cells, Real* out,
-  const BlockCells& blocks, std::int64_t blockBegin, std::int64_t blockEnd)
+  const BlockCells& blocks, std::int64_t blockBegin, std::int64_t blockEnd, std::int64_t outFirst)
 {
   static_assert(BlockSize % W == 0, "a block is a whole number of lane groups");
   using Lane = Lanes<Real, W>;
@@ -533,10 +600,10 @@ inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in,
             y = wide.DeformInCell(x, c);
           }
         }
-        Lane::Interleave3(y.x, y.y, y.z, out + 3 * i);
+        Lane::Interleave3(y.x, y.y, y.z, out + 3 * (i - outFirst));
       }
     }
-    DeformInSeveralCells<Lane>(deformation, wide, split, blocks, in, out, several, severalCount);
+    DeformInSeveralCells<Lane>(deformation, wide, split, blocks, in, out, outFirst, several, severalCount);
   }
 }
 
@@ -622,85 +689,23 @@ inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, 
   }
 }
 
-/// Lanes that the gathered pass stages at once: up to this many points, in groups of W of one cell.
-constexpr int GatherStage = 512;
-
-/// How many listed points ahead the gathered pass prefetches.
-constexpr int GatherPrefetch = 96;
+/// Blocks of the gathered list that the gathered pass deforms into a buffer on the stack before it scatters them.
+constexpr int GatherChunk = 64;
 
 template <int W, typename Deformation, typename Real>
-inline void GatheredInLanes(const Deformation& deformation, const Real* in, const int* cells, const int* gathered,
-  Real* out, std::int64_t begin, std::int64_t end)
+inline void GatheredInLanes(const Deformation& deformation, const Real* listed, const GatheredPoints& gathered,
+  Real* out, std::int64_t blockBegin, std::int64_t blockEnd)
 {
-  static_assert(GatherStage % W == 0, "whole lane groups");
-  using Lane = Lanes<Real, W>;
-  const auto wide = deformation.template WithLanes<Lane>();
-  // Points are copied into `staged` a batch of lane groups at a time, deformed there, and copied out: a lane
-  // group loaded right after its points were stored one by one would wait for the stores (no store-to-load
-  // forwarding from several stores into one load), for longer than its deformation takes.
-  alignas(64) Real staged[3 * GatherStage];
-  int groupCell[GatherStage / W], groupSize[GatherStage / W];
-  std::int64_t g = begin;
-  while (g < end)
+  alignas(64) Real staged[3 * GatherChunk * BlockSize];
+  for (std::int64_t chunk = blockBegin; chunk < blockEnd; chunk += GatherChunk)
   {
-    const std::int64_t batch = g;
-    int groups = 0;
-    while (g < end && groups < GatherStage / W)
+    const std::int64_t end = std::min(chunk + GatherChunk, blockEnd);
+    BlocksInPlaceInLanes<W>(deformation, listed, gathered.Cells.data(), staged, gathered.Blocks, chunk, end,
+      chunk * BlockSize);
+    const int* order = gathered.Order.data() + chunk * BlockSize;
+    for (std::int64_t p = 0; p < (end - chunk) * BlockSize; ++p)
     {
-      // Up to W listed points of one cell; unused lanes repeat the first point and are not written back.
-      const int cell = cells[gathered[g]];
-      int count = 1;
-      while (count < W && g + count < end && cells[gathered[g + count]] == cell)
-      {
-        ++count;
-      }
-      Real* lanes = staged + 3 * W * groups;
-      for (int l = 0; l < count; ++l)
-      {
-        // The listed points a few groups ahead, whose reads and writes would otherwise wait for memory one
-        // after the other where the mesh is larger than the caches (1.5 times faster on 6.7 M points).
-        const std::int64_t ahead = g + l + GatherPrefetch;
-        if (ahead < end)
-        {
-          const std::int64_t i = gathered[ahead];
-          __builtin_prefetch(in + 3 * i);
-          __builtin_prefetch(out + 3 * i, 1);
-          __builtin_prefetch(cells + i);
-        }
-      }
-      for (int l = 0; l < W; ++l)
-      {
-        const std::int64_t i = gathered[g + (l < count ? l : 0)];
-        lanes[3 * l] = in[3 * i];
-        lanes[3 * l + 1] = in[3 * i + 1];
-        lanes[3 * l + 2] = in[3 * i + 2];
-      }
-      groupCell[groups] = cell;
-      groupSize[groups++] = count;
-      g += count;
-    }
-    for (int k = 0; k < groups; ++k)
-    {
-      if (groupCell[k] >= 0)
-      {
-        Real* lanes = staged + 3 * W * k;
-        Vec3<Lane> x;
-        Lane::Deinterleave3(lanes, x.x, x.y, x.z);
-        const Vec3<Lane> y = wide.Deform(x, groupCell[k]);
-        Lane::Interleave3(y.x, y.y, y.z, lanes);
-      }
-    }
-    std::int64_t listed = batch;
-    for (int k = 0; k < groups; ++k)
-    {
-      const Real* lanes = staged + 3 * W * k;
-      for (int l = 0; l < groupSize[k]; ++l)
-      {
-        const std::int64_t i = gathered[listed++];
-        out[3 * i] = lanes[3 * l];
-        out[3 * i + 1] = lanes[3 * l + 1];
-        out[3 * i + 2] = lanes[3 * l + 2];
-      }
+      std::memcpy(out + 3 * std::int64_t(order[p]), staged + 3 * p, 3 * sizeof(Real));
     }
   }
 }
@@ -711,7 +716,7 @@ inline void GatheredInLanes(const Deformation& deformation, const Real* in, cons
   Target void BlocksInPlace##Suffix(const Deformation& deformation, const Real* in, const int* cells, Real* out, \
     const BlockCells& blocks, std::int64_t blockBegin, std::int64_t blockEnd)                                 \
   {                                                                                                           \
-    BlocksInPlaceInLanes<Bytes / sizeof(Real)>(deformation, in, cells, out, blocks, blockBegin, blockEnd);    \
+    BlocksInPlaceInLanes<Bytes / sizeof(Real)>(deformation, in, cells, out, blocks, blockBegin, blockEnd, 0); \
   }                                                                                                           \
   template <typename Deformation, typename Real>                                                              \
   Target void WithJacobian##Suffix(const Deformation& deformation, const Real* in, const int* cells,          \
@@ -722,10 +727,10 @@ inline void GatheredInLanes(const Deformation& deformation, const Real* in, cons
       deformation, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);                 \
   }                                                                                                           \
   template <typename Deformation, typename Real>                                                              \
-  Target void Gathered##Suffix(const Deformation& deformation, const Real* in, const int* cells,              \
-    const int* gathered, Real* out, std::int64_t begin, std::int64_t end)                                     \
+  Target void Gathered##Suffix(const Deformation& deformation, const Real* listed, const GatheredPoints& gathered, \
+    Real* out, std::int64_t blockBegin, std::int64_t blockEnd)                                                \
   {                                                                                                           \
-    GatheredInLanes<Bytes / sizeof(Real)>(deformation, in, cells, gathered, out, begin, end);                \
+    GatheredInLanes<Bytes / sizeof(Real)>(deformation, listed, gathered, out, blockBegin, blockEnd);         \
   }
 FFD_LANE_VARIANTS(AVX512, FFD_TARGET_AVX512, 64)
 FFD_LANE_VARIANTS(AVX2, FFD_TARGET_AVX2, 32)
@@ -808,27 +813,30 @@ inline void DeformWithJacobian(SimdLevel level, const Deformation& deformation, 
   }
 }
 
-/// Second pass: the points gathered[begin, end) of GatherByCell()'s list.
+/**
+ * Second pass: the listed points of blocks [blockBegin, blockEnd) of `gathered` (of GatheredPoints::BlockCount()),
+ * whose coordinates `listed` holds in listed order (CopyGatheredPoints()), each written to its place in out.
+ */
 template <typename Deformation, typename Real>
-inline void DeformGathered(SimdLevel level, const Deformation& deformation, const Real* in, const int* cells,
-  const int* gathered, Real* out, std::int64_t begin, std::int64_t end)
+inline void DeformGathered(SimdLevel level, const Deformation& deformation, const Real* listed,
+  const GatheredPoints& gathered, Real* out, std::int64_t blockBegin, std::int64_t blockEnd)
 {
 #if FFD_HAVE_LANES
   switch (level)
   {
     case SimdLevel::AVX512:
-      return detail::GatheredAVX512(deformation, in, cells, gathered, out, begin, end);
+      return detail::GatheredAVX512(deformation, listed, gathered, out, blockBegin, blockEnd);
     case SimdLevel::AVX2:
-      return detail::GatheredAVX2(deformation, in, cells, gathered, out, begin, end);
+      return detail::GatheredAVX2(deformation, listed, gathered, out, blockBegin, blockEnd);
     case SimdLevel::SSE2:
-      return detail::GatheredSSE2(deformation, in, cells, gathered, out, begin, end);
+      return detail::GatheredSSE2(deformation, listed, gathered, out, blockBegin, blockEnd);
     case SimdLevel::None:
       break;
   }
 #endif
-  for (std::int64_t g = begin; g < end; ++g)
+  for (std::int64_t g = blockBegin * BlockSize; g < blockEnd * BlockSize; ++g)
   {
-    detail::DeformOnePoint(deformation, in, cells, out, gathered[g]);
+    detail::DeformOneGathered(deformation, listed, gathered, out, g);
   }
 }
 

@@ -99,11 +99,11 @@ PointSet<Real> MeshLikePoints(ffdtest::Rng& rng, const GridLattice& lat, const K
   return set;
 }
 
-/// Both passes over the whole set with blocks in at most maxCells cells in place, the ranges cut at the given
-/// points (sorted, within the ranges).
+/// Both passes over the whole set with blocks in at most maxCells cells in place (`gathered` listed for that
+/// limit), the ranges of blocks cut at the given blocks (sorted, within the ranges).
 template <typename D, typename Real>
 std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Real>& set,
-  const std::vector<int>& gathered, int maxCells, const std::vector<std::int64_t>& blockCuts = {},
+  const ffd::GatheredPoints& gathered, int maxCells, const std::vector<std::int64_t>& blockCuts = {},
   const std::vector<std::int64_t>& gatheredCuts = {})
 {
   std::vector<Real> out(set.Values.size(), std::numeric_limits<Real>::quiet_NaN()); // poisoned
@@ -116,14 +116,15 @@ std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Rea
     begin = cut;
   }
   ffd::DeformBlocksInPlace(level, d, set.Values.data(), set.Cells.data(), out.data(), listed, begin, blocks);
+  std::vector<Real> copy(3 * gathered.Order.size());
+  ffd::CopyGatheredPoints(set.Values.data(), gathered, 0, std::int64_t(gathered.Order.size()), copy.data());
   begin = 0;
   for (std::int64_t cut : gatheredCuts)
   {
-    ffd::DeformGathered(level, d, set.Values.data(), set.Cells.data(), gathered.data(), out.data(), begin, cut);
+    ffd::DeformGathered(level, d, copy.data(), gathered, out.data(), begin, cut);
     begin = cut;
   }
-  ffd::DeformGathered(level, d, set.Values.data(), set.Cells.data(), gathered.data(), out.data(), begin,
-    std::int64_t(gathered.size()));
+  ffd::DeformGathered(level, d, copy.data(), gathered, out.data(), begin, gathered.BlockCount());
   return out;
 }
 
@@ -166,8 +167,8 @@ TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
         const PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 1001);
         for (int maxCells : MaxCellsToTry())
         {
-          const std::vector<int> gathered =
-            ffd::GatherByCell(set.Cells.data(), set.Size(), CellCount(lat), maxCells);
+          const ffd::GatheredPoints gathered =
+            ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells);
           for (ffd::SimdLevel level : Levels())
           {
             const std::vector<Real> out = DeformAll(level, k.D, set, gathered, maxCells);
@@ -245,17 +246,17 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
         std::vector<Real> first; // the result of the first cell limit, which the others must give
         for (int maxCells : MaxCellsToTry())
         {
-          const std::vector<int> gathered =
-            ffd::GatherByCell(set.Cells.data(), set.Size(), CellCount(lat), maxCells);
-          const std::vector<int> shuffledGathered =
-            ffd::GatherByCell(shuffled.Cells.data(), shuffled.Size(), CellCount(lat), maxCells);
+          const ffd::GatheredPoints gathered =
+            ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells);
+          const ffd::GatheredPoints shuffledGathered =
+            ffd::ListGatheredPoints(shuffled.Cells.data(), shuffled.Size(), CellCount(lat), maxCells);
           if (b != Basis::Bernstein && maxCells < ffd::BlockSize) // its points lie in one cell, or outside
           {
-            ASSERT_GT(shuffledGathered.size(), gathered.size()) << lat.Name();
+            ASSERT_GT(shuffledGathered.Order.size(), gathered.Order.size()) << lat.Name();
           }
           const std::vector<Real> whole = DeformAll(level, k.D, set, gathered, maxCells);
           const std::vector<Real> split = DeformAll(level, k.D, set, gathered, maxCells,
-            cuts((set.Size() + ffd::BlockSize - 1) / ffd::BlockSize), cuts(std::int64_t(gathered.size())));
+            cuts((set.Size() + ffd::BlockSize - 1) / ffd::BlockSize), cuts(gathered.BlockCount()));
           const std::vector<Real> reordered = DeformAll(level, k.D, shuffled, shuffledGathered, maxCells);
           if (first.empty())
           {
@@ -443,6 +444,17 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
   EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 1, 9));
   EXPECT_TRUE(ffd::BlockInPlace(cells.data(), n, 1, 10));
   EXPECT_EQ(ffd::GatherByCell(cells.data(), n, 8, ffd::BlockSize), expectedTail);
+
+  // What the gathered pass reads: that list, its last point repeated up to whole blocks, and their cells.
+  const ffd::GatheredPoints gathered = ffd::ListGatheredPoints(cells.data(), n, 8, maxCells);
+  ASSERT_EQ(gathered.Order.size(), 2u * ffd::BlockSize);
+  EXPECT_EQ(gathered.BlockCount(), 2);
+  for (std::size_t g = 0; g < gathered.Order.size(); ++g)
+  {
+    EXPECT_EQ(gathered.Order[g], expected[std::min(g, expected.size() - 1)]) << g;
+    EXPECT_EQ(gathered.Cells[g], cells[std::size_t(gathered.Order[g])]) << g;
+  }
+  EXPECT_EQ(gathered.Blocks.Entry.size(), 2u);
 
   // The mean over the whole blocks, and the limits it gives: every block in place for a trilinear lattice at
   // a mean of 2 or less, only the blocks in one cell above it (and never for the global basis).
