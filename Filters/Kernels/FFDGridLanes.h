@@ -122,29 +122,30 @@ inline bool WorthTrilinearCellTable(GridBasis basis, std::int64_t cells, std::in
 /**
  * The most cells a block's points may lie in for the block to be deformed in place (BlockInPlace(),
  * GatherByCell()), chosen for a binding from its mean number of cells per block. In place reads and writes
- * memory in order, but a lane group in several cells evaluates each of its cells in all its lanes; gathering
- * costs a gather and a scatter per point, at random but within a tile of points (GatherTile), and then
- * evaluates W points of one cell at once. With few cells a block on average (a mesh in a spatially coherent
- * vertex order: 1.45 for the 6.7 M-point armadillo of BENCHMARKS.md over 9^3 voxels) every block is deformed in
- * place; with more (4.5 for the 0.4 M-point one, whose vertex order is random) only the blocks in one cell are,
- * and the others gathered. The crossovers were measured on that mesh reordered to every mean in between
- * (BENCHMARKS.md): lower for the bases whose cells cost more, 5 for the trilinear basis with a CellTable
- * (WorthTrilinearCellTable()), whose cells cost least.
+ * memory in order, but a lane group in several cells evaluates each of its cells in all its lanes; the gathered
+ * pass reads a copy of its points in order, sorted by cell within tiles (GatherTile), evaluates whole lane groups
+ * of one cell, and writes each result to its place, at random within its tile. With few cells a block on
+ * average (a mesh in a spatially coherent vertex order: 1.5 for the 6.7 M-point armadillo of BENCHMARKS.md over
+ * 9^3 voxels) every block is deformed in place; with more (4.5 for the 0.4 M-point one, whose vertex order is
+ * random) only the blocks in one cell are, and the others gathered. The crossovers were measured on both meshes
+ * reordered to means in between (2026-11-23, BENCHMARKS.md): lower for the bases whose cells cost more. Where
+ * the mesh fits in the caches the gathered pass wins sooner (its writes at random stay there), where it does not
+ * later; these are in between.
  */
 inline int MaxCellsInPlace(GridBasis basis, double meanCellsPerBlock, bool cellTable)
 {
-  double crossover = 1.5; // tricubic Bezier and cubic B-spline: 64 control points a cell
+  double crossover = 1.2; // tricubic Bezier and cubic B-spline: 64 control points a cell
   if (basis == GridBasis::Bernstein)
   {
     return BlockSize; // one cell
   }
   if (basis == GridBasis::Trilinear)
   {
-    crossover = cellTable ? 5.0 : 2.2; // 7 multiply-adds a component, or 8 control points
+    crossover = cellTable ? 2.0 : 1.7; // 7 multiply-adds a component, or 8 control points
   }
   else if (basis == GridBasis::TriquadraticBezier)
   {
-    crossover = 1.7; // 27
+    crossover = 1.6; // 27 control points
   }
   return meanCellsPerBlock <= crossover ? BlockSize : 1;
 }

@@ -457,14 +457,15 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
   EXPECT_EQ(gathered.Blocks.Entry.size(), 2u);
 
   // The mean over the whole blocks, and the limits it gives: every block in place for a trilinear lattice at
-  // a mean of 2 or less, only the blocks in one cell above it (and never for the global basis).
+  // a mean of 1.7 or less (2 with a cell table), only the blocks in one cell above it (and never for the global
+  // basis).
   EXPECT_EQ(ffd::CellsOfBlock(cells.data(), 1), maxCells + 2);
   EXPECT_DOUBLE_EQ(ffd::MeanCellsPerBlock(cells.data(), n), (1.0 + (maxCells + 2) + 2.0) / 3.0);
-  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 2.0, false), ffd::BlockSize);
-  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 4.8, false), 1);
-  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 4.8, true), ffd::BlockSize);
-  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 6.0, true), 1);
-  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::CubicBSpline, 2.0, false), 1);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 1.5, false), ffd::BlockSize);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 1.9, false), 1);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 1.9, true), ffd::BlockSize);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 4.5, true), 1);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::CubicBSpline, 1.5, false), 1);
   EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Bernstein, 16.0, false), ffd::BlockSize);
 
   // The same blocks listed: block 0 in one cell, block 1 in 9 cells and -1, block 2 in cell 3 (its odd points)
