@@ -9,7 +9,8 @@
  * point is read once and broadcast). The arithmetic is GCC/Clang vector extensions rather than intrinsics: a
  * function compiled for AVX-512 gets zmm instructions, one for AVX2 ymm, and a plain x86-64 build SSE2
  * (FFDGridLanes.h picks the widest at run time), from the same source. The exceptions, a broadcast, a square
- * root and a mask to bits, are one intrinsic per width (detail::Splat(), detail::Sqrt(), detail::LaneBits()).
+ * root, a mask to bits and a non-temporal store, are one intrinsic per width (detail::Splat(), detail::Sqrt(),
+ * detail::LaneBits(), detail::Stream()).
  */
 #ifndef FFDLanes_h
 #define FFDLanes_h
@@ -70,6 +71,33 @@ inline void Splat(float s, Float32x4& v)
 inline void Splat(double s, Float64x2& v)
 {
   v = reinterpret_cast<Float64x2>(_mm_set1_pd(s));
+}
+
+/// *p = v by a non-temporal store (p aligned to the vector's size): the cache line is written without being
+/// read first, and not kept in the caches.
+__attribute__((target("avx512f"))) inline void Stream(float* p, const Float32x16& v)
+{
+  _mm512_stream_ps(p, reinterpret_cast<__m512>(v));
+}
+__attribute__((target("avx512f"))) inline void Stream(double* p, const Float64x8& v)
+{
+  _mm512_stream_pd(p, reinterpret_cast<__m512d>(v));
+}
+__attribute__((target("avx"))) inline void Stream(float* p, const Float32x8& v)
+{
+  _mm256_stream_ps(p, reinterpret_cast<__m256>(v));
+}
+__attribute__((target("avx"))) inline void Stream(double* p, const Float64x4& v)
+{
+  _mm256_stream_pd(p, reinterpret_cast<__m256d>(v));
+}
+inline void Stream(float* p, const Float32x4& v)
+{
+  _mm_stream_ps(p, reinterpret_cast<__m128>(v));
+}
+inline void Stream(double* p, const Float64x2& v)
+{
+  _mm_stream_pd(p, reinterpret_cast<__m128d>(v));
 }
 
 /// r = the square root of v in every lane.
@@ -207,12 +235,14 @@ struct Lanes
     z = Gather<2>(a, b, c, std::make_index_sequence<W>());
   }
 
-  /// The inverse of Deinterleave3().
+  /// The inverse of Deinterleave3(). Streaming: by non-temporal stores (detail::Stream()), p aligned to the
+  /// vector's size; the caller fences them (_mm_sfence()) before another thread reads them.
+  template <bool Streaming = false>
   static void Interleave3(const Lanes& x, const Lanes& y, const Lanes& z, T* p)
   {
-    Scatter<0>(x.V, y.V, z.V, p, std::make_index_sequence<W>());
-    Scatter<1>(x.V, y.V, z.V, p + W, std::make_index_sequence<W>());
-    Scatter<2>(x.V, y.V, z.V, p + 2 * W, std::make_index_sequence<W>());
+    Scatter<0, Streaming>(x.V, y.V, z.V, p, std::make_index_sequence<W>());
+    Scatter<1, Streaming>(x.V, y.V, z.V, p + W, std::make_index_sequence<W>());
+    Scatter<2, Streaming>(x.V, y.V, z.V, p + 2 * W, std::make_index_sequence<W>());
   }
 
 private:
@@ -229,14 +259,21 @@ private:
 
   // Value m = K W + j of the interleaved output is component m % 3 of lane m / 3. (Stored here rather than
   // returned: GCC warns of the ABI of a returned vector in code not compiled for its width.)
-  template <int K, std::size_t... J>
+  template <int K, bool Streaming, std::size_t... J>
   static void Scatter(const Vector& x, const Vector& y, const Vector& z, T* p, std::index_sequence<J...>)
   {
     constexpr Index w = W;
     const IndexVector fromXY = { Index(((K * W + J) % 3 == 1 ? w : 0) + ((K * W + J) % 3 == 2 ? 0 : (K * W + J) / 3))... };
     const IndexVector withZ = { Index((K * W + J) % 3 == 2 ? w + Index((K * W + J) / 3) : Index(J))... };
     const Vector v = __builtin_shuffle(__builtin_shuffle(x, y, fromXY), z, withZ);
-    std::memcpy(p, &v, sizeof(Vector));
+    if constexpr (Streaming)
+    {
+      detail::Stream(p, v);
+    }
+    else
+    {
+      std::memcpy(p, &v, sizeof(Vector));
+    }
   }
 };
 

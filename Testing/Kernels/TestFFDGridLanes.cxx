@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <cstdlib>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -100,32 +102,37 @@ PointSet<Real> MeshLikePoints(ffdtest::Rng& rng, const GridLattice& lat, const K
 }
 
 /// Both passes over the whole set with blocks in at most maxCells cells in place (`gathered` listed for that
-/// limit), the ranges of blocks cut at the given blocks (sorted, within the ranges).
+/// limit), the ranges of blocks cut at the given blocks (sorted, within the ranges); with `stream`, into memory
+/// aligned to 64 bytes, the in-place pass by non-temporal stores.
 template <typename D, typename Real>
 std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Real>& set,
   const ffd::GatheredPoints& gathered, int maxCells, const std::vector<std::int64_t>& blockCuts = {},
-  const std::vector<std::int64_t>& gatheredCuts = {})
+  const std::vector<std::int64_t>& gatheredCuts = {}, bool stream = false)
 {
-  std::vector<Real> out(set.Values.size(), std::numeric_limits<Real>::quiet_NaN()); // poisoned
+  const std::size_t bytes = (set.Values.size() * sizeof(Real) + 63) / 64 * 64;
+  const std::unique_ptr<Real, decltype(&std::free)> aligned(
+    static_cast<Real*>(std::aligned_alloc(64, std::max<std::size_t>(bytes, 64))), &std::free);
+  Real* out = aligned.get();
+  std::fill(out, out + set.Values.size(), std::numeric_limits<Real>::quiet_NaN()); // poisoned
   const std::int64_t blocks = (set.Size() + ffd::BlockSize - 1) / ffd::BlockSize;
   const ffd::BlockCells listed = ffd::ListBlockCells(set.Cells.data(), set.Size(), maxCells);
   std::int64_t begin = 0;
   for (std::int64_t cut : blockCuts)
   {
-    ffd::DeformBlocksInPlace(level, d, set.Values.data(), set.Cells.data(), out.data(), listed, begin, cut);
+    ffd::DeformBlocksInPlace(level, d, set.Values.data(), set.Cells.data(), out, listed, begin, cut, stream);
     begin = cut;
   }
-  ffd::DeformBlocksInPlace(level, d, set.Values.data(), set.Cells.data(), out.data(), listed, begin, blocks);
+  ffd::DeformBlocksInPlace(level, d, set.Values.data(), set.Cells.data(), out, listed, begin, blocks, stream);
   std::vector<Real> copy(3 * gathered.Order.size());
   ffd::CopyGatheredPoints(set.Values.data(), gathered, 0, std::int64_t(gathered.Order.size()), copy.data());
   begin = 0;
   for (std::int64_t cut : gatheredCuts)
   {
-    ffd::DeformGathered(level, d, copy.data(), gathered, out.data(), begin, cut);
+    ffd::DeformGathered(level, d, copy.data(), gathered, out, begin, cut);
     begin = cut;
   }
-  ffd::DeformGathered(level, d, copy.data(), gathered, out.data(), begin, gathered.BlockCount());
-  return out;
+  ffd::DeformGathered(level, d, copy.data(), gathered, out, begin, gathered.BlockCount());
+  return std::vector<Real>(out, out + set.Values.size());
 }
 
 /// The cell limits of the in-place pass that the tests try: every block gathered but those in one cell (what
@@ -209,7 +216,8 @@ TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
 TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
 {
   // At each level, a point's result is the same bit for bit: in its mesh order, split into random sub-ranges
-  // (as threads split it), in a shuffled order (lane groups of many cells), and whichever pass takes it: with
+  // (as threads split it), written by non-temporal stores, in a shuffled order (lane groups of many cells), and
+  // whichever pass takes it: with
   // every block gathered but those in one cell, with the filter's cell limit, and with every block in place.
   using Real = TypeParam;
   ffdtest::Rng rng(602);
@@ -258,6 +266,7 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
           const std::vector<Real> split = DeformAll(level, k.D, set, gathered, maxCells,
             cuts((set.Size() + ffd::BlockSize - 1) / ffd::BlockSize), cuts(gathered.BlockCount()));
           const std::vector<Real> reordered = DeformAll(level, k.D, shuffled, shuffledGathered, maxCells);
+          const std::vector<Real> streamed = DeformAll(level, k.D, set, gathered, maxCells, {}, {}, true);
           if (first.empty())
           {
             first = whole;
@@ -271,6 +280,7 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
             {
               ASSERT_EQ(whole[3 * i + c], first[3 * i + c]) << where;
               ASSERT_EQ(split[3 * i + c], whole[3 * i + c]) << where;
+              ASSERT_EQ(streamed[3 * i + c], whole[3 * i + c]) << where << " (non-temporal stores)";
               ASSERT_EQ(reordered[3 * p + c], whole[3 * i + c]) << where;
             }
           }
