@@ -38,6 +38,11 @@ vtkStandardNewMacro(vtkFFDDeform);
 namespace
 {
 //------------------------------------------------------------------------------------------------------------
+// Points, and blocks of ffd::BlockSize points, that an SMP task takes at least (vtkFFDForInChunks).
+constexpr vtkIdType PointGrain = 16384;
+constexpr vtkIdType BlockGrain = PointGrain / ffd::BlockSize;
+
+//------------------------------------------------------------------------------------------------------------
 // What the filter needs from a lattice, read and checked once per update.
 struct LatticeView
 {
@@ -154,7 +159,7 @@ struct BindWorker
     PointArrayT* points, const BindSettings& settings, int* cells, vtkAlgorithm* self, bool& completed)
   {
     BindFunctor<PointArrayT> functor{ points, settings, cells };
-    completed = vtkFFDForInChunks(self, points->GetNumberOfTuples(), functor, 0.0, 0.5);
+    completed = vtkFFDForInChunks(self, points->GetNumberOfTuples(), PointGrain, functor, 0.0, 0.5);
   }
 };
 
@@ -180,7 +185,7 @@ struct GridBinding
     if (listed.size() != std::size_t(3 * count))
     {
       listed.resize(std::size_t(3 * count));
-      vtkSMPTools::For(0, count, [&](vtkIdType begin, vtkIdType end) {
+      vtkSMPTools::For(0, count, PointGrain, [&](vtkIdType begin, vtkIdType end) {
         ffd::CopyGatheredPoints(inPoints, this->Gathered, begin, end, listed.data());
       });
     }
@@ -314,7 +319,7 @@ struct EvaluateWorker
     {
       const int cells = lattice.Divisions[0] * lattice.Divisions[1] * lattice.Divisions[2];
       cellTable.resize(std::size_t(cells) * ffd::TrilinearCellStride);
-      vtkSMPTools::For(0, cells, [&](int begin, int end) {
+      vtkSMPTools::For(0, cells, 4096, [&](int begin, int end) {
         ffd::FillTrilinearCellTable(
           displacements.data(), lattice.Divisions, lattice.Dims, cellTable.data(), begin, end);
       });
@@ -380,9 +385,10 @@ struct EvaluateWorker
         const vtkIdType blocks = (n + ffd::BlockSize - 1) / ffd::BlockSize;
         const vtkIdType gathered = vtkIdType(binding.Gathered.Order.size());
         const double middle = progressBegin + (1.0 - progressBegin) * double(n - gathered) / double(n);
-        completed = vtkFFDForInChunks(self, blocks, lanes, progressBegin, middle);
+        completed = vtkFFDForInChunks(self, blocks, BlockGrain, lanes, progressBegin, middle);
         lanes.GatheredPass = true;
-        completed = completed && vtkFFDForInChunks(self, binding.Gathered.BlockCount(), lanes, middle, 1.0);
+        completed =
+          completed && vtkFFDForInChunks(self, binding.Gathered.BlockCount(), BlockGrain, lanes, middle, 1.0);
         return;
       }
       using NormalArray = vtkAOSDataArrayTemplate<Real>;
@@ -393,13 +399,14 @@ struct EvaluateWorker
         JacobianFunctor<Deformation, Real> jacobian{ inPoints->GetPointer(0), outPoints->GetPointer(0), binding,
           n, normalsIn ? normalsIn->GetPointer(0) : nullptr, normalsOut ? normalsOut->GetPointer(0) : nullptr,
           determinants ? determinants->GetPointer(0) : nullptr, deformation };
-        completed = vtkFFDForInChunks(self, (n + ffd::BlockSize - 1) / ffd::BlockSize, jacobian, progressBegin, 1.0);
+        completed = vtkFFDForInChunks(
+          self, (n + ffd::BlockSize - 1) / ffd::BlockSize, BlockGrain, jacobian, progressBegin, 1.0);
         return;
       }
     }
     EvaluateFunctor<Deformation, Real, PointArrayT> functor{ inPoints, outPoints->GetPointer(0),
       binding.Cells.data(), deformation, inNormals, outNormals, determinants ? determinants->GetPointer(0) : nullptr };
-    completed = vtkFFDForInChunks(self, inPoints->GetNumberOfTuples(), functor, progressBegin, 1.0);
+    completed = vtkFFDForInChunks(self, inPoints->GetNumberOfTuples(), PointGrain, functor, progressBegin, 1.0);
   }
 };
 

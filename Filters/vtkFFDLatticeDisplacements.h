@@ -28,9 +28,10 @@ inline vtkIdType vtkFFDReadLatticeDisplacements(
   {
     restValues->resize(3 * count);
   }
-  // In parallel: a lattice of 100 k nodes, read serially, would hold up every update by a millisecond.
+  // In parallel: a lattice of 100 k nodes, read serially, would hold up every update by a millisecond; in tasks
+  // of at least 4096 nodes, so that a small lattice is read in one.
   std::atomic<vtkIdType> firstNotFinite(count);
-  vtkSMPTools::For(0, count, [&](vtkIdType begin, vtkIdType end) {
+  vtkSMPTools::For(0, count, 4096, [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType p = begin; p < end; ++p)
     {
       double x[3], x0[3];

@@ -332,7 +332,7 @@ struct EvaluateWorker
   {
     EvaluateFunctor<Real, PointArrayT> functor{ inPoints, outPoints, cells, maps, inNormals, outNormals,
       determinants };
-    completed = vtkFFDForInChunks(self, inPoints->GetNumberOfTuples(), functor, progressBegin, progressEnd);
+    completed = vtkFFDForInChunks(self, inPoints->GetNumberOfTuples(), 16384, functor, progressBegin, progressEnd);
   }
 };
 } // namespace
@@ -494,7 +494,7 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
     const Seeds seeds = MakeSeeds(this->RestValues, walker);
     WalkFunctor walk{ points, walker, seeds, this->Cells.data() };
     const double middle = progressBegin + 0.8 * (progressEnd - progressBegin);
-    if (!vtkFFDForInChunks(self, numberOfPoints, walk, progressBegin, middle))
+    if (!vtkFFDForInChunks(self, numberOfPoints, 1024, walk, progressBegin, middle))
     {
       return false;
     }
@@ -511,7 +511,7 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
   {
     buildLocator();
     LocateFunctor locate{ points, locator, this->Frames, this->Degenerate, undecided, this->Cells.data(), {}, {} };
-    if (!vtkFFDForInChunks(self, static_cast<vtkIdType>(undecided.size()), locate,
+    if (!vtkFFDForInChunks(self, static_cast<vtkIdType>(undecided.size()), 256, locate,
           progressBegin + 0.8 * (progressEnd - progressBegin), progressEnd))
     {
       return false;

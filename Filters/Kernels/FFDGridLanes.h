@@ -204,7 +204,12 @@ struct BlockCells
   bool InPlace(std::int64_t b) const
   {
     const int entry = this->Entry[std::size_t(b)];
-    return entry < 0 || this->List[std::size_t(entry) + 1] <= this->MaxCells;
+    if (entry < 0 || this->MaxCells >= BlockSize)
+    {
+      return true;
+    }
+    // A block listed is in at least 2 cells (-1 counts): what MaxCellsInPlace() gives, 1, needs no look.
+    return this->MaxCells > 1 && this->List[std::size_t(entry) + 1] <= this->MaxCells;
   }
 };
 
