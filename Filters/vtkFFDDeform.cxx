@@ -171,7 +171,7 @@ struct GridBinding
   std::vector<int> Cells;      // per input point: its cell (ffd::BindToGrid), -1 where it keeps its position
   ffd::BlockCells Blocks;      // the cells of each block of points (ffd::ListBlockCells)
   ffd::GatheredPoints Gathered; // the points of blocks not deformed in place (ffd::ListGatheredPoints)
-  bool CellTable = false;      // trilinear evaluation from ffd::FillTrilinearCellTable (ffd::WorthTrilinearCellTable)
+  bool CellTable = false;      // evaluation from ffd::FillCellTable (ffd::WorthCellTable)
   // The gathered points' coordinates in their listed order (ffd::CopyGatheredPoints), in the precision of the
   // evaluations that needed them: copied from the input at the first, then read in order by every update.
   std::vector<float> ListedFloat;
@@ -318,10 +318,10 @@ struct EvaluateWorker
     if (binding.CellTable)
     {
       const int cells = lattice.Divisions[0] * lattice.Divisions[1] * lattice.Divisions[2];
-      cellTable.resize(std::size_t(cells) * ffd::TrilinearCellStride);
-      vtkSMPTools::For(0, cells, 4096, [&](int begin, int end) {
-        ffd::FillTrilinearCellTable(
-          displacements.data(), lattice.Divisions, lattice.Dims, cellTable.data(), begin, end);
+      cellTable.resize(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(lattice.Basis)));
+      vtkSMPTools::For(0, cells, 256, [&](int begin, int end) {
+        ffd::FillCellTable(
+          lattice.Basis, displacements.data(), lattice.Divisions, lattice.Dims, cellTable.data(), begin, end);
       });
     }
     // One instantiation per basis (see ffd::GridDeformation's StaticBasis). The global basis sums over every
@@ -351,13 +351,34 @@ struct EvaluateWorker
         }
         break;
       case GridBasis::TriquadraticBezier:
-        run(Local(), std::integral_constant<int, int(GridBasis::TriquadraticBezier)>(), NoTable());
+        if (binding.CellTable)
+        {
+          run(Local(), std::integral_constant<int, int(GridBasis::TriquadraticBezier)>(), std::true_type());
+        }
+        else
+        {
+          run(Local(), std::integral_constant<int, int(GridBasis::TriquadraticBezier)>(), NoTable());
+        }
         break;
       case GridBasis::TricubicBezier:
-        run(Local(), std::integral_constant<int, int(GridBasis::TricubicBezier)>(), NoTable());
+        if (binding.CellTable)
+        {
+          run(Local(), std::integral_constant<int, int(GridBasis::TricubicBezier)>(), std::true_type());
+        }
+        else
+        {
+          run(Local(), std::integral_constant<int, int(GridBasis::TricubicBezier)>(), NoTable());
+        }
         break;
       case GridBasis::CubicBSpline:
-        run(Local(), std::integral_constant<int, int(GridBasis::CubicBSpline)>(), NoTable());
+        if (binding.CellTable)
+        {
+          run(Local(), std::integral_constant<int, int(GridBasis::CubicBSpline)>(), std::true_type());
+        }
+        else
+        {
+          run(Local(), std::integral_constant<int, int(GridBasis::CubicBSpline)>(), NoTable());
+        }
         break;
     }
   }
@@ -655,7 +676,7 @@ int vtkFFDDeform::RequestData(
         cellCount *= ffd::BindingCells(view.Basis, view.Divisions[a]);
       }
       GridBinding& grid = internals.Grid;
-      grid.CellTable = ffd::WorthTrilinearCellTable(view.Basis, cellCount, numberOfPoints);
+      grid.CellTable = ffd::WorthCellTable(view.Basis, cellCount, numberOfPoints);
       const int maxCellsInPlace = ffd::MaxCellsInPlace(
         view.Basis, ffd::MeanCellsPerBlock(grid.Cells.data(), numberOfPoints), grid.CellTable);
       grid.Blocks = ffd::ListBlockCells(grid.Cells.data(), numberOfPoints, maxCellsInPlace);

@@ -79,80 +79,219 @@ FFD_INLINE Mat3<Real> DeformationJacobian(const Mat3<Real>& displacementGradient
   return j;
 }
 
-/// Reals per cell in a TrilinearCellTable: the cell's indices along the three axes, 5 unused (so that the
-/// coefficients start 32 bytes in), then the 8 coefficients of FillTrilinearCellTable(), x y z each.
-constexpr int TrilinearCellStride = 32;
+/// The degree of a local basis's polynomial in each cell along each axis: 1 (trilinear), 2 (triquadratic), 3
+/// (tricubic Bezier and cubic B-spline); 0 for the global basis, which has no cell table.
+FFD_INLINE constexpr int CellDegree(GridBasis basis)
+{
+  return basis == GridBasis::CubicBSpline ? 3 : BezierDegree(basis);
+}
+
+/// Reals per cell in a cell table of a basis of that degree (FillCellTable()): the cell's indices along the
+/// three axes, 5 unused, then the (degree + 1)^3 coefficients x y z each, rounded up to 32 bytes of floats.
+FFD_INLINE constexpr int CellTableStride(int degree)
+{
+  return (8 + 3 * (degree + 1) * (degree + 1) * (degree + 1) + 7) / 8 * 8;
+}
 
 /**
- * A trilinear lattice's displacement in each of its cells [cellBegin, cellEnd) (flat indices, as BindToGrid()
+ * A local basis's displacement in each of its cells [cellBegin, cellEnd) (flat indices, as BindToGrid()
  * numbers them) in power form: at local coordinates (a, b, c) in [0, 1]^3 of the cell,
- * D = C000 + a C100 + b (C010 + a C110) + c (C001 + a C101 + b (C011 + a C111)), where the C are sums and
- * differences of the cell's 8 corner displacements (computed in double). That is 7 multiply-adds a component,
- * against 14 and the weights (1 - a and so on) for the weighted sum of the corners, which bounded the CPU's
- * trilinear evaluation (BENCHMARKS.md). The rest lattice's coefficients are all 0, so it stays exactly the
- * identity. `displacements` as GridDeformation::Displacements; `table` holds TrilinearCellStride Reals per cell.
+ * D = sum over i, j, k <= degree of C_ijk a^i b^j c^k, the C from the cell's (degree + 1)^3 control points by the
+ * basis's change to monomials along each axis, in double. Horner's rule then takes (degree + 1)^3 - 1
+ * multiply-adds a component, against about 1.3 times that and the weights for the weighted sum of the control
+ * points (a half, and 14 against 7, for the trilinear basis), which bounded the CPU's evaluation
+ * (BENCHMARKS.md). The rest lattice's coefficients are all 0, so it stays exactly the identity. `displacements`
+ * as GridDeformation::Displacements on a grid of `dims`; `table` holds CellTableStride(CellDegree(basis)) Reals
+ * per cell.
  */
-template <typename Real>
-inline void FillTrilinearCellTable(
-  const Real* displacements, const int voxels[3], const int dims[3], Real* table, int cellBegin, int cellEnd)
+namespace detail
 {
+/// FillCellTable() for a basis of degree N - 1 whose change to monomials along an axis is `toMonomial`
+/// (toMonomial[j][a]: the coefficient of r^j in the basis function of the cell's control point a).
+template <int N, typename Real>
+inline void FillCellTableOfDegree(GridBasis basis, const double toMonomial[4][4], const Real* displacements,
+  const int voxels[3], const int dims[3], Real* table, int cellBegin, int cellEnd)
+{
+  const int stride = CellTableStride(N - 1);
   for (int cell = cellBegin; cell < cellEnd; ++cell)
   {
-    const int ci = cell % voxels[0], cj = (cell / voxels[0]) % voxels[1], ck = cell / (voxels[0] * voxels[1]);
-    Real* entry = table + std::size_t(cell) * TrilinearCellStride;
-    entry[0] = Real(ci);
-    entry[1] = Real(cj);
-    entry[2] = Real(ck);
-    for (int u = 3; u < 8; ++u)
+    const int c[3] = { cell % voxels[0], (cell / voxels[0]) % voxels[1], cell / (voxels[0] * voxels[1]) };
+    int first[3], count;
+    for (int a = 0; a < 3; ++a)
     {
-      entry[u] = Real(0);
+      VoxelSupport(basis, voxels[a], c[a], first[a], count);
+    }
+    Real* entry = table + std::size_t(cell) * stride;
+    for (int u = 0; u < 8; ++u)
+    {
+      entry[u] = Real(u < 3 ? c[u] : 0);
     }
     for (int k = 0; k < 3; ++k)
     {
-      double p[2][2][2]; // p[c][b][a]: the corner (ci + a, cj + b, ck + c)
-      for (int corner = 0; corner < 8; ++corner)
+      // The control points' component k, v[z][y][x], changed to monomials along x, then y, then z.
+      double v[N][N][N], w[N][N][N];
+      for (int z = 0; z < N; ++z)
       {
-        const int a = corner & 1, b = (corner >> 1) & 1, c = corner >> 2;
-        p[c][b][a] = double(displacements[3 * ((ci + a) + dims[0] * ((cj + b) + dims[1] * (ck + c))) + k]);
+        for (int y = 0; y < N; ++y)
+        {
+          const Real* row = displacements + 3 * (first[0] + dims[0] * ((first[1] + y) + dims[1] * (first[2] + z)));
+          for (int x = 0; x < N; ++x)
+          {
+            v[z][y][x] = double(row[3 * x + k]);
+          }
+        }
       }
-      const double c000 = p[0][0][0], c100 = p[0][0][1] - p[0][0][0], c010 = p[0][1][0] - p[0][0][0];
-      const double c110 = p[0][1][1] - p[0][1][0] - p[0][0][1] + p[0][0][0];
-      const double c001 = p[1][0][0] - p[0][0][0], c101 = p[1][0][1] - p[1][0][0] - p[0][0][1] + p[0][0][0];
-      const double c011 = p[1][1][0] - p[1][0][0] - p[0][1][0] + p[0][0][0];
-      const double c111 = p[1][1][1] - p[1][1][0] - p[1][0][1] - p[0][1][1] + p[1][0][0] + p[0][1][0] +
-        p[0][0][1] - p[0][0][0];
-      const double coefficients[8] = { c000, c100, c010, c110, c001, c101, c011, c111 };
-      for (int m = 0; m < 8; ++m)
+      for (int z = 0; z < N; ++z)
       {
-        entry[8 + 3 * m + k] = Real(coefficients[m]);
+        for (int y = 0; y < N; ++y)
+        {
+          for (int j = 0; j < N; ++j)
+          {
+            double sum = 0.0;
+            for (int a = 0; a < N; ++a)
+            {
+              sum += toMonomial[j][a] * v[z][y][a];
+            }
+            w[z][y][j] = sum;
+          }
+        }
+      }
+      for (int z = 0; z < N; ++z)
+      {
+        for (int j = 0; j < N; ++j)
+        {
+          for (int x = 0; x < N; ++x)
+          {
+            double sum = 0.0;
+            for (int a = 0; a < N; ++a)
+            {
+              sum += toMonomial[j][a] * w[z][a][x];
+            }
+            v[z][j][x] = sum;
+          }
+        }
+      }
+      for (int j = 0; j < N; ++j)
+      {
+        for (int y = 0; y < N; ++y)
+        {
+          for (int x = 0; x < N; ++x)
+          {
+            double sum = 0.0;
+            for (int a = 0; a < N; ++a)
+            {
+              sum += toMonomial[j][a] * v[a][y][x];
+            }
+            entry[8 + 3 * (x + N * (y + N * j)) + k] = Real(sum);
+          }
+        }
       }
     }
   }
 }
+} // namespace detail
+
+template <typename Real>
+inline void FillCellTable(GridBasis basis, const Real* displacements, const int voxels[3], const int dims[3],
+  Real* table, int cellBegin, int cellEnd)
+{
+  const int degree = CellDegree(basis);
+  double toMonomial[4][4] = {};
+  if (basis == GridBasis::CubicBSpline)
+  {
+    const double m[4][4] = { { 1, 4, 1, 0 }, { -3, 0, 3, 0 }, { 3, -6, 3, 0 }, { -1, 3, -3, 1 } };
+    for (int j = 0; j < 4; ++j)
+    {
+      for (int a = 0; a < 4; ++a)
+      {
+        toMonomial[j][a] = m[j][a] / 6.0;
+      }
+    }
+  }
+  else
+  {
+    // Bernstein: C(d, a) r^a (1 - r)^(d - a) = sum over j >= a of C(d, a) C(d - a, j - a) (-1)^(j - a) r^j.
+    auto choose = [](int m, int k) {
+      double c = 1.0;
+      for (int i = 1; i <= k; ++i)
+      {
+        c = c * (m - k + i) / i;
+      }
+      return c;
+    };
+    for (int a = 0; a <= degree; ++a)
+    {
+      for (int j = a; j <= degree; ++j)
+      {
+        toMonomial[j][a] = choose(degree, a) * choose(degree - a, j - a) * ((j - a) % 2 == 0 ? 1.0 : -1.0);
+      }
+    }
+  }
+  switch (degree)
+  {
+    case 1:
+      return detail::FillCellTableOfDegree<2>(basis, toMonomial, displacements, voxels, dims, table, cellBegin, cellEnd);
+    case 2:
+      return detail::FillCellTableOfDegree<3>(basis, toMonomial, displacements, voxels, dims, table, cellBegin, cellEnd);
+    default:
+      return detail::FillCellTableOfDegree<4>(basis, toMonomial, displacements, voxels, dims, table, cellBegin, cellEnd);
+  }
+}
 
 /**
- * D of FillTrilinearCellTable() at local coordinates r of the cell whose entry is `entry`, and, where dDdr is not
- * null, its derivatives: column a is dD/dr[a].
+ * D of FillCellTable() (a basis of degree Degree) at local coordinates r of the cell whose entry is `entry`, by
+ * Horner's rule, and, where dDdr is not null, its derivatives: column a is dD/dr[a].
  */
-template <typename Lane, typename Real>
-FFD_INLINE Vec3<Lane> TrilinearPowerForm(const Real* entry, const Lane r[3], Mat3<Lane>* dDdr)
+template <int Degree, typename Lane, typename Real>
+FFD_INLINE Vec3<Lane> PowerForm(const Real* entry, const Lane r[3], Mat3<Lane>* dDdr)
 {
+  constexpr int N = Degree + 1;
   const Real* c = entry + 8;
   Lane d[3];
   FFD_UNROLL
   for (int k = 0; k < 3; ++k)
   {
-    const Lane a = Lane(c[k]) + r[0] * Lane(c[3 + k]);       // C000 + a C100
-    const Lane b = Lane(c[6 + k]) + r[0] * Lane(c[9 + k]);   // C010 + a C110
-    const Lane e = Lane(c[12 + k]) + r[0] * Lane(c[15 + k]); // C001 + a C101
-    const Lane f = Lane(c[18 + k]) + r[0] * Lane(c[21 + k]); // C011 + a C111
-    const Lane g = e + r[1] * f;
-    d[k] = (a + r[1] * b) + r[2] * g;
+    // Along z, of polynomials along y, of polynomials along x; each with its derivative where asked.
+    Lane z = Lane(0), zx = Lane(0), zy = Lane(0), zz = Lane(0);
+    FFD_UNROLL
+    for (int iz = Degree; iz >= 0; --iz)
+    {
+      Lane y = Lane(0), yx = Lane(0), yy = Lane(0);
+      FFD_UNROLL
+      for (int iy = Degree; iy >= 0; --iy)
+      {
+        const Real* row = c + 3 * N * (iy + N * iz) + k;
+        Lane x = Lane(row[3 * Degree]), xx = Lane(0);
+        FFD_UNROLL
+        for (int ix = Degree - 1; ix >= 0; --ix)
+        {
+          if (dDdr)
+          {
+            xx = x + r[0] * xx;
+          }
+          x = Lane(row[3 * ix]) + r[0] * x;
+        }
+        if (dDdr)
+        {
+          yy = iy == Degree ? Lane(0) : y + r[1] * yy;
+          yx = iy == Degree ? xx : xx + r[1] * yx;
+        }
+        y = iy == Degree ? x : x + r[1] * y;
+      }
+      if (dDdr)
+      {
+        zz = iz == Degree ? Lane(0) : z + r[2] * zz;
+        zx = iz == Degree ? yx : yx + r[2] * zx;
+        zy = iz == Degree ? yy : yy + r[2] * zy;
+      }
+      z = iz == Degree ? y : y + r[2] * z;
+    }
+    d[k] = z;
     if (dDdr)
     {
-      dDdr->M[k][0] = (Lane(c[3 + k]) + r[1] * Lane(c[9 + k])) + r[2] * (Lane(c[15 + k]) + r[1] * Lane(c[21 + k]));
-      dDdr->M[k][1] = b + r[2] * f;
-      dDdr->M[k][2] = g;
+      dDdr->M[k][0] = zx;
+      dDdr->M[k][1] = zy;
+      dDdr->M[k][2] = zz;
     }
   }
   return { d[0], d[1], d[2] };
@@ -166,7 +305,7 @@ FFD_INLINE Vec3<Lane> TrilinearPowerForm(const Real* entry, const Lane r[3], Mat
  * the other bases' branches and unrolls the fixed-size sums, which made the local bases 2-3 times faster.
  * Real is the displacements' type; Lane, the arithmetic's, is Real too, or on the host a Lanes type
  * (FFDLanes.h) that deforms several points of one cell at once through these same functions (WithLanes()).
- * A trilinear deformation WithCellTable evaluates each cell in power form from CellTable (FillTrilinearCellTable()
+ * A deformation of a local basis WithCellTable evaluates each cell in power form from CellTable (FillCellTable()
  * of its displacements): the same function, rounded differently. That is a compile-time choice, so that no
  * code path holds both evaluations, whose common subexpressions the compiler would otherwise share and round
  * differently (a multiply no longer fused into its add) from one caller to another.
@@ -174,8 +313,7 @@ FFD_INLINE Vec3<Lane> TrilinearPowerForm(const Real* entry, const Lane r[3], Mat
 template <int MaxCount, typename Real, int StaticBasis = -1, typename Lane = Real, bool WithCellTable = false>
 struct GridDeformation
 {
-  static_assert(!WithCellTable || StaticBasis == -1 || StaticBasis == int(GridBasis::Trilinear),
-    "a cell table is for the trilinear basis");
+  static_assert(!WithCellTable || StaticBasis != int(GridBasis::Bernstein), "a cell table is for a local basis");
 
   using Value = Real; ///< the displacements' type
 
@@ -184,7 +322,7 @@ struct GridDeformation
   int Dims[3];               ///< control points per axis
   const Real* Displacements; ///< 3 per control point, VTK order: the lattice's points minus RestPosition
   ffd::Frame<Lane> Frame;
-  const Real* CellTable = nullptr; ///< WithCellTable: FillTrilinearCellTable() of Displacements
+  const Real* CellTable = nullptr; ///< WithCellTable: FillCellTable() of Displacements
 
   /// This deformation evaluated in lanes of type OtherLane (its frame converted once, host only).
   template <typename OtherLane>
@@ -209,10 +347,10 @@ struct GridDeformation
   {
     if constexpr (WithCellTable)
     {
-      const Real* entry = this->CellTable + std::size_t(cell) * TrilinearCellStride;
+      const Real* entry = this->CellEntry(cell);
       Lane r[3];
       this->TableCoordinates(this->Frame.ToParametric(x), { Lane(entry[0]), Lane(entry[1]), Lane(entry[2]) }, r);
-      return x + TrilinearPowerForm<Lane>(entry, r, nullptr);
+      return x + this->CellPowerForm(entry, r, nullptr);
     }
     int c[3];
     this->CellIndices(cell, c);
@@ -263,11 +401,11 @@ struct GridDeformation
     const Vec3<Lane> stu = this->Frame.ToParametric(x);
     if constexpr (WithCellTable)
     {
-      const Real* entry = this->CellTable + std::size_t(cell) * TrilinearCellStride;
+      const Real* entry = this->CellEntry(cell);
       Lane r[3];
       this->TableCoordinates(stu, { Lane(entry[0]), Lane(entry[1]), Lane(entry[2]) }, r);
       Mat3<Lane> gradient;
-      const Vec3<Lane> d = TrilinearPowerForm<Lane>(entry, r, &gradient);
+      const Vec3<Lane> d = this->CellPowerForm(entry, r, &gradient);
       jacobian = this->JacobianAt(stu, this->TableGradient(gradient));
       return x + d;
     }
@@ -294,6 +432,26 @@ struct GridDeformation
   }
 
 private:
+  /// The CellTable entry of a bound cell.
+  FFD_INLINE const Real* CellEntry(int cell) const
+  {
+    return this->CellTable + std::size_t(cell) * CellTableStride(CellDegree(this->BasisOf()));
+  }
+
+  /// PowerForm() of this deformation's basis.
+  FFD_INLINE Vec3<Lane> CellPowerForm(const Real* entry, const Lane r[3], Mat3<Lane>* dDdr) const
+  {
+    switch (CellDegree(this->BasisOf()))
+    {
+      case 1:
+        return PowerForm<1>(entry, r, dDdr);
+      case 2:
+        return PowerForm<2>(entry, r, dDdr);
+      default:
+        return PowerForm<3>(entry, r, dDdr);
+    }
+  }
+
   /**
    * The displacement (and, where `gradient` is not null, dD/d(s, t, u)) at parameters stu of lanes in the cells
    * of `group` (DeformInLaneCells()): each lane's weights (or local coordinates) from its own cell's indices,
@@ -308,7 +466,7 @@ private:
       Vec3<Lane> ck;
       if constexpr (WithCellTable)
       {
-        const Real* entry = this->CellTable + std::size_t(group.Cells[k]) * TrilinearCellStride;
+        const Real* entry = this->CellEntry(group.Cells[k]);
         ck = { Lane(entry[0]), Lane(entry[1]), Lane(entry[2]) };
       }
       else
@@ -337,8 +495,7 @@ private:
       Vec3<Lane> dk;
       if constexpr (WithCellTable)
       {
-        const Real* entry = this->CellTable + std::size_t(group.Cells[k]) * TrilinearCellStride;
-        dk = TrilinearPowerForm<Lane>(entry, r, gradient ? &gk : nullptr);
+        dk = this->CellPowerForm(this->CellEntry(group.Cells[k]), r, gradient ? &gk : nullptr);
         if (gradient)
         {
           gk = this->TableGradient(gk);
@@ -387,7 +544,7 @@ private:
     }
   }
 
-  /// dD/d(s, t, u) from the dD/dr of TrilinearPowerForm(): r = s n - c along each axis.
+  /// dD/d(s, t, u) from the dD/dr of PowerForm(): r = s n - c along each axis.
   FFD_INLINE Mat3<Lane> TableGradient(Mat3<Lane> dDdr) const
   {
     FFD_UNROLL

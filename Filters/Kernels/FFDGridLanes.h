@@ -110,13 +110,19 @@ inline double MeanCellsPerBlock(const int* cells, std::int64_t n)
 }
 
 /**
- * True when a trilinear deformation of `points` points over `cells` cells is worth a CellTable
- * (FillTrilinearCellTable(), rebuilt at every update): when it has at least 8 points a cell, so that building
- * the table (about the cost of deforming 6 points a cell) costs less than what it saves.
+ * True when a deformation of `points` points over `cells` cells of a local basis is worth a CellTable
+ * (FillCellTable(), rebuilt at every update): when building the table costs less than it saves, that is with
+ * at least 8 points a cell for the trilinear basis, 64 for the triquadratic one and 256 for the cubic
+ * B-spline (a cell's table costs about as much as deforming 6, 40 and 150 of its points). Never for the
+ * tricubic Bezier basis: its monomial coefficients reach 8 times its control points along each axis, and the
+ * power form lost up to 2 more bits than the weighted sum in float32 (beyond the tests' tolerance), where the
+ * B-spline's (at most its control points) and the triquadratic's (4 times) stayed within it.
  */
-inline bool WorthTrilinearCellTable(GridBasis basis, std::int64_t cells, std::int64_t points)
+inline bool WorthCellTable(GridBasis basis, std::int64_t cells, std::int64_t points)
 {
-  return basis == GridBasis::Trilinear && cells <= points / 8;
+  const int degree = CellDegree(basis);
+  const std::int64_t pointsPerCell = degree == 1 ? 8 : (degree == 2 ? 64 : 256);
+  return degree > 0 && basis != GridBasis::TricubicBezier && cells * pointsPerCell <= points;
 }
 
 /**

@@ -282,7 +282,7 @@ inline GridLattice RandomGridLattice(Rng& rng, ffdref::Basis basis, int maxDivis
 
 /**
  * A lattice's deformation as the filters hold it: displacements rounded to Real and an ffd::GridDeformation over
- * them, for a trilinear lattice with CellTable its ffd::FillTrilinearCellTable() too. MaxCount is 4, what the local
+ * them, for a local basis with CellTable its ffd::FillCellTable() too. MaxCount is 4, what the local
  * bases need, and MaxBernsteinDegree + 1 for the global basis.
  */
 template <typename Real, int MaxCount, bool CellTable = false>
@@ -304,8 +304,9 @@ public:
     if (CellTable)
     {
       const int cells = lat.Divisions[0] * lat.Divisions[1] * lat.Divisions[2];
-      this->Table.resize(std::size_t(cells) * ffd::TrilinearCellStride);
-      ffd::FillTrilinearCellTable(this->Values.data(), this->D.Voxels, this->D.Dims, this->Table.data(), 0, cells);
+      this->Table.resize(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(this->D.Basis)));
+      ffd::FillCellTable(
+        this->D.Basis, this->Values.data(), this->D.Voxels, this->D.Dims, this->Table.data(), 0, cells);
       this->D.CellTable = this->Table.data();
     }
   }
@@ -323,8 +324,8 @@ public:
 };
 
 /// Calls f(kernel) with the Kernels of lat that the filters may build: MaxCount 4 for the local bases and for
-/// the global basis of degree <= 3 (one cubic voxel), MaxBernsteinDegree + 1 for the global basis, and for the
-/// trilinear basis one with a cell table too.
+/// the global basis of degree <= 3 (one cubic voxel), MaxBernsteinDegree + 1 for the global basis, and for a
+/// local basis but the tricubic Bezier one, one with a cell table too.
 template <typename Real, typename F>
 void WithKernel(const GridLattice& lat, F&& f)
 {
@@ -338,7 +339,7 @@ void WithKernel(const GridLattice& lat, F&& f)
     const Kernel<Real, 4> k(lat);
     f(k);
   }
-  if (lat.Basis == ffdref::Basis::Trilinear)
+  if (lat.Basis != ffdref::Basis::Bernstein && lat.Basis != ffdref::Basis::TricubicBezier) // ffd::WorthCellTable()
   {
     const Kernel<Real, 4, true> k(lat);
     f(k);
