@@ -106,6 +106,27 @@ FFD_INLINE constexpr int CellTableStride(int degree)
  */
 namespace detail
 {
+/// out = in (N^3 values, x fastest) with its axis of stride Stride (1, N or N^2) changed to monomials.
+template <int N, int Stride>
+inline void ToMonomialsAlong(const double toMonomial[4][4], const double* in, double* out)
+{
+  for (int outer = 0; outer < N * N * N; outer += N * Stride) // the axes above
+  {
+    for (int j = 0; j < N; ++j)
+    {
+      for (int inner = 0; inner < Stride; ++inner) // the axes below
+      {
+        double sum = 0.0;
+        for (int a = 0; a < N; ++a)
+        {
+          sum += toMonomial[j][a] * in[outer + a * Stride + inner];
+        }
+        out[outer + j * Stride + inner] = sum;
+      }
+    }
+  }
+}
+
 /// FillCellTable() for a basis of degree N - 1 whose change to monomials along an axis is `toMonomial`
 /// (toMonomial[j][a]: the coefficient of r^j in the basis function of the cell's control point a).
 template <int N, typename Real>
@@ -128,63 +149,19 @@ inline void FillCellTableOfDegree(GridBasis basis, const double toMonomial[4][4]
     }
     for (int k = 0; k < 3; ++k)
     {
-      // The control points' component k, v[z][y][x], changed to monomials along x, then y, then z.
-      double v[N][N][N], w[N][N][N];
-      for (int z = 0; z < N; ++z)
+      // The control points' component k (x fastest), changed to monomials along x, then y, then z.
+      double v[N * N * N], w[N * N * N];
+      for (int i = 0; i < N * N * N; ++i)
       {
-        for (int y = 0; y < N; ++y)
-        {
-          const Real* row = displacements + 3 * (first[0] + dims[0] * ((first[1] + y) + dims[1] * (first[2] + z)));
-          for (int x = 0; x < N; ++x)
-          {
-            v[z][y][x] = double(row[3 * x + k]);
-          }
-        }
+        const int x = i % N, y = i / N % N, z = i / (N * N);
+        v[i] = double(displacements[3 * ((first[0] + x) + dims[0] * ((first[1] + y) + dims[1] * (first[2] + z))) + k]);
       }
-      for (int z = 0; z < N; ++z)
+      ToMonomialsAlong<N, 1>(toMonomial, v, w);
+      ToMonomialsAlong<N, N>(toMonomial, w, v);
+      ToMonomialsAlong<N, N * N>(toMonomial, v, w);
+      for (int i = 0; i < N * N * N; ++i)
       {
-        for (int y = 0; y < N; ++y)
-        {
-          for (int j = 0; j < N; ++j)
-          {
-            double sum = 0.0;
-            for (int a = 0; a < N; ++a)
-            {
-              sum += toMonomial[j][a] * v[z][y][a];
-            }
-            w[z][y][j] = sum;
-          }
-        }
-      }
-      for (int z = 0; z < N; ++z)
-      {
-        for (int j = 0; j < N; ++j)
-        {
-          for (int x = 0; x < N; ++x)
-          {
-            double sum = 0.0;
-            for (int a = 0; a < N; ++a)
-            {
-              sum += toMonomial[j][a] * w[z][a][x];
-            }
-            v[z][j][x] = sum;
-          }
-        }
-      }
-      for (int j = 0; j < N; ++j)
-      {
-        for (int y = 0; y < N; ++y)
-        {
-          for (int x = 0; x < N; ++x)
-          {
-            double sum = 0.0;
-            for (int a = 0; a < N; ++a)
-            {
-              sum += toMonomial[j][a] * v[a][y][x];
-            }
-            entry[8 + 3 * (x + N * (y + N * j)) + k] = Real(sum);
-          }
-        }
+        entry[8 + 3 * i + k] = Real(w[i]);
       }
     }
   }
