@@ -274,6 +274,39 @@ FFD_INLINE Vec3<Lane> PowerForm(const Real* entry, const Lane r[3], Mat3<Lane>* 
   return { d[0], d[1], d[2] };
 }
 
+namespace detail
+{
+/// The control points of a lane group's cells (GridDeformation::DeformInLaneCells()), each lane reading its own
+/// cell's: for one sum with its gradient over all lanes, which costs less than one per cell (host only).
+template <typename Real, typename Group>
+struct GroupValues
+{
+  const Real* Displacements;
+  const Group* Cells;
+};
+} // namespace detail
+
+/// Control point `index` (relative to its cell's first one) of each lane's cell: a broadcast and a select per
+/// cell of the group.
+template <typename Real, typename Group>
+struct LatticeValues<detail::GroupValues<Real, Group>>
+{
+  template <typename Lane>
+  static Vec3<Lane> Get(const detail::GroupValues<Real, Group>* values, int index)
+  {
+    const Group& group = *values->Cells;
+    const Real* v = values->Displacements + 3 * (group.Firsts[0] + index);
+    Vec3<Lane> value = { Lane(v[0]), Lane(v[1]), Lane(v[2]) };
+    for (int k = 1; k < group.Count; ++k)
+    {
+      v = values->Displacements + 3 * (group.Firsts[k] + index);
+      value = { Select(group.Lanes[k], Lane(v[0]), value.x), Select(group.Lanes[k], Lane(v[1]), value.y),
+        Select(group.Lanes[k], Lane(v[2]), value.z) };
+    }
+    return value;
+  }
+};
+
 /**
  * A grid lattice's deformation, as plain data that host and device code evaluate alike. MaxCount bounds the
  * control points per axis that influence a point: 4 covers every local basis (and global ones up to degree 3),
@@ -464,6 +497,16 @@ private:
     else
     {
       this->LaneCellWeights(stu, index, gradient != nullptr, axes);
+    }
+    if constexpr (!WithCellTable)
+    {
+      if (gradient && group.Count > 1)
+      {
+        // One sum with its gradient over values read per lane: a cell's sum with its gradient (12 multiply-adds
+        // a control point) costs more than reading its control points into its lanes (6 operations).
+        const detail::GroupValues<Real, Group> values{ this->Displacements, &group };
+        return SumTensorProductWithGradient(&values, this->Dims, axes, *gradient);
+      }
     }
     Vec3<Lane> d;
     for (int k = 0; k < group.Count; ++k)
