@@ -406,7 +406,8 @@ struct EvaluateWorker
         const vtkIdType blocks = (n + ffd::BlockSize - 1) / ffd::BlockSize;
         const vtkIdType gathered = vtkIdType(binding.Gathered.Order.size());
         const double middle = progressBegin + (1.0 - progressBegin) * double(n - gathered) / double(n);
-        completed = vtkFFDForInChunks(self, blocks, BlockGrain, lanes, progressBegin, middle);
+        completed = binding.Blocks.MaxCells <= 0 || // every block gathered
+          vtkFFDForInChunks(self, blocks, BlockGrain, lanes, progressBegin, middle);
         lanes.GatheredPass = true;
         completed =
           completed && vtkFFDForInChunks(self, binding.Gathered.BlockCount(), BlockGrain, lanes, middle, 1.0);

@@ -143,8 +143,9 @@ inline bool StreamOutput(std::int64_t bytes)
  * pass reads a copy of its points in order, sorted by cell within tiles (GatherTile), evaluates whole lane groups
  * of one cell, and writes each result to its place, at random within its tile. With few cells a block on
  * average (a mesh in a spatially coherent vertex order: 1.5 for the 6.7 M-point armadillo of BENCHMARKS.md over
- * 9^3 voxels) every block is deformed in place; with more (4.5 for the 0.4 M-point one, whose vertex order is
- * random) only the blocks in one cell are, and the others gathered. The crossovers were measured on both meshes
+ * 9^3 voxels) every block is deformed in place (BlockSize); with more (4.5 for the 0.4 M-point one, whose
+ * vertex order is random) every block is gathered (0), those in one cell too: the gathered pass reads them in
+ * order with the others, where the in-place pass would read them at random. The crossovers were measured on both meshes
  * reordered to means in between (2026-11-23, BENCHMARKS.md): lower for the bases whose cells cost more. Where
  * the mesh fits in the caches the gathered pass wins sooner (its writes at random stay there), where it does not
  * later; these are in between.
@@ -164,7 +165,7 @@ inline int MaxCellsInPlace(GridBasis basis, double meanCellsPerBlock, bool cellT
   {
     crossover = 1.6; // 27 control points
   }
-  return meanCellsPerBlock <= crossover ? BlockSize : 1;
+  return meanCellsPerBlock <= crossover ? BlockSize : 0;
 }
 
 /// True when block b (of n points) is deformed in place: it is whole and its points lie in at most maxCells
@@ -179,6 +180,10 @@ inline bool BlockInPlace(const int* cells, std::int64_t n, std::int64_t b, int m
   if (maxCells >= BlockSize)
   {
     return true;
+  }
+  if (maxCells <= 0)
+  {
+    return false;
   }
   if (maxCells == 1)
   {
@@ -210,7 +215,11 @@ struct BlockCells
   bool InPlace(std::int64_t b) const
   {
     const int entry = this->Entry[std::size_t(b)];
-    if (entry < 0 || this->MaxCells >= BlockSize)
+    if (this->MaxCells <= 0 || this->MaxCells >= BlockSize)
+    {
+      return this->MaxCells > 0;
+    }
+    if (entry < 0)
     {
       return true;
     }
