@@ -11,12 +11,12 @@
  *   each lane's weights once, then each cell's sum in all lanes, kept in that cell's lanes
  *   (GridDeformation::DeformInLaneCells()).
  * - Gathered (DeformGathered()): the points of the blocks in more than MaxCellsInPlace() cells are listed once,
- *   at binding, tile by tile, each tile's sorted by cell (GatherByCell()), and deformed W of one cell at a
- *   time: a gather and a scatter per point, at random but within a tile that stays in cache.
+ *   at binding, tile by tile, each tile's sorted by cell (ListGatheredPoints()); the caller keeps a copy of
+ *   their coordinates in that order (CopyGatheredPoints()), which the pass deforms in place, in order, and
+ *   then writes each result to its place: at random, but within a tile that stays in cache.
  * A mesh whose vertices come in a spatially coherent order has most of its groups in one cell and a few in two
  * or three: it is deformed in place. A mesh in random vertex order (the 0.4 M-point armadillo of BENCHMARKS.md,
- * 4.5 cells a block on average) would evaluate several cells a group: its blocks in several cells are gathered,
- * but for the trilinear basis with a cell table, whose cells cost least.
+ * 4.5 cells a block on average) would evaluate several cells a group: all its blocks are gathered.
  * Every lane's result depends only on its own point and cell, so a point is deformed the same whichever pass
  * takes it and however the work is split among threads. The one-point code (SimdLevel::None) computes the same
  * function; it may differ in the last bit, where the wide code fuses a multiply and an add.
@@ -211,20 +211,16 @@ struct BlockCells
   std::vector<int> Entry;
   std::vector<int> List;
 
-  /// True when whole block b is deformed in place (BlockInPlace()).
+  /// True when whole block b is deformed in place (BlockInPlace()). The limits MaxCellsInPlace() gives, 0 and
+  /// BlockSize, need no look at the block.
   bool InPlace(std::int64_t b) const
   {
-    const int entry = this->Entry[std::size_t(b)];
     if (this->MaxCells <= 0 || this->MaxCells >= BlockSize)
     {
       return this->MaxCells > 0;
     }
-    if (entry < 0)
-    {
-      return true;
-    }
-    // A block listed is in at least 2 cells (-1 counts): what MaxCellsInPlace() gives, 1, needs no look.
-    return this->MaxCells > 1 && this->List[std::size_t(entry) + 1] <= this->MaxCells;
+    const int entry = this->Entry[std::size_t(b)];
+    return entry < 0 || this->List[std::size_t(entry) + 1] <= this->MaxCells; // a listed block: 2 cells or more
   }
 };
 
