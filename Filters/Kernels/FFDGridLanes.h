@@ -246,7 +246,8 @@ inline BlockCells ListBlockCells(const int* cells, std::int64_t n, int maxCells)
     const std::size_t entry = blocks.List.size();
     blocks.Entry[b] = int(entry);
     blocks.List.push_back(0);
-    blocks.List.push_back(CellsOfBlock(cells, std::int64_t(b)));
+    blocks.List.push_back(0);
+    unsigned bound = 0; // the points in a listed cell
     for (int l = 0; l < BlockSize; ++l)
     {
       bool seen = block[l] < 0;
@@ -264,8 +265,11 @@ inline BlockCells ListBlockCells(const int* cells, std::int64_t n, int maxCells)
         blocks.List.push_back(block[l]);
         blocks.List.push_back(int(bits));
         ++blocks.List[entry];
+        bound |= bits;
       }
     }
+    // CellsOfBlock(): the listed cells, and -1 where some point is in none.
+    blocks.List[entry + 1] = blocks.List[entry] + (bound != (1u << BlockSize) - 1 ? 1 : 0);
   }
   return blocks;
 }
@@ -407,13 +411,19 @@ inline void DeformOneGathered(
   to[2] = y.z;
 }
 
-/// Where `outNormals` (or `determinants`) is not null: point i's transformed normal (its Jacobian's determinant)
-/// from its Jacobian, as the filter's one-point code computes them (a point that keeps its position has the
-/// identity).
-template <typename Real>
-inline void FinishOnePoint(const Mat3<Real>& jacobian, const Real* inNormals, Real* outNormals, Real* determinants,
-  std::int64_t i)
+/// Point i deformed alone with its Jacobian (the identity where it keeps its position): its position and, where
+/// `outNormals` (or `determinants`) is not null, its transformed normal (its Jacobian's determinant), as the
+/// filter's one-point code computes them.
+template <typename Deformation, typename Real>
+inline void DeformOnePointWithJacobian(const Deformation& deformation, const Real* in, const int* cells,
+  const Real* inNormals, Real* out, Real* outNormals, Real* determinants, std::int64_t i)
 {
+  const Vec3<Real> x = Vec3<Real>::From(in + 3 * i);
+  Mat3<Real> jacobian = Mat3<Real>::Identity();
+  const Vec3<Real> y = cells[i] >= 0 ? deformation.Deform(x, cells[i], jacobian) : x;
+  out[3 * i] = y.x;
+  out[3 * i + 1] = y.y;
+  out[3 * i + 2] = y.z;
   if (outNormals)
   {
     const Vec3<Real> m = TransformNormal(jacobian, Vec3<Real>::From(inNormals + 3 * i));
@@ -721,13 +731,7 @@ inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, 
   }
   for (; i < end; ++i) // the points of the last, partial block
   {
-    const Vec3<Real> x = Vec3<Real>::From(in + 3 * i);
-    Mat3<Real> jacobian = Mat3<Real>::Identity();
-    const Vec3<Real> y = cells[i] >= 0 ? deformation.Deform(x, cells[i], jacobian) : x;
-    out[3 * i] = y.x;
-    out[3 * i + 1] = y.y;
-    out[3 * i + 2] = y.z;
-    FinishOnePoint(jacobian, inNormals, outNormals, determinants, i);
+    DeformOnePointWithJacobian(deformation, in, cells, inNormals, out, outNormals, determinants, i);
   }
 }
 
@@ -856,13 +860,7 @@ inline void DeformWithJacobian(SimdLevel level, const Deformation& deformation, 
 #endif
   for (std::int64_t i = begin; i < end; ++i)
   {
-    const Vec3<Real> x = Vec3<Real>::From(in + 3 * i);
-    Mat3<Real> jacobian = Mat3<Real>::Identity();
-    const Vec3<Real> y = cells[i] >= 0 ? deformation.Deform(x, cells[i], jacobian) : x;
-    out[3 * i] = y.x;
-    out[3 * i + 1] = y.y;
-    out[3 * i + 2] = y.z;
-    detail::FinishOnePoint(jacobian, inNormals, outNormals, determinants, i);
+    detail::DeformOnePointWithJacobian(deformation, in, cells, inNormals, out, outNormals, determinants, i);
   }
 }
 
