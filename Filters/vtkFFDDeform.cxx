@@ -332,8 +332,19 @@ struct EvaluateWorker
         self, progressBegin, completed);
     };
     using NoTable = std::false_type;
-    using ffd::GridBasis;
     using Local = std::integral_constant<int, 4>;
+    // A local basis, with or without its cell table as the binding chose.
+    auto runLocal = [&](auto basis) {
+      if (binding.CellTable)
+      {
+        run(Local(), basis, std::true_type());
+      }
+      else
+      {
+        run(Local(), basis, NoTable());
+      }
+    };
+    using ffd::GridBasis;
     switch (lattice.Basis)
     {
       case GridBasis::Bernstein:
@@ -341,44 +352,16 @@ struct EvaluateWorker
           std::integral_constant<int, int(GridBasis::Bernstein)>(), NoTable());
         break;
       case GridBasis::Trilinear:
-        if (binding.CellTable)
-        {
-          run(Local(), std::integral_constant<int, int(GridBasis::Trilinear)>(), std::true_type());
-        }
-        else
-        {
-          run(Local(), std::integral_constant<int, int(GridBasis::Trilinear)>(), NoTable());
-        }
+        runLocal(std::integral_constant<int, int(GridBasis::Trilinear)>());
         break;
       case GridBasis::TriquadraticBezier:
-        if (binding.CellTable)
-        {
-          run(Local(), std::integral_constant<int, int(GridBasis::TriquadraticBezier)>(), std::true_type());
-        }
-        else
-        {
-          run(Local(), std::integral_constant<int, int(GridBasis::TriquadraticBezier)>(), NoTable());
-        }
+        runLocal(std::integral_constant<int, int(GridBasis::TriquadraticBezier)>());
         break;
-      case GridBasis::TricubicBezier:
-        if (binding.CellTable)
-        {
-          run(Local(), std::integral_constant<int, int(GridBasis::TricubicBezier)>(), std::true_type());
-        }
-        else
-        {
-          run(Local(), std::integral_constant<int, int(GridBasis::TricubicBezier)>(), NoTable());
-        }
+      case GridBasis::TricubicBezier: // never a cell table (ffd::WorthCellTable)
+        run(Local(), std::integral_constant<int, int(GridBasis::TricubicBezier)>(), NoTable());
         break;
       case GridBasis::CubicBSpline:
-        if (binding.CellTable)
-        {
-          run(Local(), std::integral_constant<int, int(GridBasis::CubicBSpline)>(), std::true_type());
-        }
-        else
-        {
-          run(Local(), std::integral_constant<int, int(GridBasis::CubicBSpline)>(), NoTable());
-        }
+        runLocal(std::integral_constant<int, int(GridBasis::CubicBSpline)>());
         break;
     }
   }
