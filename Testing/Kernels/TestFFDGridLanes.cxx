@@ -101,6 +101,36 @@ PointSet<Real> MeshLikePoints(ffdtest::Rng& rng, const GridLattice& lat, const K
   return set;
 }
 
+/// The points of `set` in a random order; order[p] is the point of `set` at p.
+template <typename Real>
+PointSet<Real> Shuffled(const PointSet<Real>& set, ffdtest::Rng& rng, std::vector<std::int64_t>& order)
+{
+  order.resize(std::size_t(set.Size()));
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), rng);
+  PointSet<Real> shuffled;
+  for (std::int64_t i : order)
+  {
+    shuffled.Values.insert(shuffled.Values.end(), &set.Values[3 * i], &set.Values[3 * i] + 3);
+    shuffled.Cells.push_back(set.Cells[i]);
+  }
+  return shuffled;
+}
+
+/// Where ffdref::DeformLocal puts a point bound to a cell, clamped or not: X plus the reference's displacement
+/// at the nearest point of the frame (X itself inside).
+Vec ClampedReference(Basis b, const GridLattice& lat, const Vec& xd)
+{
+  Vec stu = ffdref::Parameters(lat.F, xd);
+  for (double& p : stu)
+  {
+    p = std::min(1.0, std::max(0.0, p));
+  }
+  const Vec edge = ffdtest::ToWorld(lat.F, stu);
+  const Vec moved = ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, edge);
+  return { xd[0] + moved[0] - edge[0], xd[1] + moved[1] - edge[1], xd[2] + moved[2] - edge[2] };
+}
+
 /// Both passes over the whole set with blocks in at most maxCells cells in place (`gathered` listed for that
 /// limit), the ranges of blocks cut at the given blocks (sorted, within the ranges); with `stream`, into memory
 /// aligned to 64 bytes, the in-place pass by non-temporal stores.
@@ -192,16 +222,8 @@ TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
               }
               ffd::Mat3<Real> j;
               k.D.Deform(x, set.Cells[i], j);
-              // X plus the reference's displacement at the nearest point of the frame (X itself inside).
               const Vec xd = ffdtest::ToRef(x);
-              Vec stu = ffdref::Parameters(lat.F, xd);
-              for (double& p : stu)
-              {
-                p = std::min(1.0, std::max(0.0, p));
-              }
-              const Vec edge = ffdtest::ToWorld(lat.F, stu);
-              const Vec moved = ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, edge);
-              const Vec want = { xd[0] + moved[0] - edge[0], xd[1] + moved[1] - edge[1], xd[2] + moved[2] - edge[2] };
+              const Vec want = ClampedReference(b, lat, xd);
               const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
               worst.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
               ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
@@ -217,8 +239,8 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
 {
   // At each level, a point's result is the same bit for bit: in its mesh order, split into random sub-ranges
   // (as threads split it), written by non-temporal stores, in a shuffled order (lane groups of many cells), and
-  // whichever pass takes it: with
-  // every block gathered but those in one cell, with the filter's cell limit, and with every block in place.
+  // whichever pass takes it, at every cell limit of MaxCellsToTry() (every block gathered, up to every block in
+  // place).
   using Real = TypeParam;
   ffdtest::Rng rng(602);
   for (Basis b : ffdtest::AllBases)
@@ -230,15 +252,8 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
     } while (b != Basis::Bernstein && CellCount(lat) < 16);
     ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
       const PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 2003);
-      std::vector<std::int64_t> order(std::size_t(set.Size()));
-      std::iota(order.begin(), order.end(), 0);
-      std::shuffle(order.begin(), order.end(), rng);
-      PointSet<Real> shuffled;
-      for (std::int64_t i : order)
-      {
-        shuffled.Values.insert(shuffled.Values.end(), &set.Values[3 * i], &set.Values[3 * i] + 3);
-        shuffled.Cells.push_back(set.Cells[i]);
-      }
+      std::vector<std::int64_t> order;
+      const PointSet<Real> shuffled = Shuffled(set, rng, order);
 
       auto cuts = [&](std::int64_t n) {
         std::vector<std::int64_t> c;
@@ -321,16 +336,8 @@ TYPED_TEST(FFDGridLanesTest, JacobianInLanesMatchesOnePoint)
         }
         if (trial % 2 == 1)
         {
-          std::vector<std::int64_t> order(std::size_t(set.Size()));
-          std::iota(order.begin(), order.end(), 0);
-          std::shuffle(order.begin(), order.end(), rng);
-          PointSet<Real> shuffled;
-          for (std::int64_t i : order)
-          {
-            shuffled.Values.insert(shuffled.Values.end(), &set.Values[3 * i], &set.Values[3 * i] + 3);
-            shuffled.Cells.push_back(set.Cells[i]);
-          }
-          set = shuffled;
+          std::vector<std::int64_t> order;
+          set = Shuffled(set, rng, order);
         }
         std::vector<Real> normals;
         for (std::int64_t i = 0; i < set.Size(); ++i)
@@ -370,16 +377,8 @@ TYPED_TEST(FFDGridLanesTest, JacobianInLanesMatchesOnePoint)
             else
             {
               k.D.Deform(x, set.Cells[i], j);
-              // X plus the reference's displacement at the nearest point of the frame (X itself inside).
               const Vec xd = ffdtest::ToRef(x);
-              Vec stu = ffdref::Parameters(lat.F, xd);
-              for (double& p : stu)
-              {
-                p = std::min(1.0, std::max(0.0, p));
-              }
-              const Vec edge = ffdtest::ToWorld(lat.F, stu);
-              const Vec moved = ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, edge);
-              const Vec want = { xd[0] + moved[0] - edge[0], xd[1] + moved[1] - edge[1], xd[2] + moved[2] - edge[2] };
+              const Vec want = ClampedReference(b, lat, xd);
               const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
               worst.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
               ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
