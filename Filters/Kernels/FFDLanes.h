@@ -9,8 +9,8 @@
  * point is read once and broadcast). The arithmetic is GCC/Clang vector extensions rather than intrinsics: a
  * function compiled for AVX-512 gets zmm instructions, one for AVX2 ymm, and a plain x86-64 build SSE2
  * (FFDGridLanes.h picks the widest at run time), from the same source. The exceptions, a broadcast, a square
- * root, a mask to bits and a non-temporal store, are one intrinsic per width (detail::Splat(), detail::Sqrt(),
- * detail::LaneBits(), detail::Stream()).
+ * root, a clamp to [0, 1], a mask to bits and a non-temporal store, are one intrinsic per width (detail::Splat(),
+ * detail::Sqrt(), detail::Clamp01(), detail::LaneBits(), detail::Stream()).
  */
 #ifndef FFDLanes_h
 #define FFDLanes_h
@@ -126,6 +126,39 @@ inline void Sqrt(const Float64x2& v, Float64x2& r)
   r = reinterpret_cast<Float64x2>(_mm_sqrt_pd(reinterpret_cast<__m128d>(v)));
 }
 
+/// r = v clamped to [0, 1] in every lane: max(0, v) then min(1, .), whose operand order keeps a NaN and -0 as the
+/// comparisons v < 0 ? 0 : v and v > 1 ? 1 : v do (GCC 12 compiles those to a compare and a masked move each).
+__attribute__((target("avx512f"))) inline void Clamp01(const Float32x16& v, Float32x16& r)
+{
+  r = reinterpret_cast<Float32x16>(
+    _mm512_min_ps(_mm512_set1_ps(1.0f), _mm512_max_ps(_mm512_setzero_ps(), reinterpret_cast<__m512>(v))));
+}
+__attribute__((target("avx512f"))) inline void Clamp01(const Float64x8& v, Float64x8& r)
+{
+  r = reinterpret_cast<Float64x8>(
+    _mm512_min_pd(_mm512_set1_pd(1.0), _mm512_max_pd(_mm512_setzero_pd(), reinterpret_cast<__m512d>(v))));
+}
+__attribute__((target("avx"))) inline void Clamp01(const Float32x8& v, Float32x8& r)
+{
+  r = reinterpret_cast<Float32x8>(
+    _mm256_min_ps(_mm256_set1_ps(1.0f), _mm256_max_ps(_mm256_setzero_ps(), reinterpret_cast<__m256>(v))));
+}
+__attribute__((target("avx"))) inline void Clamp01(const Float64x4& v, Float64x4& r)
+{
+  r = reinterpret_cast<Float64x4>(
+    _mm256_min_pd(_mm256_set1_pd(1.0), _mm256_max_pd(_mm256_setzero_pd(), reinterpret_cast<__m256d>(v))));
+}
+inline void Clamp01(const Float32x4& v, Float32x4& r)
+{
+  r = reinterpret_cast<Float32x4>(
+    _mm_min_ps(_mm_set1_ps(1.0f), _mm_max_ps(_mm_setzero_ps(), reinterpret_cast<__m128>(v))));
+}
+inline void Clamp01(const Float64x2& v, Float64x2& r)
+{
+  r = reinterpret_cast<Float64x2>(
+    _mm_min_pd(_mm_set1_pd(1.0), _mm_max_pd(_mm_setzero_pd(), reinterpret_cast<__m128d>(v))));
+}
+
 /// Bit l set where lane l of m is -1 (lanes are -1 or 0).
 __attribute__((target("avx512f,avx512dq"))) inline unsigned LaneBits(const Int32x16& m)
 {
@@ -218,9 +251,9 @@ struct Lanes
   static unsigned Bits(const IndexVector& mask) { return detail::LaneBits(mask); }
   friend Lanes Clamp01(const Lanes& a)
   {
-    const Vector zero = Vector{}, one = zero + T(1);
-    const Vector low = a.V < zero ? zero : a.V;
-    return Lanes(low > one ? one : low);
+    Lanes r;
+    detail::Clamp01(a.V, r.V);
+    return r;
   }
 
   /// x, y, z of W points stored as x0 y0 z0 x1 y1 z1 ... (3 W values, no alignment needed).
