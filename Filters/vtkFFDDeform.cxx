@@ -19,6 +19,7 @@
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
+#include "vtkSMPThreadLocal.h"
 #include "vtkSmartPointer.h"
 #include "vtkUnstructuredGrid.h"
 
@@ -253,7 +254,7 @@ struct EvaluateFunctor
 
 // Evaluation of the points alone (no normals, no determinants) from points of the output's precision, W at a
 // time in SIMD lanes (FFDGridLanes.h): first the blocks deformed in place, then the points of the other blocks,
-// gathered by cell at binding.
+// gathered by cell at binding, tile by tile.
 template <typename Deformer, typename Real>
 struct LanesFunctor
 {
@@ -263,15 +264,18 @@ struct LanesFunctor
   const Real* Listed; // GridBinding::Listed()
   Deformer Deformation;
   bool Stream;       // non-temporal stores in the in-place pass (ffd::StreamOutput())
-  bool GatheredPass; // false: over the blocks of points, true: over the blocks of Binding.Gathered
+  bool GatheredPass; // false: over the blocks of points, true: over the tiles of Binding.Gathered
+  vtkSMPThreadLocal<std::vector<Real>> Staging; // each thread's tile of results (ffd::DeformGathered)
 
   void operator()(vtkIdType begin, vtkIdType end)
   {
     static const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
     if (this->GatheredPass)
     {
-      ffd::DeformGathered(
-        level, this->Deformation, this->Listed, this->Binding.Gathered, this->OutPoints, begin, end);
+      std::vector<Real>& staging = this->Staging.Local();
+      staging.resize(3 * std::size_t(ffd::GatherTile));
+      ffd::DeformGathered(level, this->Deformation, this->Listed, this->Binding.Gathered, this->OutPoints, begin,
+        end, staging.data());
     }
     else
     {
@@ -385,15 +389,14 @@ struct EvaluateWorker
         const Real* in = inPoints->GetPointer(0);
         LanesFunctor<Deformation, Real> lanes{ in, outPoints->GetPointer(0), binding,
           binding.Gathered.Order.empty() ? nullptr : binding.Listed(in), deformation,
-          ffd::StreamOutput(std::int64_t(3 * sizeof(Real)) * n), false };
+          ffd::StreamOutput(std::int64_t(3 * sizeof(Real)) * n), false, {} };
         const vtkIdType blocks = (n + ffd::BlockSize - 1) / ffd::BlockSize;
         const vtkIdType gathered = vtkIdType(binding.Gathered.Order.size());
         const double middle = progressBegin + (1.0 - progressBegin) * double(n - gathered) / double(n);
         completed = binding.Blocks.MaxCells <= 0 || // every block gathered
           vtkFFDForInChunks(self, blocks, BlockGrain, lanes, progressBegin, middle);
         lanes.GatheredPass = true;
-        completed =
-          completed && vtkFFDForInChunks(self, binding.Gathered.BlockCount(), BlockGrain, lanes, middle, 1.0);
+        completed = completed && vtkFFDForInChunks(self, binding.Gathered.TileCount(), 1, lanes, middle, 1.0);
         return;
       }
       using NormalArray = vtkAOSDataArrayTemplate<Real>;

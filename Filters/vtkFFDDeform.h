@@ -17,9 +17,10 @@
  * when the outside policy changes; moving lattice points only re-runs the evaluation, which for a local basis
  * touches only the 8, 27 or 64 control points of the point's voxel. GetNumberOfBindings() counts the bindings.
  * An input whose vertex order is spatially random also keeps, with its binding, the points of its blocks of
- * 16 in several voxels listed by voxel (8 bytes per point: its index and voxel) and, from the first
- * evaluation, a copy of their coordinates in that order (12 bytes per point in float32, 24 in float64), read
- * in order by every evaluation.
+ * 16 in several voxels listed by voxel within tiles of 32768 points (10.5 bytes per point: its index, voxel
+ * and place in the list) and, from the first evaluation, a copy of their coordinates in that order (12 bytes
+ * per point in float32, 24 in float64), read in order by every evaluation; each thread stages a tile's
+ * results (384 KB in float32, 768 KB in float64) before writing them out in point order.
  *
  * Points outside the frame keep their input position (KEEP_POSITION, the default) or take the displacement of
  * the nearest point of the frame (CLAMP_TO_EDGE, as VTK's Edge border mode and Blender's lattice do);

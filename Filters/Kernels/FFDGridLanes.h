@@ -12,8 +12,9 @@
  *   (GridDeformation::DeformInLaneCells()).
  * - Gathered (DeformGathered()): the points of the blocks in more than MaxCellsInPlace() cells are listed once,
  *   at binding, tile by tile, each tile's sorted by cell (ListGatheredPoints()); the caller keeps a copy of
- *   their coordinates in that order (CopyGatheredPoints()), which the pass deforms in place, in order, and
- *   then writes each result to its place: at random, but within a tile that stays in cache.
+ *   their coordinates in that order (CopyGatheredPoints()). The pass deforms a tile's list in order into a
+ *   staging buffer that stays in cache, then writes the tile's results out in point order, each read from its
+ *   place in the buffer.
  * A mesh whose vertices come in a spatially coherent order has most of its groups in one cell and a few in two
  * or three: it is deformed in place. A mesh in random vertex order (the 0.4 M-point armadillo of BENCHMARKS.md,
  * 4.5 cells a block on average) would evaluate several cells a group: all its blocks are gathered.
@@ -137,18 +138,17 @@ inline bool StreamOutput(std::int64_t bytes)
 }
 
 /**
- * The most cells a block's points may lie in for the block to be deformed in place (BlockInPlace(),
- * GatherByCell()), chosen for a binding from its mean number of cells per block. In place reads and writes
- * memory in order, but a lane group in several cells evaluates each of its cells in all its lanes; the gathered
- * pass reads a copy of its points in order, sorted by cell within tiles (GatherTile), evaluates whole lane groups
- * of one cell, and writes each result to its place, at random within its tile. With few cells a block on
- * average (a mesh in a spatially coherent vertex order: 1.5 for the 6.7 M-point armadillo of BENCHMARKS.md over
- * 9^3 voxels) every block is deformed in place (BlockSize); with more (4.5 for the 0.4 M-point one, whose
- * vertex order is random) every block is gathered (0), those in one cell too: the gathered pass reads them in
- * order with the others, where the in-place pass would read them at random. The crossovers were measured on both meshes
- * reordered to means in between (2026-11-23, BENCHMARKS.md): lower for the bases whose cells cost more. Where
- * the mesh fits in the caches the gathered pass wins sooner (its writes at random stay there), where it does not
- * later; these are in between.
+ * The most cells a block's points may lie in for the block to be deformed in place (BlockInPlace(), GatherByCell()),
+ * chosen for a binding from its mean number of cells per block. In place reads and writes memory in order, but a lane
+ * group in several cells evaluates each of its cells in all its lanes; the gathered pass reads a copy of its points in
+ * order, sorted by cell within tiles (GatherTile), evaluates whole lane groups of one cell into a tile's staging
+ * buffer, and writes the tile out in point order from there. With few cells a block on average (a mesh in a spatially
+ * coherent vertex order: 1.5 for the 6.7 M-point armadillo of BENCHMARKS.md over 9^3 voxels) every block is deformed in
+ * place (BlockSize); with more (4.5 for the 0.4 M-point one, whose vertex order is random) every block is gathered (0),
+ * those in one cell too: the gathered pass reads them in order with the others, where the in-place pass would read them
+ * at random. The crossovers were measured on both meshes reordered to means in between (2026-11-23, BENCHMARKS.md, with
+ * the results then written at random within a tile rather than staged): lower for the bases whose cells cost more.
+ * Where the mesh fits in the caches the gathered pass wins sooner, where it does not later; these are in between.
  */
 inline int MaxCellsInPlace(GridBasis basis, double meanCellsPerBlock, bool cellTable)
 {
@@ -274,18 +274,22 @@ inline BlockCells ListBlockCells(const int* cells, std::int64_t n, int maxCells)
   return blocks;
 }
 
-/// Consecutive points among which GatherByCell() sorts by cell: the gathered pass writes at random only within
-/// such a tile, whose points (384 KB in float32) stay in a core's L2 cache, instead of across the whole mesh
-/// (from DRAM where the mesh is larger than the caches). Larger tiles leave fewer lane groups in two cells.
+/**
+ * Consecutive points among which GatherByCell() sorts by cell (a multiple of BlockSize, at most 2^16: see
+ * GatheredPoints::Ranks). The gathered pass stages a tile's results (384 KB in float32, 768 KB in float64: a
+ * core's L2 cache) and reads them from there at random, instead of writing them at random across the output,
+ * whose lines a write at random reads from memory first. Larger tiles leave fewer lane groups in two cells.
+ */
 constexpr int GatherTile = 32768;
 
 /**
- * The points of the blocks not deformed in place (BlockInPlace() with maxCells), tile by tile (GatherTile),
- * each tile's sorted by cell: cell -1 first, then by cell, each cell's points in input order (two stable
- * counting sorts: by cell, then by tile). For DeformGathered(); `cellCount` is the number of cells of the
- * binding.
+ * The points of the blocks not deformed in place (BlockInPlace() with maxCells), tile by tile (of `tile` points,
+ * GatherTile but in tests), each tile's sorted by cell: cell -1 first, then by cell, each cell's points in input
+ * order (two stable counting sorts: by cell, then by tile). For DeformGathered(); `cellCount` is the number of
+ * cells of the binding.
  */
-inline std::vector<int> GatherByCell(const int* cells, std::int64_t n, int cellCount, int maxCells)
+inline std::vector<int> GatherByCell(
+  const int* cells, std::int64_t n, int cellCount, int maxCells, int tile = GatherTile)
 {
   std::vector<std::int64_t> offsets(std::size_t(cellCount) + 2, 0);
   const std::int64_t blocks = (n + BlockSize - 1) / BlockSize;
@@ -316,10 +320,10 @@ inline std::vector<int> GatherByCell(const int* cells, std::int64_t n, int cellC
       }
     }
   }
-  std::vector<std::int64_t> tiles(std::size_t((n + GatherTile - 1) / GatherTile) + 1, 0);
+  std::vector<std::int64_t> tiles(std::size_t((n + tile - 1) / tile) + 1, 0);
   for (int i : byCell)
   {
-    ++tiles[std::size_t(i / GatherTile) + 1];
+    ++tiles[std::size_t(i / tile) + 1];
   }
   for (std::size_t t = 1; t < tiles.size(); ++t)
   {
@@ -328,38 +332,92 @@ inline std::vector<int> GatherByCell(const int* cells, std::int64_t n, int cellC
   std::vector<int> gathered(byCell.size());
   for (int i : byCell)
   {
-    gathered[std::size_t(tiles[std::size_t(i / GatherTile)]++)] = i;
+    gathered[std::size_t(tiles[std::size_t(i / tile)]++)] = i;
   }
   return gathered;
 }
 
 /**
- * The points that the gathered pass deforms (DeformGathered()), listed once per binding: Order, GatherByCell()'s
- * list, its last point repeated up to a whole number of blocks (so that every listed point is deformed in lanes,
- * as bit for bit as the in-place pass; a repeated point is written twice, the same value); Cells, their cells in
- * that order; Blocks, the BlockCells of that order (every block in place). The pass reads the points'
- * coordinates in that order from a copy (CopyGatheredPoints()), so that it reads memory in order and deforms
- * whole lane groups of one cell, and writes each result to its place, at random within a tile.
+ * The points that the gathered pass deforms (DeformGathered()), listed once per binding, with where each result
+ * goes. The list, Order, is GatherByCell()'s, each tile's run of it padded to whole blocks by repeating its last
+ * point (so that every listed point is deformed in lanes, as bit for bit as the in-place pass); Cells, their
+ * cells in that order; Blocks, the BlockCells of that order (every block in place); TileBlocks, the blocks of
+ * each tile's run: tile t's are [TileBlocks[t], TileBlocks[t + 1]). The pass reads the points' coordinates in
+ * that order from a copy (CopyGatheredPoints()), so that it reads memory in order and deforms whole lane groups
+ * of one cell. For the writing: Sources, the blocks of points not deformed in place, in point order, tile t's
+ * being [TileSources[t], TileSources[t + 1]); Ranks, for point l of the k-th of them, at k BlockSize + l, its
+ * place in its tile's run.
  */
 struct GatheredPoints
 {
+  std::int64_t Points = 0; ///< the binding's points
+  int Tile = GatherTile;   ///< points a tile
   std::vector<int> Order;
   std::vector<int> Cells;
   BlockCells Blocks;
+  std::vector<std::int64_t> TileBlocks;
+  std::vector<std::int64_t> Sources;
+  std::vector<std::int64_t> TileSources;
+  std::vector<std::uint16_t> Ranks;
 
   /// The blocks of the list.
   std::int64_t BlockCount() const { return std::int64_t(this->Order.size()) / BlockSize; }
+
+  /// The tiles of the binding's points (some may list no point).
+  std::int64_t TileCount() const { return std::int64_t(this->TileBlocks.size()) - 1; }
 };
 
 /// The GatheredPoints of n points bound to `cells` (a binding of cellCount cells) with blocks in more than
-/// maxCells cells gathered.
-inline GatheredPoints ListGatheredPoints(const int* cells, std::int64_t n, int cellCount, int maxCells)
+/// maxCells cells gathered, in tiles of `tile` points (GatherTile but in tests: a multiple of BlockSize, at most
+/// GatherTile, the points a staging buffer of DeformGathered() holds).
+inline GatheredPoints ListGatheredPoints(
+  const int* cells, std::int64_t n, int cellCount, int maxCells, int tile = GatherTile)
 {
+  static_assert(GatherTile % BlockSize == 0 && GatherTile <= 65536, "tiles of whole blocks, ranks of 16 bits");
+  tile = std::max(BlockSize, std::min(GatherTile, tile / BlockSize * BlockSize));
   GatheredPoints gathered;
-  gathered.Order = GatherByCell(cells, n, cellCount, maxCells);
-  while (gathered.Order.size() % BlockSize != 0)
+  gathered.Points = n;
+  gathered.Tile = tile;
+  const std::vector<int> byCell = GatherByCell(cells, n, cellCount, maxCells, tile);
+  const std::int64_t tiles = (n + tile - 1) / tile;
+  const std::int64_t blocks = (n + BlockSize - 1) / BlockSize;
+  gathered.TileSources.assign(std::size_t(tiles) + 1, 0);
+  for (std::int64_t b = 0; b < blocks; ++b)
   {
-    gathered.Order.push_back(gathered.Order.back());
+    if (!BlockInPlace(cells, n, b, maxCells))
+    {
+      gathered.Sources.push_back(b);
+      ++gathered.TileSources[std::size_t(b * BlockSize / tile) + 1];
+    }
+  }
+  for (std::size_t t = 1; t < gathered.TileSources.size(); ++t)
+  {
+    gathered.TileSources[t] += gathered.TileSources[t - 1];
+  }
+  // Each point's place in its tile's run, found through its block's place among Sources.
+  std::vector<std::int64_t> sourceOfBlock(std::size_t(blocks), -1);
+  for (std::size_t k = 0; k < gathered.Sources.size(); ++k)
+  {
+    sourceOfBlock[std::size_t(gathered.Sources[k])] = std::int64_t(k);
+  }
+  gathered.Ranks.assign(gathered.Sources.size() * BlockSize, 0);
+  gathered.TileBlocks.assign(std::size_t(tiles) + 1, 0);
+  std::size_t next = 0;
+  for (std::int64_t t = 0; t < tiles; ++t)
+  {
+    const std::size_t runFirst = gathered.Order.size();
+    for (; next < byCell.size() && byCell[next] / tile == t; ++next)
+    {
+      const int i = byCell[next];
+      gathered.Ranks[std::size_t(sourceOfBlock[std::size_t(i / BlockSize)] * BlockSize + i % BlockSize)] =
+        std::uint16_t(gathered.Order.size() - runFirst);
+      gathered.Order.push_back(i);
+    }
+    while ((gathered.Order.size() - runFirst) % BlockSize != 0)
+    {
+      gathered.Order.push_back(gathered.Order.back());
+    }
+    gathered.TileBlocks[std::size_t(t) + 1] = std::int64_t(gathered.Order.size()) / BlockSize;
   }
   gathered.Cells.reserve(gathered.Order.size());
   for (int i : gathered.Order)
@@ -386,29 +444,33 @@ inline void CopyGatheredPoints(
 
 namespace detail
 {
-/// Point i deformed alone: cell -1 keeps its position.
+/// Point i deformed alone, written to out + 3 (i - outFirst): cell -1 keeps its position.
 template <typename Deformation, typename Real>
-inline void DeformOnePoint(const Deformation& deformation, const Real* in, const int* cells, Real* out, std::int64_t i)
+inline void DeformOnePoint(
+  const Deformation& deformation, const Real* in, const int* cells, Real* out, std::int64_t i, std::int64_t outFirst)
 {
-  const Vec3<Real> x = { in[3 * i], in[3 * i + 1], in[3 * i + 2] };
+  const Vec3<Real> x = Vec3<Real>::From(in + 3 * i);
   const Vec3<Real> y = cells[i] >= 0 ? deformation.Deform(x, cells[i]) : x;
-  out[3 * i] = y.x;
-  out[3 * i + 1] = y.y;
-  out[3 * i + 2] = y.z;
-}
-
-/// Point g of the gathered list deformed alone, written to its place.
-template <typename Deformation, typename Real>
-inline void DeformOneGathered(
-  const Deformation& deformation, const Real* listed, const GatheredPoints& gathered, Real* out, std::int64_t g)
-{
-  const Vec3<Real> x = Vec3<Real>::From(listed + 3 * g);
-  const int cell = gathered.Cells[std::size_t(g)];
-  const Vec3<Real> y = cell >= 0 ? deformation.Deform(x, cell) : x;
-  Real* to = out + 3 * std::int64_t(gathered.Order[std::size_t(g)]);
+  Real* to = out + 3 * (i - outFirst);
   to[0] = y.x;
   to[1] = y.y;
   to[2] = y.z;
+}
+
+/// Tile t's results, staged in its run's order (DeformGathered()), written out in point order.
+template <typename Real>
+inline void WriteTile(const GatheredPoints& gathered, std::int64_t t, const Real* staged, Real* out)
+{
+  for (std::int64_t k = gathered.TileSources[std::size_t(t)]; k < gathered.TileSources[std::size_t(t) + 1]; ++k)
+  {
+    const std::int64_t first = gathered.Sources[std::size_t(k)] * BlockSize;
+    const std::uint16_t* ranks = gathered.Ranks.data() + k * BlockSize;
+    const int count = int(std::min<std::int64_t>(BlockSize, gathered.Points - first));
+    for (int l = 0; l < count; ++l)
+    {
+      std::memcpy(out + 3 * (first + l), staged + 3 * std::int64_t(ranks[l]), 3 * sizeof(Real));
+    }
+  }
 }
 
 /// Point i deformed alone with its Jacobian (the identity where it keeps its position): its position and, where
@@ -735,25 +797,13 @@ inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, 
   }
 }
 
-/// Blocks of the gathered list that the gathered pass deforms into a buffer on the stack before it scatters them.
-constexpr int GatherChunk = 64;
-
+/// Blocks [blockBegin, blockEnd) of the gathered list deformed into staged, from its block blockBegin on.
 template <int W, typename Deformation, typename Real>
 inline void GatheredInLanes(const Deformation& deformation, const Real* listed, const GatheredPoints& gathered,
-  Real* out, std::int64_t blockBegin, std::int64_t blockEnd)
+  Real* staged, std::int64_t blockBegin, std::int64_t blockEnd)
 {
-  alignas(64) Real staged[3 * GatherChunk * BlockSize];
-  for (std::int64_t chunk = blockBegin; chunk < blockEnd; chunk += GatherChunk)
-  {
-    const std::int64_t end = std::min(chunk + GatherChunk, blockEnd);
-    BlocksInPlaceInLanes<W, false>(deformation, listed, gathered.Cells.data(), staged, gathered.Blocks, chunk,
-      end, chunk * BlockSize);
-    const int* order = gathered.Order.data() + chunk * BlockSize;
-    for (std::int64_t p = 0; p < (end - chunk) * BlockSize; ++p)
-    {
-      std::memcpy(out + 3 * std::int64_t(order[p]), staged + 3 * p, 3 * sizeof(Real));
-    }
-  }
+  BlocksInPlaceInLanes<W, false>(deformation, listed, gathered.Cells.data(), staged, gathered.Blocks, blockBegin,
+    blockEnd, blockBegin * BlockSize);
 }
 
 // The wide variants of both passes, one function per instruction set (see the file's documentation).
@@ -783,9 +833,9 @@ inline void GatheredInLanes(const Deformation& deformation, const Real* listed, 
   }                                                                                                           \
   template <typename Deformation, typename Real>                                                              \
   Target void Gathered##Suffix(const Deformation& deformation, const Real* listed, const GatheredPoints& gathered, \
-    Real* out, std::int64_t blockBegin, std::int64_t blockEnd)                                                \
+    Real* staged, std::int64_t blockBegin, std::int64_t blockEnd)                                             \
   {                                                                                                           \
-    GatheredInLanes<Bytes / sizeof(Real)>(deformation, listed, gathered, out, blockBegin, blockEnd);         \
+    GatheredInLanes<Bytes / sizeof(Real)>(deformation, listed, gathered, staged, blockBegin, blockEnd);      \
   }
 FFD_LANE_VARIANTS(AVX512, FFD_TARGET_AVX512, 64)
 FFD_LANE_VARIANTS(AVX2, FFD_TARGET_AVX2, 32)
@@ -825,7 +875,7 @@ inline void DeformBlocksInPlace(SimdLevel level, const Deformation& deformation,
     {
       for (std::int64_t i = b * BlockSize; i < (b + 1) * BlockSize; ++i)
       {
-        detail::DeformOnePoint(deformation, in, cells, out, i);
+        detail::DeformOnePoint(deformation, in, cells, out, i, 0);
       }
     }
   }
@@ -865,29 +915,41 @@ inline void DeformWithJacobian(SimdLevel level, const Deformation& deformation, 
 }
 
 /**
- * Second pass: the listed points of blocks [blockBegin, blockEnd) of `gathered` (of GatheredPoints::BlockCount()),
+ * Second pass: the listed points of tiles [tileBegin, tileEnd) of `gathered` (of GatheredPoints::TileCount()),
  * whose coordinates `listed` holds in listed order (CopyGatheredPoints()), each written to its place in out.
+ * `staging` holds 3 GatherTile Reals, the caller's so that a thread allocates it once.
  */
 template <typename Deformation, typename Real>
 inline void DeformGathered(SimdLevel level, const Deformation& deformation, const Real* listed,
-  const GatheredPoints& gathered, Real* out, std::int64_t blockBegin, std::int64_t blockEnd)
+  const GatheredPoints& gathered, Real* out, std::int64_t tileBegin, std::int64_t tileEnd, Real* staging)
 {
+  for (std::int64_t t = tileBegin; t < tileEnd; ++t)
+  {
+    const std::int64_t first = gathered.TileBlocks[std::size_t(t)], last = gathered.TileBlocks[std::size_t(t) + 1];
+    if (first == last)
+    {
+      continue;
+    }
+    switch (level)
+    {
 #if FFD_HAVE_LANES
-  switch (level)
-  {
-    case SimdLevel::AVX512:
-      return detail::GatheredAVX512(deformation, listed, gathered, out, blockBegin, blockEnd);
-    case SimdLevel::AVX2:
-      return detail::GatheredAVX2(deformation, listed, gathered, out, blockBegin, blockEnd);
-    case SimdLevel::SSE2:
-      return detail::GatheredSSE2(deformation, listed, gathered, out, blockBegin, blockEnd);
-    case SimdLevel::None:
-      break;
-  }
+      case SimdLevel::AVX512:
+        detail::GatheredAVX512(deformation, listed, gathered, staging, first, last);
+        break;
+      case SimdLevel::AVX2:
+        detail::GatheredAVX2(deformation, listed, gathered, staging, first, last);
+        break;
+      case SimdLevel::SSE2:
+        detail::GatheredSSE2(deformation, listed, gathered, staging, first, last);
+        break;
 #endif
-  for (std::int64_t g = blockBegin * BlockSize; g < blockEnd * BlockSize; ++g)
-  {
-    detail::DeformOneGathered(deformation, listed, gathered, out, g);
+      default:
+        for (std::int64_t g = first * BlockSize; g < last * BlockSize; ++g)
+        {
+          detail::DeformOnePoint(deformation, listed, gathered.Cells.data(), staging, g, first * BlockSize);
+        }
+    }
+    detail::WriteTile(gathered, t, staging, out);
   }
 }
 

@@ -132,8 +132,8 @@ Vec ClampedReference(Basis b, const GridLattice& lat, const Vec& xd)
 }
 
 /// Both passes over the whole set with blocks in at most maxCells cells in place (`gathered` listed for that
-/// limit), the ranges of blocks cut at the given blocks (sorted, within the ranges); with `stream`, into memory
-/// aligned to 64 bytes, the in-place pass by non-temporal stores.
+/// limit), the in-place pass's range of blocks and the gathered pass's range of tiles cut where given (sorted,
+/// within the ranges); with `stream`, into memory aligned to 64 bytes, the in-place pass by non-temporal stores.
 template <typename D, typename Real>
 std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Real>& set,
   const ffd::GatheredPoints& gathered, int maxCells, const std::vector<std::int64_t>& blockCuts = {},
@@ -155,13 +155,14 @@ std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Rea
   ffd::DeformBlocksInPlace(level, d, set.Values.data(), set.Cells.data(), out, listed, begin, blocks, stream);
   std::vector<Real> copy(3 * gathered.Order.size());
   ffd::CopyGatheredPoints(set.Values.data(), gathered, 0, std::int64_t(gathered.Order.size()), copy.data());
+  std::vector<Real> staging(3 * ffd::GatherTile, std::numeric_limits<Real>::quiet_NaN());
   begin = 0;
   for (std::int64_t cut : gatheredCuts)
   {
-    ffd::DeformGathered(level, d, copy.data(), gathered, out, begin, cut);
+    ffd::DeformGathered(level, d, copy.data(), gathered, out, begin, cut, staging.data());
     begin = cut;
   }
-  ffd::DeformGathered(level, d, copy.data(), gathered, out, begin, gathered.BlockCount());
+  ffd::DeformGathered(level, d, copy.data(), gathered, out, begin, gathered.TileCount(), staging.data());
   return std::vector<Real>(out, out + set.Values.size());
 }
 
@@ -172,6 +173,10 @@ std::vector<int> MaxCellsToTry()
 {
   return { 0, 1, 4, ffd::BlockSize };
 }
+
+/// Points a tile of the gathered pass in the tests: several tiles in sets of 1001 and 2003 points, a last one
+/// partial (the filter's, ffd::GatherTile, holds 32768).
+constexpr int TestTile = 256;
 
 int CellCount(const GridLattice& lat)
 {
@@ -205,7 +210,7 @@ TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
         for (int maxCells : MaxCellsToTry())
         {
           const ffd::GatheredPoints gathered =
-            ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells);
+            ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells, TestTile);
           for (ffd::SimdLevel level : Levels())
           {
             const std::vector<Real> out = DeformAll(level, k.D, set, gathered, maxCells);
@@ -238,9 +243,9 @@ TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
 TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
 {
   // At each level, a point's result is the same bit for bit: in its mesh order, split into random sub-ranges
-  // (as threads split it), written by non-temporal stores, in a shuffled order (lane groups of many cells), and
-  // whichever pass takes it, at every cell limit of MaxCellsToTry() (every block gathered, up to every block in
-  // place).
+  // (as threads split it), written by non-temporal stores, in a shuffled order (lane groups of many cells),
+  // gathered in tiles of TestTile or GatherTile points, and whichever pass takes it, at every cell limit of
+  // MaxCellsToTry() (every block gathered, up to every block in place).
   using Real = TypeParam;
   ffdtest::Rng rng(602);
   for (Basis b : ffdtest::AllBases)
@@ -270,16 +275,19 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
         for (int maxCells : MaxCellsToTry())
         {
           const ffd::GatheredPoints gathered =
-            ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells);
+            ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells, TestTile);
           const ffd::GatheredPoints shuffledGathered =
-            ffd::ListGatheredPoints(shuffled.Cells.data(), shuffled.Size(), CellCount(lat), maxCells);
+            ffd::ListGatheredPoints(shuffled.Cells.data(), shuffled.Size(), CellCount(lat), maxCells, TestTile);
+          const ffd::GatheredPoints oneTile =
+            ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells);
           if (b != Basis::Bernstein && maxCells > 0 && maxCells < ffd::BlockSize) // in one cell, or outside
           {
             ASSERT_GT(shuffledGathered.Order.size(), gathered.Order.size()) << lat.Name();
           }
           const std::vector<Real> whole = DeformAll(level, k.D, set, gathered, maxCells);
           const std::vector<Real> split = DeformAll(level, k.D, set, gathered, maxCells,
-            cuts((set.Size() + ffd::BlockSize - 1) / ffd::BlockSize), cuts(gathered.BlockCount()));
+            cuts((set.Size() + ffd::BlockSize - 1) / ffd::BlockSize), cuts(gathered.TileCount()));
+          const std::vector<Real> tiled = DeformAll(level, k.D, set, oneTile, maxCells);
           const std::vector<Real> reordered = DeformAll(level, k.D, shuffled, shuffledGathered, maxCells);
           const std::vector<Real> streamed = DeformAll(level, k.D, set, gathered, maxCells, {}, {}, true);
           if (first.empty())
@@ -295,6 +303,7 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
             {
               ASSERT_EQ(whole[3 * i + c], first[3 * i + c]) << where;
               ASSERT_EQ(split[3 * i + c], whole[3 * i + c]) << where;
+              ASSERT_EQ(tiled[3 * i + c], whole[3 * i + c]) << where << " (one tile of " << ffd::GatherTile << ")";
               ASSERT_EQ(streamed[3 * i + c], whole[3 * i + c]) << where << " (non-temporal stores)";
               ASSERT_EQ(reordered[3 * p + c], whole[3 * i + c]) << where;
             }
@@ -416,6 +425,7 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
   // and 3 are deformed in place; block 1 spans 10 cells (-1 included) and the partial tail are gathered: their
   // points, stably sorted by cell with -1 first. With a limit of BlockSize every full block is in place.
   const int maxCells = 8;
+  const int cellCount = maxCells + 1; // cells 0 .. 8
   const int n = 3 * ffd::BlockSize + 5;
   std::vector<int> cells(n, 5);
   for (int i = ffd::BlockSize; i < 2 * ffd::BlockSize; ++i)
@@ -430,7 +440,7 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
   std::copy(tail, tail + 5, cells.begin() + 3 * ffd::BlockSize);
 
   std::vector<int> expected, expectedTail;
-  for (int cell = -1; cell < 8; ++cell)
+  for (int cell = -1; cell < cellCount; ++cell)
   {
     for (int i = 0; i < n; ++i)
     {
@@ -445,17 +455,17 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
       }
     }
   }
-  EXPECT_EQ(ffd::GatherByCell(cells.data(), n, 8, maxCells), expected);
+  EXPECT_EQ(ffd::GatherByCell(cells.data(), n, cellCount, maxCells), expected);
   EXPECT_TRUE(ffd::BlockInPlace(cells.data(), n, 0, maxCells));
   EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 1, maxCells));
   EXPECT_TRUE(ffd::BlockInPlace(cells.data(), n, 2, maxCells));
   EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 3, maxCells));
   EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 1, 9));
   EXPECT_TRUE(ffd::BlockInPlace(cells.data(), n, 1, 10));
-  EXPECT_EQ(ffd::GatherByCell(cells.data(), n, 8, ffd::BlockSize), expectedTail);
+  EXPECT_EQ(ffd::GatherByCell(cells.data(), n, cellCount, ffd::BlockSize), expectedTail);
 
   // What the gathered pass reads: that list, its last point repeated up to whole blocks, and their cells.
-  const ffd::GatheredPoints gathered = ffd::ListGatheredPoints(cells.data(), n, 8, maxCells);
+  const ffd::GatheredPoints gathered = ffd::ListGatheredPoints(cells.data(), n, cellCount, maxCells);
   ASSERT_EQ(gathered.Order.size(), 2u * ffd::BlockSize);
   EXPECT_EQ(gathered.BlockCount(), 2);
   for (std::size_t g = 0; g < gathered.Order.size(); ++g)
@@ -464,6 +474,41 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
     EXPECT_EQ(gathered.Cells[g], cells[std::size_t(gathered.Order[g])]) << g;
   }
   EXPECT_EQ(gathered.Blocks.Entry.size(), 2u);
+  // Where the results go: the gathered blocks 1 and 3 (partial), in the one tile, each point's rank its place
+  // in the list.
+  EXPECT_EQ(gathered.TileCount(), 1);
+  EXPECT_EQ(gathered.TileBlocks, (std::vector<std::int64_t>{ 0, 2 }));
+  EXPECT_EQ(gathered.Sources, (std::vector<std::int64_t>{ 1, 3 }));
+  EXPECT_EQ(gathered.TileSources, (std::vector<std::int64_t>{ 0, 2 }));
+  for (std::size_t k = 0; k < gathered.Sources.size(); ++k)
+  {
+    for (int l = 0; l < ffd::BlockSize && gathered.Sources[k] * ffd::BlockSize + l < n; ++l)
+    {
+      EXPECT_EQ(gathered.Order[gathered.Ranks[k * ffd::BlockSize + l]], gathered.Sources[k] * ffd::BlockSize + l);
+    }
+  }
+
+  // In tiles of 2 blocks: block 1 in the first, sorted by cell; the tail in the second, padded by its last point.
+  const ffd::GatheredPoints tiled =
+    ffd::ListGatheredPoints(cells.data(), n, cellCount, maxCells, 2 * ffd::BlockSize);
+  EXPECT_EQ(tiled.TileCount(), 2);
+  EXPECT_EQ(tiled.TileBlocks, (std::vector<std::int64_t>{ 0, 1, 2 }));
+  EXPECT_EQ(tiled.TileSources, (std::vector<std::int64_t>{ 0, 1, 2 }));
+  std::vector<int> firstTile, secondTile;
+  for (int i : expected)
+  {
+    (i < 2 * ffd::BlockSize ? firstTile : secondTile).push_back(i);
+  }
+  for (int g = 0; g < ffd::BlockSize; ++g)
+  {
+    EXPECT_EQ(tiled.Order[std::size_t(g)], firstTile[std::size_t(g)]) << g;
+    EXPECT_EQ(tiled.Order[std::size_t(ffd::BlockSize + g)],
+      secondTile[std::min(std::size_t(g), secondTile.size() - 1)]) << g;
+  }
+  for (int l = 0; l < 5; ++l) // ranks are places within the tile's run
+  {
+    EXPECT_EQ(tiled.Order[std::size_t(ffd::BlockSize + tiled.Ranks[ffd::BlockSize + l])], 3 * ffd::BlockSize + l);
+  }
 
   // The mean over the whole blocks, and the limits it gives: every block in place for a trilinear lattice at
   // a mean of 1.7 or less (2 with a cell table), none above it (and never for the global
