@@ -142,17 +142,18 @@ inline bool StreamOutput(std::int64_t bytes)
  * chosen for a binding from its mean number of cells per block. In place reads and writes memory in order, but a lane
  * group in several cells evaluates each of its cells in all its lanes; the gathered pass reads a copy of its points in
  * order, sorted by cell within tiles (GatherTile), evaluates whole lane groups of one cell into a tile's staging
- * buffer, and writes the tile out in point order from there. With few cells a block on average (a mesh in a spatially
- * coherent vertex order: 1.5 for the 6.7 M-point armadillo of BENCHMARKS.md over 9^3 voxels) every block is deformed in
- * place (BlockSize); with more (4.5 for the 0.4 M-point one, whose vertex order is random) every block is gathered (0),
- * those in one cell too: the gathered pass reads them in order with the others, where the in-place pass would read them
- * at random. The crossovers were measured on both meshes reordered to means in between (2026-11-23, BENCHMARKS.md, with
- * the results then written at random within a tile rather than staged): lower for the bases whose cells cost more.
- * Where the mesh fits in the caches the gathered pass wins sooner, where it does not later; these are in between.
+ * buffer, and writes the tile out in point order from there. Below the crossover every block is deformed in place
+ * (BlockSize), above it every block is gathered (0), those in one cell too: the gathered pass reads them in order with
+ * the others, where the in-place pass would read them at random. The 0.4 M-point armadillo of BENCHMARKS.md, in random
+ * vertex order, has 4.5 cells a block over 9^3 voxels: gathered. The 6.7 M-point one, in a spatially coherent order,
+ * has 1.4 to 1.5: in place for the trilinear basis, gathered for the others, whose cells cost more. The crossovers were
+ * measured on both meshes reordered to means in between (BENCHMARKS.md, 2026-11-23, again for the staged gathered
+ * pass); they are lower for float64 than for float32 (trilinear with its table: 1.5 against 2.1), and these are in
+ * between.
  */
 inline int MaxCellsInPlace(GridBasis basis, double meanCellsPerBlock, bool cellTable)
 {
-  double crossover = 1.2; // tricubic Bezier and cubic B-spline: 64 control points a cell
+  double crossover = 1.2; // the triquadratic and cubic bases: 27 or 64 control points a cell
   if (basis == GridBasis::Bernstein)
   {
     return BlockSize; // one cell
@@ -160,10 +161,6 @@ inline int MaxCellsInPlace(GridBasis basis, double meanCellsPerBlock, bool cellT
   if (basis == GridBasis::Trilinear)
   {
     crossover = cellTable ? 2.0 : 1.7; // 7 multiply-adds a component, or 8 control points
-  }
-  else if (basis == GridBasis::TriquadraticBezier)
-  {
-    crossover = 1.6; // 27 control points
   }
   return meanCellsPerBlock <= crossover ? BlockSize : 0;
 }

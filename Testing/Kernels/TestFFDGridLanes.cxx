@@ -511,8 +511,8 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
   }
 
   // The mean over the whole blocks, and the limits it gives: every block in place for a trilinear lattice at
-  // a mean of 1.7 or less (2 with a cell table), none above it (and never for the global
-  // basis).
+  // a mean of 1.7 or less (2 with a cell table), for the other local bases at 1.2 or less, none above it (and
+  // never for the global basis).
   EXPECT_EQ(ffd::CellsOfBlock(cells.data(), 1), maxCells + 2);
   EXPECT_DOUBLE_EQ(ffd::MeanCellsPerBlock(cells.data(), n), (1.0 + (maxCells + 2) + 2.0) / 3.0);
   EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 1.5, false), ffd::BlockSize);
@@ -520,6 +520,8 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
   EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 1.9, true), ffd::BlockSize);
   EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Trilinear, 4.5, true), 0);
   EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::CubicBSpline, 1.5, false), 0);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::TriquadraticBezier, 1.1, true), ffd::BlockSize);
+  EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::TriquadraticBezier, 1.4, true), 0);
   EXPECT_EQ(ffd::MaxCellsInPlace(ffd::GridBasis::Bernstein, 16.0, false), ffd::BlockSize);
 
   // The same blocks listed: block 0 in one cell, block 1 in 9 cells and -1, block 2 in cell 3 (its odd points)
