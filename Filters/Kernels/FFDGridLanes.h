@@ -279,27 +279,33 @@ inline BlockCells ListBlockCells(const int* cells, std::int64_t n, int maxCells)
  */
 constexpr int GatherTile = 32768;
 
-/**
- * The points of the blocks not deformed in place (BlockInPlace() with maxCells), tile by tile (of `tile` points,
- * GatherTile but in tests), each tile's sorted by cell: cell -1 first, then by cell, each cell's points in input
- * order (two stable counting sorts: by cell, then by tile). For DeformGathered(); `cellCount` is the number of
- * cells of the binding.
- */
-inline std::vector<int> GatherByCell(
-  const int* cells, std::int64_t n, int cellCount, int maxCells, int tile = GatherTile)
+/// The blocks of n points bound to `cells` that are not deformed in place (BlockInPlace() with maxCells), in
+/// order.
+inline std::vector<std::int64_t> GatheredBlocks(const int* cells, std::int64_t n, int maxCells)
+{
+  std::vector<std::int64_t> gathered;
+  for (std::int64_t b = 0; b < (n + BlockSize - 1) / BlockSize; ++b)
+  {
+    if (!BlockInPlace(cells, n, b, maxCells))
+    {
+      gathered.push_back(b);
+    }
+  }
+  return gathered;
+}
+
+namespace detail
+{
+/// GatherByCell() of the points of the blocks `sources` (GatheredBlocks()).
+inline std::vector<int> SortByCell(
+  const int* cells, std::int64_t n, int cellCount, const std::vector<std::int64_t>& sources, int tile)
 {
   std::vector<std::int64_t> offsets(std::size_t(cellCount) + 2, 0);
-  const std::int64_t blocks = (n + BlockSize - 1) / BlockSize;
-  std::vector<bool> gather(std::size_t(blocks), false);
-  for (std::int64_t b = 0; b < blocks; ++b)
+  for (std::int64_t b : sources)
   {
-    gather[std::size_t(b)] = !BlockInPlace(cells, n, b, maxCells);
-    if (gather[std::size_t(b)])
+    for (std::int64_t i = b * BlockSize; i < n && i < (b + 1) * BlockSize; ++i)
     {
-      for (std::int64_t i = b * BlockSize; i < n && i < (b + 1) * BlockSize; ++i)
-      {
-        ++offsets[std::size_t(cells[i] + 2)];
-      }
+      ++offsets[std::size_t(cells[i] + 2)];
     }
   }
   for (std::size_t c = 1; c < offsets.size(); ++c)
@@ -307,14 +313,11 @@ inline std::vector<int> GatherByCell(
     offsets[c] += offsets[c - 1];
   }
   std::vector<int> byCell(std::size_t(offsets.back()));
-  for (std::int64_t b = 0; b < blocks; ++b)
+  for (std::int64_t b : sources)
   {
-    if (gather[std::size_t(b)])
+    for (std::int64_t i = b * BlockSize; i < n && i < (b + 1) * BlockSize; ++i)
     {
-      for (std::int64_t i = b * BlockSize; i < n && i < (b + 1) * BlockSize; ++i)
-      {
-        byCell[std::size_t(offsets[std::size_t(cells[i] + 1)]++)] = int(i);
-      }
+      byCell[std::size_t(offsets[std::size_t(cells[i] + 1)]++)] = int(i);
     }
   }
   std::vector<std::int64_t> tiles(std::size_t((n + tile - 1) / tile) + 1, 0);
@@ -333,22 +336,33 @@ inline std::vector<int> GatherByCell(
   }
   return gathered;
 }
+} // namespace detail
 
 /**
- * The points that the gathered pass deforms (DeformGathered()), listed once per binding, with where each result
- * goes. The list, Order, is GatherByCell()'s, each tile's run of it padded to whole blocks by repeating its last
- * point (so that every listed point is deformed in lanes, as bit for bit as the in-place pass); Cells, their
- * cells in that order; Blocks, the BlockCells of that order (every block in place); TileBlocks, the blocks of
- * each tile's run: tile t's are [TileBlocks[t], TileBlocks[t + 1]). The pass reads the points' coordinates in
- * that order from a copy (CopyGatheredPoints()), so that it reads memory in order and deforms whole lane groups
- * of one cell. For the writing: Sources, the blocks of points not deformed in place, in point order, tile t's
- * being [TileSources[t], TileSources[t + 1]); Ranks, for point l of the k-th of them, at k BlockSize + l, its
- * place in its tile's run.
+ * The points of the blocks not deformed in place (GatheredBlocks() with maxCells), tile by tile (of `tile`
+ * points, GatherTile but in tests), each tile's sorted by cell: cell -1 first, then by cell, each cell's points
+ * in input order (two stable counting sorts: by cell, then by tile). For DeformGathered(); `cellCount` is the
+ * number of cells of the binding.
+ */
+inline std::vector<int> GatherByCell(
+  const int* cells, std::int64_t n, int cellCount, int maxCells, int tile = GatherTile)
+{
+  return detail::SortByCell(cells, n, cellCount, GatheredBlocks(cells, n, maxCells), tile);
+}
+
+/**
+ * The points that the gathered pass deforms (DeformGathered()), listed once per binding, with where each result goes.
+ * The list, Order, is GatherByCell()'s, each tile's run of it padded to whole blocks by repeating its last point (so
+ * that every listed point is deformed in lanes, as bit for bit as the in-place pass); Cells, their cells in that order;
+ * Blocks, the BlockCells of that order (every block in place); TileBlocks, the blocks of each tile's run: tile t's are
+ * [TileBlocks[t], TileBlocks[t + 1]). The pass reads the points' coordinates in that order from a copy
+ * (CopyGatheredPoints()), so that it reads memory in order and deforms whole lane groups of one cell. For the writing:
+ * Sources, GatheredBlocks(), in point order, tile t's being [TileSources[t], TileSources[t + 1]); Ranks, for point l of
+ * the k-th of them, at k BlockSize + l, its place in its tile's run.
  */
 struct GatheredPoints
 {
   std::int64_t Points = 0; ///< the binding's points
-  int Tile = GatherTile;   ///< points a tile
   std::vector<int> Order;
   std::vector<int> Cells;
   BlockCells Blocks;
@@ -356,9 +370,6 @@ struct GatheredPoints
   std::vector<std::int64_t> Sources;
   std::vector<std::int64_t> TileSources;
   std::vector<std::uint16_t> Ranks;
-
-  /// The blocks of the list.
-  std::int64_t BlockCount() const { return std::int64_t(this->Order.size()) / BlockSize; }
 
   /// The tiles of the binding's points (some may list no point).
   std::int64_t TileCount() const { return std::int64_t(this->TileBlocks.size()) - 1; }
@@ -374,18 +385,14 @@ inline GatheredPoints ListGatheredPoints(
   tile = std::max(BlockSize, std::min(GatherTile, tile / BlockSize * BlockSize));
   GatheredPoints gathered;
   gathered.Points = n;
-  gathered.Tile = tile;
-  const std::vector<int> byCell = GatherByCell(cells, n, cellCount, maxCells, tile);
+  gathered.Sources = GatheredBlocks(cells, n, maxCells);
+  const std::vector<int> byCell = detail::SortByCell(cells, n, cellCount, gathered.Sources, tile);
   const std::int64_t tiles = (n + tile - 1) / tile;
   const std::int64_t blocks = (n + BlockSize - 1) / BlockSize;
   gathered.TileSources.assign(std::size_t(tiles) + 1, 0);
-  for (std::int64_t b = 0; b < blocks; ++b)
+  for (std::int64_t b : gathered.Sources)
   {
-    if (!BlockInPlace(cells, n, b, maxCells))
-    {
-      gathered.Sources.push_back(b);
-      ++gathered.TileSources[std::size_t(b * BlockSize / tile) + 1];
-    }
+    ++gathered.TileSources[std::size_t(b * BlockSize / tile) + 1];
   }
   for (std::size_t t = 1; t < gathered.TileSources.size(); ++t)
   {

@@ -467,7 +467,7 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
   // What the gathered pass reads: that list, its last point repeated up to whole blocks, and their cells.
   const ffd::GatheredPoints gathered = ffd::ListGatheredPoints(cells.data(), n, cellCount, maxCells);
   ASSERT_EQ(gathered.Order.size(), 2u * ffd::BlockSize);
-  EXPECT_EQ(gathered.BlockCount(), 2);
+  EXPECT_EQ(gathered.TileBlocks.back(), 2);
   for (std::size_t g = 0; g < gathered.Order.size(); ++g)
   {
     EXPECT_EQ(gathered.Order[g], expected[std::min(g, expected.size() - 1)]) << g;
