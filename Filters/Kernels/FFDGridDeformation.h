@@ -216,62 +216,92 @@ inline void FillCellTable(GridBasis basis, const Real* displacements, const int 
 }
 
 /**
- * D of FillCellTable() (a basis of degree Degree) at local coordinates r of the cell whose entry is `entry`, by
- * Horner's rule, and, where dDdr is not null, its derivatives: column a is dD/dr[a].
+ * D of FillCellTable() (a basis of degree Degree) at local coordinates r[g] of the cell whose entry is `entry`, for
+ * G lane groups g at once, by Horner's rule, into d[g], and, where dDdr is not null, its derivatives into dDdr[g]:
+ * column a is dD/dr[a]. Each coefficient is read (broadcast to the lanes) once for all G groups: with AVX-512 in
+ * float64 the broadcasts took about a third of a trilinear cell's evaluation (BENCHMARKS.md, 2026-11-23, late).
  */
-template <int Degree, typename Lane, typename Real>
-FFD_INLINE Vec3<Lane> PowerForm(const Real* entry, const Lane r[3], Mat3<Lane>* dDdr)
+template <int Degree, int G, typename Lane, typename Real>
+FFD_INLINE void PowerForm(const Real* entry, const Lane (*r)[3], Vec3<Lane>* d, Mat3<Lane>* dDdr)
 {
   constexpr int N = Degree + 1;
   const Real* c = entry + 8;
-  Lane d[3];
+  Lane out[G][3];
   FFD_UNROLL
   for (int k = 0; k < 3; ++k)
   {
     // Along z, of polynomials along y, of polynomials along x; each with its derivative where asked.
-    Lane z = Lane(0), zx = Lane(0), zy = Lane(0), zz = Lane(0);
+    Lane z[G], zx[G], zy[G], zz[G];
     FFD_UNROLL
     for (int iz = Degree; iz >= 0; --iz)
     {
-      Lane y = Lane(0), yx = Lane(0), yy = Lane(0);
+      Lane y[G], yx[G], yy[G];
       FFD_UNROLL
       for (int iy = Degree; iy >= 0; --iy)
       {
         const Real* row = c + 3 * N * (iy + N * iz) + k;
-        Lane x = Lane(row[3 * Degree]), xx = Lane(0);
+        Lane x[G], xx[G];
+        const Lane top = Lane(row[3 * Degree]);
+        FFD_UNROLL
+        for (int g = 0; g < G; ++g)
+        {
+          x[g] = top;
+          xx[g] = Lane(0);
+        }
         FFD_UNROLL
         for (int ix = Degree - 1; ix >= 0; --ix)
         {
+          const Lane coefficient = Lane(row[3 * ix]);
+          FFD_UNROLL
+          for (int g = 0; g < G; ++g)
+          {
+            if (dDdr)
+            {
+              xx[g] = x[g] + r[g][0] * xx[g];
+            }
+            x[g] = coefficient + r[g][0] * x[g];
+          }
+        }
+        FFD_UNROLL
+        for (int g = 0; g < G; ++g)
+        {
           if (dDdr)
           {
-            xx = x + r[0] * xx;
+            yy[g] = iy == Degree ? Lane(0) : y[g] + r[g][1] * yy[g];
+            yx[g] = iy == Degree ? xx[g] : xx[g] + r[g][1] * yx[g];
           }
-          x = Lane(row[3 * ix]) + r[0] * x;
+          y[g] = iy == Degree ? x[g] : x[g] + r[g][1] * y[g];
         }
+      }
+      FFD_UNROLL
+      for (int g = 0; g < G; ++g)
+      {
         if (dDdr)
         {
-          yy = iy == Degree ? Lane(0) : y + r[1] * yy;
-          yx = iy == Degree ? xx : xx + r[1] * yx;
+          zz[g] = iz == Degree ? Lane(0) : z[g] + r[g][2] * zz[g];
+          zx[g] = iz == Degree ? yx[g] : yx[g] + r[g][2] * zx[g];
+          zy[g] = iz == Degree ? yy[g] : yy[g] + r[g][2] * zy[g];
         }
-        y = iy == Degree ? x : x + r[1] * y;
+        z[g] = iz == Degree ? y[g] : y[g] + r[g][2] * z[g];
       }
+    }
+    FFD_UNROLL
+    for (int g = 0; g < G; ++g)
+    {
+      out[g][k] = z[g];
       if (dDdr)
       {
-        zz = iz == Degree ? Lane(0) : z + r[2] * zz;
-        zx = iz == Degree ? yx : yx + r[2] * zx;
-        zy = iz == Degree ? yy : yy + r[2] * zy;
+        dDdr[g].M[k][0] = zx[g];
+        dDdr[g].M[k][1] = zy[g];
+        dDdr[g].M[k][2] = zz[g];
       }
-      z = iz == Degree ? y : y + r[2] * z;
-    }
-    d[k] = z;
-    if (dDdr)
-    {
-      dDdr->M[k][0] = zx;
-      dDdr->M[k][1] = zy;
-      dDdr->M[k][2] = zz;
     }
   }
-  return { d[0], d[1], d[2] };
+  FFD_UNROLL
+  for (int g = 0; g < G; ++g)
+  {
+    d[g] = { out[g][0], out[g][1], out[g][2] };
+  }
 }
 
 namespace detail
@@ -355,16 +385,41 @@ struct GridDeformation
   /// X + D(s, t, u) for a point bound to `cell` (not -1); with lanes, every lane is bound to `cell`.
   FFD_INLINE Vec3<Lane> Deform(const Vec3<Lane>& x, int cell) const
   {
+    Vec3<Lane> y;
+    this->Deform<1>(&x, cell, &y);
+    return y;
+  }
+
+  /// Deform() of G lane groups x[g] (or points) all bound to `cell`, into y[g]: with a CellTable, each of the
+  /// cell's coefficients is read once for all groups (PowerForm()).
+  template <int G>
+  FFD_INLINE void Deform(const Vec3<Lane>* x, int cell, Vec3<Lane>* y) const
+  {
     if constexpr (WithCellTable)
     {
       const Real* entry = this->CellEntry(cell);
-      Lane r[3];
-      this->TableCoordinates(this->Frame.ToParametric(x), { Lane(entry[0]), Lane(entry[1]), Lane(entry[2]) }, r);
-      return x + this->CellPowerForm(entry, r, nullptr);
+      const Vec3<Lane> index = { Lane(entry[0]), Lane(entry[1]), Lane(entry[2]) };
+      Lane r[G][3];
+      FFD_UNROLL
+      for (int g = 0; g < G; ++g)
+      {
+        this->TableCoordinates(this->Frame.ToParametric(x[g]), index, r[g]);
+      }
+      this->CellPowerForm<G>(entry, r, y, nullptr);
+      FFD_UNROLL
+      for (int g = 0; g < G; ++g)
+      {
+        y[g] = x[g] + y[g];
+      }
+      return;
     }
     int c[3];
     this->CellIndices(cell, c);
-    return this->DeformInCell(x, c);
+    FFD_UNROLL
+    for (int g = 0; g < G; ++g)
+    {
+      y[g] = this->DeformInCell(x[g], c);
+    }
   }
 
   /// Deform() for a cell given by its index along each axis (CellIndices()), for callers that take the flat
@@ -415,7 +470,8 @@ struct GridDeformation
       Lane r[3];
       this->TableCoordinates(stu, { Lane(entry[0]), Lane(entry[1]), Lane(entry[2]) }, r);
       Mat3<Lane> gradient;
-      const Vec3<Lane> d = this->CellPowerForm(entry, r, &gradient);
+      Vec3<Lane> d;
+      this->CellPowerForm<1>(entry, &r, &d, &gradient);
       jacobian = this->JacobianAt(stu, this->TableGradient(gradient));
       return x + d;
     }
@@ -449,16 +505,17 @@ private:
   }
 
   /// PowerForm() of this deformation's basis.
-  FFD_INLINE Vec3<Lane> CellPowerForm(const Real* entry, const Lane r[3], Mat3<Lane>* dDdr) const
+  template <int G>
+  FFD_INLINE void CellPowerForm(const Real* entry, const Lane (*r)[3], Vec3<Lane>* d, Mat3<Lane>* dDdr) const
   {
     switch (CellDegree(this->BasisOf()))
     {
       case 1:
-        return PowerForm<1>(entry, r, dDdr);
+        return PowerForm<1, G>(entry, r, d, dDdr);
       case 2:
-        return PowerForm<2>(entry, r, dDdr);
+        return PowerForm<2, G>(entry, r, d, dDdr);
       default:
-        return PowerForm<3>(entry, r, dDdr);
+        return PowerForm<3, G>(entry, r, d, dDdr);
     }
   }
 
@@ -515,7 +572,7 @@ private:
       Vec3<Lane> dk;
       if constexpr (WithCellTable)
       {
-        dk = this->CellPowerForm(this->CellEntry(group.Cells[k]), r, gradient ? &gk : nullptr);
+        this->CellPowerForm<1>(this->CellEntry(group.Cells[k]), &r, &dk, gradient ? &gk : nullptr);
         if (gradient)
         {
           gk = this->TableGradient(gk);

@@ -694,31 +694,43 @@ inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in,
       {
         split.Split(first < 0 ? 0 : first, c);
       }
-      for (std::int64_t i = b * BlockSize; i < (b + 1) * BlockSize; i += W)
+      constexpr int Groups = BlockSize / W;
+      const std::int64_t begin = b * BlockSize;
+      Vec3<Lane> x[Groups], y[Groups];
+      for (int g = 0; g < Groups; ++g)
       {
-        Vec3<Lane> x;
-        Lane::Deinterleave3(in + 3 * i, x.x, x.y, x.z);
-        Vec3<Lane> y = x; // lanes of cell -1 keep their position
-        if (global)
+        Lane::Deinterleave3(in + 3 * (begin + g * W), x[g].x, x[g].y, x[g].z);
+        y[g] = x[g]; // lanes of cell -1 keep their position
+      }
+      if (global)
+      {
+        // The global basis has one cell, 0.
+        for (int g = 0; g < Groups; ++g)
         {
-          // The global basis has one cell, 0.
-          const Mask bound = LaneCellsOf<Lane>(cells + i) >= Mask{};
-          const Vec3<Lane> yc = wide.Deform(x, 0);
-          y = { Select(bound, yc.x, x.x), Select(bound, yc.y, x.y), Select(bound, yc.z, x.z) };
+          const Mask bound = LaneCellsOf<Lane>(cells + begin + g * W) >= Mask{};
+          const Vec3<Lane> yc = wide.Deform(x[g], 0);
+          y[g] = { Select(bound, yc.x, x[g].x), Select(bound, yc.y, x[g].y), Select(bound, yc.z, x[g].z) };
         }
-        else if (first >= 0)
+      }
+      else if (first >= 0)
+      {
+        // One cell: each control point read once for all lanes of a group, or with a cell table each coefficient
+        // once for all lanes of the block (GridDeformation::Deform() of Groups groups).
+        if constexpr (Deformation::UsesCellTable())
         {
-          // One cell: each control point (or coefficient) read once for all lanes.
-          if constexpr (Deformation::UsesCellTable())
+          wide.template Deform<Groups>(x, first, y);
+        }
+        else
+        {
+          for (int g = 0; g < Groups; ++g)
           {
-            y = wide.Deform(x, first);
-          }
-          else
-          {
-            y = wide.DeformInCell(x, c);
+            y[g] = wide.DeformInCell(x[g], c);
           }
         }
-        Lane::template Interleave3<Streaming>(y.x, y.y, y.z, out + 3 * (i - outFirst));
+      }
+      for (int g = 0; g < Groups; ++g)
+      {
+        Lane::template Interleave3<Streaming>(y[g].x, y[g].y, y[g].z, out + 3 * (begin + g * W - outFirst));
       }
     }
     DeformInSeveralCells<Lane, Streaming>(deformation, wide, split, blocks, in, out, outFirst, several, severalCount);
