@@ -8,9 +8,9 @@
  * - global: the Bernstein evaluation with 5^3 and 10^3 control points, against the FMA peak (compute-bound);
  * - bases: every basis (the global one over 4^3 voxels, the local ones over 4^3 voxels and over lattices of
  *   about 10^3 control points), against the copy bandwidth (std::memcpy): the bytes the evaluation must move
- *   per point (read the point and its 4-byte cell, write the point) per second; and CUBIC_BSPLINE against
- *   VTK's vtkBSplineTransform + vtkTransformFilter on the same mesh and lattice (with the largest difference
- *   between the two outputs, which must be rounding).
+ *   per point (read the point and its 4-byte cell, write the point) per second, the copy measured beside each
+ *   row; and CUBIC_BSPLINE against VTK's vtkBSplineTransform + vtkTransformFilter on the same mesh and lattice
+ *   (with the largest difference between the two outputs, which must be rounding).
  *
  * What is timed: vtkFFDDeform::Update() after the lattice's points moved, the binding being cached (the
  * program checks that it was not recomputed). That is the evaluation as a user sees it: reading the lattice,
@@ -583,7 +583,8 @@ struct VtkRow
 /**
  * For each mesh, precision, basis case and thread count: vtkFFDDeform::Update() timed as in the global
  * section, its points per second turned into bytes per second (BytesPerPoint) and compared with the copy
- * bandwidth of the same thread count. For CUBIC_BSPLINE over `vtkDivisions`, VTK's vtkBSplineTransform +
+ * bandwidth of the same thread count measured just before it (the load of a shared machine drifts within a run:
+ * a copy measured once at the start swung from 39 to 64 GB/s between runs minutes apart). For CUBIC_BSPLINE over `vtkDivisions`, VTK's vtkBSplineTransform +
  * vtkTransformFilter on the same mesh and lattice, timed the same way. Returns false when a pipeline failed.
  */
 bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, const std::vector<int>& threadCounts,
@@ -591,15 +592,6 @@ bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, co
 {
   // 256 MB per buffer: far beyond the caches (32 MB of L3 on this class of CPU), as the 5 M-point meshes are.
   const size_t copyBytes = size_t(quick ? 32 : 256) << 20;
-  std::vector<double> bandwidth;
-  std::printf("\nCopy bandwidth (std::memcpy of a %zu MB buffer into another, split over the threads; bytes "
-              "read + written per second, best of 5):\n",
-    copyBytes >> 20);
-  for (int threads : threadCounts)
-  {
-    bandwidth.push_back(MeasureCopyBandwidth(copyBytes, threads));
-    std::printf("  %2d thread(s): %6.2f GB/s\n", threads, bandwidth.back() * 1e-9);
-  }
 
   // Every basis over 4 x 4 x 4 voxels (the global one's cost grows with its degree, so it stays at 4), and the
   // local ones again over lattices of about 10^3 control points: their cost per point should not change.
@@ -611,14 +603,15 @@ bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, co
     { vtkFFDBuildLattice::CUBIC_BSPLINE, vtkDivisions } };
   std::printf("\nEvaluation per basis (vtkFFDDeform::Update() after moving the lattice, binding cached).\n"
               "bytes/point: what the evaluation must move: read the point and its 4-byte cell, write the point "
-              "(%d float32, %d float64);\nGB/s: Mpoints/s * bytes/point; %% copy: of the copy bandwidth above "
-              "for the same thread count.\nbind+1st: the first Update(), binding included, on all threads; "
-              "best, median: evaluation only.\n\n",
-    BytesPerPoint(false), BytesPerPoint(true));
+              "(%d float32, %d float64);\nGB/s: Mpoints/s * bytes/point; copy: std::memcpy of a %zu MB buffer "
+              "into another on the same threads, split between them, bytes read + written per second, best of 5,\n"
+              "measured just before the row (the machine's load drifts within a run); %% copy: GB/s of copy.\n"
+              "bind+1st: the first Update(), binding included, on all threads; best, median: evaluation only.\n\n",
+    BytesPerPoint(false), BytesPerPoint(true), copyBytes >> 20);
   std::printf("| basis               | div | ctrl | points    | type    | th | bind+1st | best (s) | median   | "
-              "Mpoints/s | GB/s   | %% copy  |\n");
+              "Mpoints/s | GB/s   | copy   | %% copy  |\n");
   std::printf("|---------------------|----:|-----:|----------:|---------|---:|---------:|---------:|---------:|"
-              "----------:|-------:|--------:|\n");
+              "----------:|-------:|-------:|--------:|\n");
   const int minRepeats = quick ? 2 : 3;
   const double minSeconds = quick ? 0.0 : 0.5;
   std::vector<VtkRow> vtkRows;
@@ -649,16 +642,17 @@ bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, co
         }
         for (size_t t = 0; t < threadCounts.size(); ++t)
         {
+          const double bandwidth = MeasureCopyBandwidth(copyBytes, threadCounts[t]);
           const Timing timing = TimeEvaluation(deform, lattice, rng, threadCounts[t], minRepeats, minSeconds);
           const double pointsPerSecond = input->GetNumberOfPoints() / timing.Best;
           const double bytesPerSecond = pointsPerSecond * BytesPerPoint(useDouble);
           std::printf("| %-19s | %3d | %4lld | %9lld | %-7s | %2d | %8.3f | %8.4f | %8.4f | %9.2f | %6.2f | "
-                      "%5.1f %% |\n",
+                      "%6.2f | %5.1f %% |\n",
             vtkFFDBuildLattice::GetBasisAsString(c.Basis), c.Divisions,
             static_cast<long long>(lattice.Grid->GetNumberOfPoints()),
             static_cast<long long>(input->GetNumberOfPoints()), useDouble ? "float64" : "float32",
             vtkSMPTools::GetEstimatedNumberOfThreads(), bindSeconds, timing.Best, timing.Median,
-            pointsPerSecond * 1e-6, bytesPerSecond * 1e-9, 100.0 * bytesPerSecond / bandwidth[t]);
+            pointsPerSecond * 1e-6, bytesPerSecond * 1e-9, bandwidth * 1e-9, 100.0 * bytesPerSecond / bandwidth);
           std::fflush(stdout);
           if (compare && ok)
           {
