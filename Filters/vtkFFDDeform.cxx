@@ -273,7 +273,7 @@ struct LanesFunctor
     if (this->GatheredPass)
     {
       std::vector<Real>& staging = this->Staging.Local();
-      staging.resize(ffd::GatherStaging);
+      staging.resize(3 * std::size_t(ffd::GatherTile));
       ffd::DeformGathered(level, this->Deformation, this->Listed, this->Binding.Gathered, this->OutPoints, begin,
         end, staging.data());
     }

@@ -279,10 +279,6 @@ inline BlockCells ListBlockCells(const int* cells, std::int64_t n, int maxCells)
  */
 constexpr int GatherTile = 32768;
 
-/// Reals in a staging buffer of DeformGathered(): a tile's results, and one more that the write-out reads past
-/// the last (detail::WriteTile()).
-constexpr std::size_t GatherStaging = 3 * std::size_t(GatherTile) + 1;
-
 /// The blocks of n points bound to `cells` that are not deformed in place (BlockInPlace() with maxCells), in
 /// order.
 inline std::vector<std::int64_t> GatheredBlocks(const int* cells, std::int64_t n, int maxCells)
@@ -465,12 +461,7 @@ inline void DeformOnePoint(
   to[2] = y.z;
 }
 
-/**
- * Tile t's results, staged in its run's order (DeformGathered()), written out in point order. Within a whole
- * block each point but the last is copied as 4 Reals, one move instead of two (float32: the gathered pass 1.2 to
- * 1.8 times faster on the 0.4 M-point armadillo, float64 the same): the fourth lands on the next point's x, which
- * the next copy then writes; `staged` holds one Real past the tile (GatherStaging) for its last point's.
- */
+/// Tile t's results, staged in its run's order (DeformGathered()), written out in point order.
 template <typename Real>
 inline void WriteTile(const GatheredPoints& gathered, std::int64_t t, const Real* staged, Real* out)
 {
@@ -479,12 +470,7 @@ inline void WriteTile(const GatheredPoints& gathered, std::int64_t t, const Real
     const std::int64_t first = gathered.Sources[std::size_t(k)] * BlockSize;
     const std::uint16_t* ranks = gathered.Ranks.data() + k * BlockSize;
     const int count = int(std::min<std::int64_t>(BlockSize, gathered.Points - first));
-    const int wide = count == BlockSize ? BlockSize - 1 : 0;
-    for (int l = 0; l < wide; ++l)
-    {
-      std::memcpy(out + 3 * (first + l), staged + 3 * std::int64_t(ranks[l]), 4 * sizeof(Real));
-    }
-    for (int l = wide; l < count; ++l)
+    for (int l = 0; l < count; ++l)
     {
       std::memcpy(out + 3 * (first + l), staged + 3 * std::int64_t(ranks[l]), 3 * sizeof(Real));
     }
@@ -947,7 +933,7 @@ inline void DeformWithJacobian(SimdLevel level, const Deformation& deformation, 
 /**
  * Second pass: the listed points of tiles [tileBegin, tileEnd) of `gathered` (of GatheredPoints::TileCount()),
  * whose coordinates `listed` holds in listed order (CopyGatheredPoints()), each written to its place in out.
- * `staging` holds GatherStaging Reals, the caller's so that a thread allocates it once.
+ * `staging` holds 3 GatherTile Reals, the caller's so that a thread allocates it once.
  */
 template <typename Deformation, typename Real>
 inline void DeformGathered(SimdLevel level, const Deformation& deformation, const Real* listed,
