@@ -218,8 +218,9 @@ inline void FillCellTable(GridBasis basis, const Real* displacements, const int 
 /**
  * D of FillCellTable() (a basis of degree Degree) at local coordinates r[g] of the cell whose entry is `entry`, for
  * G lane groups g at once, by Horner's rule, into d[g], and, where dDdr is not null, its derivatives into dDdr[g]:
- * column a is dD/dr[a]. Each coefficient is read (broadcast to the lanes) once for all G groups: with AVX-512 in
- * float64 the broadcasts took about a third of a trilinear cell's evaluation (BENCHMARKS.md, 2026-11-23, late).
+ * column a is dD/dr[a]. Each coefficient is read (broadcast to the lanes) once for all G groups: in a hand-written
+ * AVX-512 loop of a trilinear cell in float64 the broadcasts took about a third of the time (BENCHMARKS.md,
+ * 2026-11-23, late).
  */
 template <int Degree, int G, typename Lane, typename Real>
 FFD_INLINE void PowerForm(const Real* entry, const Lane (*r)[3], Vec3<Lane>* d, Mat3<Lane>* dDdr)
