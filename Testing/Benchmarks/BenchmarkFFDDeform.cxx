@@ -8,9 +8,9 @@
  * - global: the Bernstein evaluation with 5^3 and 10^3 control points, against the FMA peak (compute-bound);
  * - bases: every basis (the global one over 4^3 voxels, the local ones over 4^3 voxels and over lattices of
  *   about 10^3 control points), against the copy bandwidth (std::memcpy): the bytes the evaluation must move
- *   per point (read the point and its 4-byte cell, write the point) per second, the copy measured between the
- *   row's evaluations; and CUBIC_BSPLINE against VTK's vtkBSplineTransform + vtkTransformFilter on the same
- *   mesh and lattice (with the largest difference between the two outputs, which must be rounding).
+ *   per point (read the point and its 4-byte cell, write the point) per second, the copy measured beside each
+ *   row; and CUBIC_BSPLINE against VTK's vtkBSplineTransform + vtkTransformFilter on the same mesh and lattice
+ *   (with the largest difference between the two outputs, which must be rounding).
  *
  * What is timed: vtkFFDDeform::Update() after the lattice's points moved, the binding being cached (the
  * program checks that it was not recomputed). That is the evaluation as a user sees it: reading the lattice,
@@ -50,7 +50,6 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <functional>
 #include <random>
 #include <string>
 #include <thread>
@@ -329,19 +328,14 @@ Timing Repeat(Step&& step, int minRepeats, double minSeconds)
   return { times.front(), times[times.size() / 2] };
 }
 
-/// Times vtkFFDDeform::Update() after moving the lattice's points (the binding cached), on `threads` threads;
-/// `between`, where given, runs before each Update(), untimed.
+/// Times vtkFFDDeform::Update() after moving the lattice's points (the binding cached), on `threads` threads.
 Timing TimeEvaluation(vtkFFDDeform* deform, BenchmarkLattice& lattice, std::mt19937& rng, int threads,
-  int minRepeats, double minSeconds, const std::function<void()>& between = nullptr)
+  int minRepeats, double minSeconds)
 {
   vtkSMPTools::Initialize(threads);
   const vtkIdType bindings = deform->GetNumberOfBindings();
   const Timing timing = Repeat(
     [&]() {
-      if (between)
-      {
-        between();
-      }
       MoveLattice(lattice.Grid, lattice.Rest, rng);
       const Clock::time_point begin = Clock::now();
       deform->Update();
@@ -444,42 +438,35 @@ bool RunGlobalSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, c
 // vtkBSplineTransform.
 
 /**
- * Two buffers of the same size for the copy bandwidth, both written once so that page faults are not timed.
- * Once(): bytes read plus bytes written per second when `threads` threads each std::memcpy their share of the
- * source into the target at once.
+ * Copy bandwidth: bytes read plus bytes written per second when `threads` threads each std::memcpy their
+ * share of a `bytes` buffer into another at once, best of 5. Both buffers are written before timing, so that
+ * page faults are not timed.
  */
-struct CopyBuffers
+double MeasureCopyBandwidth(size_t bytes, int threads)
 {
-  std::vector<char> Source, Target;
-
-  explicit CopyBuffers(size_t bytes)
-    : Source(bytes, 1)
-    , Target(bytes, 0)
+  std::vector<char> source(bytes, 1), target(bytes, 0);
+  double best = 0.0;
+  for (int trial = 0; trial < 5; ++trial)
   {
-  }
-
-  double Once(int threads)
-  {
-    const size_t bytes = this->Source.size();
     std::vector<std::thread> pool;
     const Clock::time_point begin = Clock::now();
     for (int t = 0; t < threads; ++t)
     {
-      pool.emplace_back([this, bytes, threads, t]() {
+      pool.emplace_back([&, t]() {
         const size_t first = bytes * t / threads, last = bytes * (t + 1) / threads;
-        std::memcpy(this->Target.data() + first, this->Source.data() + first, last - first);
+        std::memcpy(target.data() + first, source.data() + first, last - first);
       });
     }
     for (std::thread& th : pool)
     {
       th.join();
     }
-    const double bandwidth = 2.0 * double(bytes) / Seconds(begin);
-    static volatile char sink = 0;
-    sink = sink + this->Target[bytes / 2]; // the copies are used, so none is optimised away
-    return bandwidth;
+    best = std::max(best, 2.0 * double(bytes) / Seconds(begin));
   }
-};
+  static volatile char sink = 0;
+  sink = sink + target[bytes / 2]; // the copies are used, so none is optimised away
+  return best;
+}
 
 /// Bytes a local evaluation must move per point: read the input point and its 4-byte cell, write the output.
 int BytesPerPoint(bool useDouble)
@@ -596,16 +583,17 @@ struct VtkRow
 /**
  * For each mesh, precision, basis case and thread count: vtkFFDDeform::Update() timed as in the global
  * section, its points per second turned into bytes per second (BytesPerPoint) and compared with the copy
- * bandwidth of the same thread count, measured by a copy before each timed Update() so that both bests come from
- * the same seconds (the load of a shared machine drifts within a run: a copy measured once at the start swung
- * from 39 to 64 GB/s between runs minutes apart, and rows late in a run met another load). For CUBIC_BSPLINE over `vtkDivisions`, VTK's vtkBSplineTransform +
+ * bandwidth of the same thread count measured just before it (the load of a shared machine drifts within a run:
+ * a copy measured once at the start swung from 39 to 64 GB/s between runs minutes apart). Not between the row's
+ * evaluations: a copy there evicts what a 0.4 M-point mesh keeps in the caches from one evaluation to the next, as
+ * a user's repeated updates do (its rows measured 10 to 20 % slower that way). For CUBIC_BSPLINE over `vtkDivisions`, VTK's vtkBSplineTransform +
  * vtkTransformFilter on the same mesh and lattice, timed the same way. Returns false when a pipeline failed.
  */
 bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, const std::vector<int>& threadCounts,
   bool quick)
 {
   // 256 MB per buffer: far beyond the caches (32 MB of L3 on this class of CPU), as the 5 M-point meshes are.
-  CopyBuffers copy(size_t(quick ? 32 : 256) << 20);
+  const size_t copyBytes = size_t(quick ? 32 : 256) << 20;
 
   // Every basis over 4 x 4 x 4 voxels (the global one's cost grows with its degree, so it stays at 4), and the
   // local ones again over lattices of about 10^3 control points: their cost per point should not change.
@@ -618,11 +606,10 @@ bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, co
   std::printf("\nEvaluation per basis (vtkFFDDeform::Update() after moving the lattice, binding cached).\n"
               "bytes/point: what the evaluation must move: read the point and its 4-byte cell, write the point "
               "(%d float32, %d float64);\nGB/s: Mpoints/s * bytes/point; copy: std::memcpy of a %zu MB buffer "
-              "into another split over the row's threads, bytes read + written per second, the best of\nthe copies "
-              "made before each of the row's timed Update()s (each copy followed by an untimed Update()), so that "
-              "both bests come from the same seconds;\n%% copy: GB/s of copy.\n"
+              "into another on the same threads, split between them, bytes read + written per second, best of 5,\n"
+              "measured just before the row (the machine's load drifts within a run); %% copy: GB/s of copy.\n"
               "bind+1st: the first Update(), binding included, on all threads; best, median: evaluation only.\n\n",
-    BytesPerPoint(false), BytesPerPoint(true), copy.Source.size() >> 20);
+    BytesPerPoint(false), BytesPerPoint(true), copyBytes >> 20);
   std::printf("| basis               | div | ctrl | points    | type    | th | bind+1st | best (s) | median   | "
               "Mpoints/s | GB/s   | copy   | %% copy  |\n");
   std::printf("|---------------------|----:|-----:|----------:|---------|---:|---------:|---------:|---------:|"
@@ -657,14 +644,8 @@ bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, co
         }
         for (size_t t = 0; t < threadCounts.size(); ++t)
         {
-          // A copy, then an untimed evaluation that brings back into the caches what the copy evicted (a
-          // 0.4 M-point mesh stays in the last-level cache between evaluations), before each timed one.
-          double bandwidth = 0.0;
-          const Timing timing = TimeEvaluation(deform, lattice, rng, threadCounts[t], minRepeats, minSeconds, [&]() {
-            bandwidth = std::max(bandwidth, copy.Once(threadCounts[t]));
-            MoveLattice(lattice.Grid, lattice.Rest, rng);
-            deform->Update();
-          });
+          const double bandwidth = MeasureCopyBandwidth(copyBytes, threadCounts[t]);
+          const Timing timing = TimeEvaluation(deform, lattice, rng, threadCounts[t], minRepeats, minSeconds);
           const double pointsPerSecond = input->GetNumberOfPoints() / timing.Best;
           const double bytesPerSecond = pointsPerSecond * BytesPerPoint(useDouble);
           std::printf("| %-19s | %3d | %4lld | %9lld | %-7s | %2d | %8.3f | %8.4f | %8.4f | %9.2f | %6.2f | "
