@@ -438,35 +438,46 @@ bool RunGlobalSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, c
 // vtkBSplineTransform.
 
 /**
- * Copy bandwidth: bytes read plus bytes written per second when `threads` threads each std::memcpy their
- * share of a `bytes` buffer into another at once, best of 5. Both buffers are written before timing, so that
- * page faults are not timed.
+ * Two buffers of the same size for the copy bandwidth, both written once so that page faults are not timed.
+ * Measure(): bytes read plus bytes written per second when `threads` threads each std::memcpy their share of
+ * the source into the target at once, best of 5.
  */
-double MeasureCopyBandwidth(size_t bytes, int threads)
+struct CopyBuffers
 {
-  std::vector<char> source(bytes, 1), target(bytes, 0);
-  double best = 0.0;
-  for (int trial = 0; trial < 5; ++trial)
+  std::vector<char> Source, Target;
+
+  explicit CopyBuffers(size_t bytes)
+    : Source(bytes, 1)
+    , Target(bytes, 0)
   {
-    std::vector<std::thread> pool;
-    const Clock::time_point begin = Clock::now();
-    for (int t = 0; t < threads; ++t)
-    {
-      pool.emplace_back([&, t]() {
-        const size_t first = bytes * t / threads, last = bytes * (t + 1) / threads;
-        std::memcpy(target.data() + first, source.data() + first, last - first);
-      });
-    }
-    for (std::thread& th : pool)
-    {
-      th.join();
-    }
-    best = std::max(best, 2.0 * double(bytes) / Seconds(begin));
   }
-  static volatile char sink = 0;
-  sink = sink + target[bytes / 2]; // the copies are used, so none is optimised away
-  return best;
-}
+
+  double Measure(int threads)
+  {
+    const size_t bytes = this->Source.size();
+    double best = 0.0;
+    for (int trial = 0; trial < 5; ++trial)
+    {
+      std::vector<std::thread> pool;
+      const Clock::time_point begin = Clock::now();
+      for (int t = 0; t < threads; ++t)
+      {
+        pool.emplace_back([this, bytes, threads, t]() {
+          const size_t first = bytes * t / threads, last = bytes * (t + 1) / threads;
+          std::memcpy(this->Target.data() + first, this->Source.data() + first, last - first);
+        });
+      }
+      for (std::thread& th : pool)
+      {
+        th.join();
+      }
+      best = std::max(best, 2.0 * double(bytes) / Seconds(begin));
+    }
+    static volatile char sink = 0;
+    sink = sink + this->Target[bytes / 2]; // the copies are used, so none is optimised away
+    return best;
+  }
+};
 
 /// Bytes a local evaluation must move per point: read the input point and its 4-byte cell, write the output.
 int BytesPerPoint(bool useDouble)
@@ -593,7 +604,7 @@ bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, co
   bool quick)
 {
   // 256 MB per buffer: far beyond the caches (32 MB of L3 on this class of CPU), as the 5 M-point meshes are.
-  const size_t copyBytes = size_t(quick ? 32 : 256) << 20;
+  CopyBuffers copy(size_t(quick ? 32 : 256) << 20);
 
   // Every basis over 4 x 4 x 4 voxels (the global one's cost grows with its degree, so it stays at 4), and the
   // local ones again over lattices of about 10^3 control points: their cost per point should not change.
@@ -609,7 +620,7 @@ bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, co
               "into another on the same threads, split between them, bytes read + written per second, best of 5,\n"
               "measured just before the row (the machine's load drifts within a run); %% copy: GB/s of copy.\n"
               "bind+1st: the first Update(), binding included, on all threads; best, median: evaluation only.\n\n",
-    BytesPerPoint(false), BytesPerPoint(true), copyBytes >> 20);
+    BytesPerPoint(false), BytesPerPoint(true), copy.Source.size() >> 20);
   std::printf("| basis               | div | ctrl | points    | type    | th | bind+1st | best (s) | median   | "
               "Mpoints/s | GB/s   | copy   | %% copy  |\n");
   std::printf("|---------------------|----:|-----:|----------:|---------|---:|---------:|---------:|---------:|"
@@ -644,7 +655,7 @@ bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, co
         }
         for (size_t t = 0; t < threadCounts.size(); ++t)
         {
-          const double bandwidth = MeasureCopyBandwidth(copyBytes, threadCounts[t]);
+          const double bandwidth = copy.Measure(threadCounts[t]);
           const Timing timing = TimeEvaluation(deform, lattice, rng, threadCounts[t], minRepeats, minSeconds);
           const double pointsPerSecond = input->GetNumberOfPoints() / timing.Best;
           const double bytesPerSecond = pointsPerSecond * BytesPerPoint(useDouble);
