@@ -138,7 +138,7 @@ inline bool StreamOutput(std::int64_t bytes)
 }
 
 /**
- * The most cells a block's points may lie in for the block to be deformed in place (BlockInPlace(), GatherByCell()),
+ * The most cells a block's points may lie in for the block to be deformed in place (BlockInPlace(), GatheredBlocks()),
  * chosen for a binding from its mean number of cells per block. In place reads and writes memory in order, but a lane
  * group in several cells evaluates each of its cells in all its lanes; the gathered pass reads a copy of its points in
  * order, sorted by cell within tiles (GatherTile), evaluates whole lane groups of one cell into a tile's staging
@@ -294,11 +294,14 @@ inline std::vector<std::int64_t> GatheredBlocks(const int* cells, std::int64_t n
   return gathered;
 }
 
-namespace detail
-{
-/// GatherByCell() of the points of the blocks `sources` (GatheredBlocks()).
-inline std::vector<int> SortByCell(
-  const int* cells, std::int64_t n, int cellCount, const std::vector<std::int64_t>& sources, int tile)
+/**
+ * The points of the blocks `sources` (GatheredBlocks(): those not deformed in place), tile by tile (of `tile`
+ * points, GatherTile but in tests), each tile's sorted by cell: cell -1 first, then by cell, each cell's points
+ * in input order (two stable counting sorts: by cell, then by tile). For DeformGathered(); `cellCount` is the
+ * number of cells of the binding.
+ */
+inline std::vector<int> GatherByCell(const int* cells, std::int64_t n, int cellCount,
+  const std::vector<std::int64_t>& sources, int tile = GatherTile)
 {
   std::vector<std::int64_t> offsets(std::size_t(cellCount) + 2, 0);
   for (std::int64_t b : sources)
@@ -335,19 +338,6 @@ inline std::vector<int> SortByCell(
     gathered[std::size_t(tiles[std::size_t(i / tile)]++)] = i;
   }
   return gathered;
-}
-} // namespace detail
-
-/**
- * The points of the blocks not deformed in place (GatheredBlocks() with maxCells), tile by tile (of `tile`
- * points, GatherTile but in tests), each tile's sorted by cell: cell -1 first, then by cell, each cell's points
- * in input order (two stable counting sorts: by cell, then by tile). For DeformGathered(); `cellCount` is the
- * number of cells of the binding.
- */
-inline std::vector<int> GatherByCell(
-  const int* cells, std::int64_t n, int cellCount, int maxCells, int tile = GatherTile)
-{
-  return detail::SortByCell(cells, n, cellCount, GatheredBlocks(cells, n, maxCells), tile);
 }
 
 /**
@@ -386,7 +376,7 @@ inline GatheredPoints ListGatheredPoints(
   GatheredPoints gathered;
   gathered.Points = n;
   gathered.Sources = GatheredBlocks(cells, n, maxCells);
-  const std::vector<int> byCell = detail::SortByCell(cells, n, cellCount, gathered.Sources, tile);
+  const std::vector<int> byCell = GatherByCell(cells, n, cellCount, gathered.Sources, tile);
   const std::int64_t tiles = (n + tile - 1) / tile;
   const std::int64_t blocks = (n + BlockSize - 1) / BlockSize;
   gathered.TileSources.assign(std::size_t(tiles) + 1, 0);
@@ -862,7 +852,7 @@ FFD_LANE_VARIANTS(SSE2, FFD_TARGET_SSE2, 16)
 
 /**
  * First pass: out = the deformation of in for the points of blocks [blockBegin, blockEnd) that are deformed in
- * place (BlockCells::InPlace(); `blocks` from ListBlockCells() with the maxCells given to GatherByCell()); the
+ * place (BlockCells::InPlace(); `blocks` from ListBlockCells() with the maxCells given to GatheredBlocks()); the
  * others, and the last block where it is partial, are left to DeformGathered(). 3 values per point (x y z),
  * cells[i] from BindToGrid() (-1: the point keeps its position). `level` at most SimdLevelOfCpu(). With
  * `stream` (StreamOutput()), and out aligned to 64 bytes, the lanes write by non-temporal stores.

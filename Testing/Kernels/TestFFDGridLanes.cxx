@@ -455,14 +455,15 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
       }
     }
   }
-  EXPECT_EQ(ffd::GatherByCell(cells.data(), n, cellCount, maxCells), expected);
+  EXPECT_EQ(ffd::GatherByCell(cells.data(), n, cellCount, ffd::GatheredBlocks(cells.data(), n, maxCells)), expected);
   EXPECT_TRUE(ffd::BlockInPlace(cells.data(), n, 0, maxCells));
   EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 1, maxCells));
   EXPECT_TRUE(ffd::BlockInPlace(cells.data(), n, 2, maxCells));
   EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 3, maxCells));
   EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 1, 9));
   EXPECT_TRUE(ffd::BlockInPlace(cells.data(), n, 1, 10));
-  EXPECT_EQ(ffd::GatherByCell(cells.data(), n, cellCount, ffd::BlockSize), expectedTail);
+  EXPECT_EQ(ffd::GatherByCell(cells.data(), n, cellCount, ffd::GatheredBlocks(cells.data(), n, ffd::BlockSize)),
+    expectedTail);
 
   // What the gathered pass reads: that list, its last point repeated up to whole blocks, and their cells.
   const ffd::GatheredPoints gathered = ffd::ListGatheredPoints(cells.data(), n, cellCount, maxCells);
