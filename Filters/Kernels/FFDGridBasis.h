@@ -48,7 +48,7 @@ FFD_INLINE bool IsGridBasis(int basis)
 }
 
 /// Polynomial degree of a Bezier basis in each voxel (1, 2, 3), 0 for the others.
-FFD_INLINE int BezierDegree(GridBasis basis)
+FFD_INLINE constexpr int BezierDegree(GridBasis basis)
 {
   return basis == GridBasis::Trilinear ? 1
     : basis == GridBasis::TriquadraticBezier ? 2
