@@ -197,12 +197,12 @@ struct GridBinding
     return listed.data();
   }
 
-  /// The calling thread's staging buffer of Real values (ffd::DeformGathered), 3 GatherTile of them.
+  /// The calling thread's staging buffer of ffd::GatherStaging Real values (ffd::DeformGathered).
   template <typename Real>
   Real* Staging()
   {
     std::vector<Real>& staging = this->StagingOf(Real()).Local();
-    staging.resize(3 * std::size_t(ffd::GatherTile));
+    staging.resize(ffd::GatherStaging);
     return staging.data();
   }
 
