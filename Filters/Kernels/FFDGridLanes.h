@@ -824,13 +824,16 @@ inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, 
   }
 }
 
-/// Blocks [blockBegin, blockEnd) of the gathered list deformed into staged, from its block blockBegin on.
+/// Tile t of the gathered list deformed into staged, then written out (WriteTile(), compiled for the same
+/// instruction set: float64 points copied as 4 Reals take one 32-byte move with AVX).
 template <int W, typename Deformation, typename Real>
 inline void GatheredInLanes(const Deformation& deformation, const Real* listed, const GatheredPoints& gathered,
-  Real* staged, std::int64_t blockBegin, std::int64_t blockEnd)
+  std::int64_t t, Real* staged, Real* out)
 {
-  BlocksInPlaceInLanes<W, false>(deformation, listed, gathered.Cells.data(), staged, gathered.Blocks, blockBegin,
-    blockEnd, blockBegin * BlockSize);
+  const std::int64_t first = gathered.TileBlocks[std::size_t(t)], last = gathered.TileBlocks[std::size_t(t) + 1];
+  BlocksInPlaceInLanes<W, false>(
+    deformation, listed, gathered.Cells.data(), staged, gathered.Blocks, first, last, first * BlockSize);
+  WriteTile(gathered, t, staged, out);
 }
 
 // The wide variants of both passes, one function per instruction set (see the file's documentation).
@@ -860,9 +863,9 @@ inline void GatheredInLanes(const Deformation& deformation, const Real* listed, 
   }                                                                                                           \
   template <typename Deformation, typename Real>                                                              \
   Target void Gathered##Suffix(const Deformation& deformation, const Real* listed, const GatheredPoints& gathered, \
-    Real* staged, std::int64_t blockBegin, std::int64_t blockEnd)                                             \
+    std::int64_t t, Real* staged, Real* out)                                                                  \
   {                                                                                                           \
-    GatheredInLanes<Bytes / sizeof(Real)>(deformation, listed, gathered, staged, blockBegin, blockEnd);      \
+    GatheredInLanes<Bytes / sizeof(Real)>(deformation, listed, gathered, t, staged, out);                     \
   }
 FFD_LANE_VARIANTS(AVX512, FFD_TARGET_AVX512, 64)
 FFD_LANE_VARIANTS(AVX2, FFD_TARGET_AVX2, 32)
@@ -961,20 +964,21 @@ inline void DeformGathered(SimdLevel level, const Deformation& deformation, cons
     {
 #if FFD_HAVE_LANES
       case SimdLevel::AVX512:
-        detail::GatheredAVX512(deformation, listed, gathered, staging, first, last);
-        break;
+        detail::GatheredAVX512(deformation, listed, gathered, t, staging, out);
+        continue;
       case SimdLevel::AVX2:
-        detail::GatheredAVX2(deformation, listed, gathered, staging, first, last);
-        break;
+        detail::GatheredAVX2(deformation, listed, gathered, t, staging, out);
+        continue;
       case SimdLevel::SSE2:
-        detail::GatheredSSE2(deformation, listed, gathered, staging, first, last);
-        break;
+        detail::GatheredSSE2(deformation, listed, gathered, t, staging, out);
+        continue;
 #endif
       default:
-        for (std::int64_t g = first * BlockSize; g < last * BlockSize; ++g)
-        {
-          detail::DeformOnePoint(deformation, listed, gathered.Cells.data(), staging, g, first * BlockSize);
-        }
+        break;
+    }
+    for (std::int64_t g = first * BlockSize; g < last * BlockSize; ++g)
+    {
+      detail::DeformOnePoint(deformation, listed, gathered.Cells.data(), staging, g, first * BlockSize);
     }
     detail::WriteTile(gathered, t, staging, out);
   }
