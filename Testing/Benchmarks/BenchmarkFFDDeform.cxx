@@ -313,40 +313,62 @@ double BindOnce(vtkFFDDeform* deform, vtkPolyData* mesh, BenchmarkLattice& latti
   return seconds;
 }
 
-/// Runs `step` (which returns the seconds of its timed part) at least `minRepeats` times and until
-/// `minSeconds` have been spent; best and median of the timed parts.
-template <typename Step>
-Timing Repeat(Step&& step, int minRepeats, double minSeconds)
+/// Best and median of `times` (not empty).
+Timing BestAndMedian(std::vector<double> times)
 {
-  std::vector<double> times;
-  const Clock::time_point begin = Clock::now();
-  while (int(times.size()) < minRepeats || Seconds(begin) < minSeconds)
-  {
-    times.push_back(step());
-  }
   std::sort(times.begin(), times.end());
   return { times.front(), times[times.size() / 2] };
 }
 
-/// Times vtkFFDDeform::Update() after moving the lattice's points (the binding cached), on `threads` threads.
-Timing TimeEvaluation(vtkFFDDeform* deform, BenchmarkLattice& lattice, std::mt19937& rng, int threads,
-  int minRepeats, double minSeconds)
+/// Runs `step` (which returns the seconds of its timed part) at least `minRepeats` times and until
+/// `minSeconds` have been spent; appends the timed parts to `times`.
+template <typename Step>
+void RepeatInto(Step&& step, int minRepeats, double minSeconds, std::vector<double>& times)
 {
-  vtkSMPTools::Initialize(threads);
+  const Clock::time_point begin = Clock::now();
+  for (int repeats = 0; repeats < minRepeats || Seconds(begin) < minSeconds; ++repeats)
+  {
+    times.push_back(step());
+  }
+}
+
+/// RepeatInto(); best and median of the timed parts.
+template <typename Step>
+Timing Repeat(Step&& step, int minRepeats, double minSeconds)
+{
+  std::vector<double> times;
+  RepeatInto(step, minRepeats, minSeconds, times);
+  return BestAndMedian(times);
+}
+
+/// Times vtkFFDDeform::Update() after moving the lattice's points (the binding cached), on the threads
+/// vtkSMPTools was initialized to; appends the times to `times`.
+void TimeUpdates(vtkFFDDeform* deform, BenchmarkLattice& lattice, std::mt19937& rng, int minRepeats,
+  double minSeconds, std::vector<double>& times)
+{
   const vtkIdType bindings = deform->GetNumberOfBindings();
-  const Timing timing = Repeat(
+  RepeatInto(
     [&]() {
       MoveLattice(lattice.Grid, lattice.Rest, rng);
       const Clock::time_point begin = Clock::now();
       deform->Update();
       return Seconds(begin);
     },
-    minRepeats, minSeconds);
+    minRepeats, minSeconds, times);
   if (deform->GetNumberOfBindings() != bindings)
   {
     std::fprintf(stderr, "warning: the binding was recomputed; these timings include it\n");
   }
-  return timing;
+}
+
+/// TimeUpdates() on `threads` threads; best and median.
+Timing TimeEvaluation(vtkFFDDeform* deform, BenchmarkLattice& lattice, std::mt19937& rng, int threads,
+  int minRepeats, double minSeconds)
+{
+  vtkSMPTools::Initialize(threads);
+  std::vector<double> times;
+  TimeUpdates(deform, lattice, rng, minRepeats, minSeconds, times);
+  return BestAndMedian(times);
 }
 
 /**
@@ -440,7 +462,7 @@ bool RunGlobalSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, c
 /**
  * Two buffers of the same size for the copy bandwidth, both written once so that page faults are not timed.
  * Measure(): bytes read plus bytes written per second when `threads` threads each std::memcpy their share of
- * the source into the target at once, best of 5.
+ * the source into the target at once, best of `trials`.
  */
 struct CopyBuffers
 {
@@ -452,11 +474,11 @@ struct CopyBuffers
   {
   }
 
-  double Measure(int threads)
+  double Measure(int threads, int trials)
   {
     const size_t bytes = this->Source.size();
     double best = 0.0;
-    for (int trial = 0; trial < 5; ++trial)
+    for (int trial = 0; trial < trials; ++trial)
     {
       std::vector<std::thread> pool;
       const Clock::time_point begin = Clock::now();
@@ -478,6 +500,38 @@ struct CopyBuffers
     return best;
   }
 };
+
+/// The copy bandwidth and the evaluation of a row, measured side by side (MeasureSideBySide()).
+struct SideBySide
+{
+  double Bandwidth = 0.0; // best over the rounds
+  Timing Evaluation;      // best and median over every timed update of every round
+};
+
+/**
+ * The copy bandwidth and vtkFFDDeform::Update() on `threads` threads, measured in `rounds` rounds spread over
+ * the row's time, so that the best of each comes from the same seconds of a shared machine: each round copies
+ * (CopyBuffers::Measure(), best of 2), runs one untimed update (the copy evicted what a 0.4 M-point mesh keeps
+ * in the caches between a user's updates), then times updates for minSeconds / rounds. Measured once just
+ * before the row instead, the copy met another load than the evaluation: in one run the 6.7 M-point float32 row
+ * took 1.7x its time of the runs before and after, the copy beside it unchanged.
+ */
+SideBySide MeasureSideBySide(CopyBuffers& copy, vtkFFDDeform* deform, BenchmarkLattice& lattice, std::mt19937& rng,
+  int threads, int rounds, int minRepeats, double minSeconds)
+{
+  SideBySide measured;
+  std::vector<double> times;
+  for (int round = 0; round < rounds; ++round)
+  {
+    measured.Bandwidth = std::max(measured.Bandwidth, copy.Measure(threads, 2));
+    vtkSMPTools::Initialize(threads);
+    MoveLattice(lattice.Grid, lattice.Rest, rng);
+    deform->Update();
+    TimeUpdates(deform, lattice, rng, (minRepeats + rounds - 1) / rounds, minSeconds / rounds, times);
+  }
+  measured.Evaluation = BestAndMedian(times);
+  return measured;
+}
 
 /// Bytes a local evaluation must move per point: read the input point and its 4-byte cell, write the output.
 int BytesPerPoint(bool useDouble)
@@ -594,11 +648,10 @@ struct VtkRow
 /**
  * For each mesh, precision, basis case and thread count: vtkFFDDeform::Update() timed as in the global
  * section, its points per second turned into bytes per second (BytesPerPoint) and compared with the copy
- * bandwidth of the same thread count measured just before it (the load of a shared machine drifts within a run:
- * a copy measured once at the start swung from 39 to 64 GB/s between runs minutes apart). Not between the row's
- * evaluations: a copy there evicts what a 0.4 M-point mesh keeps in the caches from one evaluation to the next, as
- * a user's repeated updates do (its rows measured 10 to 20 % slower that way). For CUBIC_BSPLINE over `vtkDivisions`, VTK's vtkBSplineTransform +
- * vtkTransformFilter on the same mesh and lattice, timed the same way. Returns false when a pipeline failed.
+ * bandwidth of the same thread count, the two measured side by side (MeasureSideBySide(): the load of a shared
+ * machine drifts within a run, and a copy measured once at the start swung from 39 to 64 GB/s between runs
+ * minutes apart). For CUBIC_BSPLINE over `vtkDivisions`, VTK's vtkBSplineTransform + vtkTransformFilter on the
+ * same mesh and lattice, timed as in the global section. Returns false when a pipeline failed.
  */
 bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, const std::vector<int>& threadCounts,
   bool quick)
@@ -614,19 +667,21 @@ bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, co
     { vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, 4 }, { vtkFFDBuildLattice::TRICUBIC_BEZIER, 4 },
     { vtkFFDBuildLattice::TRICUBIC_BEZIER, 3 }, { vtkFFDBuildLattice::CUBIC_BSPLINE, 4 },
     { vtkFFDBuildLattice::CUBIC_BSPLINE, vtkDivisions } };
+  const int minRepeats = quick ? 2 : 3;
+  const double minSeconds = quick ? 0.0 : 0.5;
+  const int rounds = quick ? 1 : 5; // of MeasureSideBySide()
   std::printf("\nEvaluation per basis (vtkFFDDeform::Update() after moving the lattice, binding cached).\n"
               "bytes/point: what the evaluation must move: read the point and its 4-byte cell, write the point "
               "(%d float32, %d float64);\nGB/s: Mpoints/s * bytes/point; copy: std::memcpy of a %zu MB buffer "
-              "into another on the same threads, split between them, bytes read + written per second, best of 5,\n"
-              "measured just before the row (the machine's load drifts within a run); %% copy: GB/s of copy.\n"
+              "into another on the same threads, split between them, bytes read + written per second;\n"
+              "the copy and the evaluation measured side by side, in rounds over the row's time (%d; each: 2 "
+              "copies, one untimed update, updates for %.1f s), the best of each kept; %% copy: GB/s of copy.\n"
               "bind+1st: the first Update(), binding included, on all threads; best, median: evaluation only.\n\n",
-    BytesPerPoint(false), BytesPerPoint(true), copy.Source.size() >> 20);
+    BytesPerPoint(false), BytesPerPoint(true), copy.Source.size() >> 20, rounds, minSeconds / rounds);
   std::printf("| basis               | div | ctrl | points    | type    | th | bind+1st | best (s) | median   | "
               "Mpoints/s | GB/s   | copy   | %% copy  |\n");
   std::printf("|---------------------|----:|-----:|----------:|---------|---:|---------:|---------:|---------:|"
               "----------:|-------:|-------:|--------:|\n");
-  const int minRepeats = quick ? 2 : 3;
-  const double minSeconds = quick ? 0.0 : 0.5;
   std::vector<VtkRow> vtkRows;
   bool ok = true;
   for (const auto& mesh : meshes)
@@ -655,8 +710,10 @@ bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, co
         }
         for (size_t t = 0; t < threadCounts.size(); ++t)
         {
-          const double bandwidth = copy.Measure(threadCounts[t]);
-          const Timing timing = TimeEvaluation(deform, lattice, rng, threadCounts[t], minRepeats, minSeconds);
+          const SideBySide measured =
+            MeasureSideBySide(copy, deform, lattice, rng, threadCounts[t], rounds, minRepeats, minSeconds);
+          const double bandwidth = measured.Bandwidth;
+          const Timing& timing = measured.Evaluation;
           const double pointsPerSecond = input->GetNumberOfPoints() / timing.Best;
           const double bytesPerSecond = pointsPerSecond * BytesPerPoint(useDouble);
           std::printf("| %-19s | %3d | %4lld | %9lld | %-7s | %2d | %8.3f | %8.4f | %8.4f | %9.2f | %6.2f | "
