@@ -278,7 +278,7 @@ struct LanesFunctor
   GridBinding& Binding;
   const Real* Listed; // GridBinding::Listed()
   Deformer Deformation;
-  bool Stream;       // non-temporal stores in both passes (ffd::StreamOutput())
+  bool Stream;       // non-temporal stores in the in-place pass (ffd::StreamOutput())
   bool GatheredPass; // false: over the blocks of points, true: over the tiles of Binding.Gathered
 
   void operator()(vtkIdType begin, vtkIdType end)
@@ -287,7 +287,7 @@ struct LanesFunctor
     if (this->GatheredPass)
     {
       ffd::DeformGathered(level, this->Deformation, this->Listed, this->Binding.Gathered, this->OutPoints, begin,
-        end, this->Binding.template Staging<Real>(), this->Stream);
+        end, this->Binding.template Staging<Real>());
     }
     else
     {

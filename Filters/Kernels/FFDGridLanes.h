@@ -455,30 +455,15 @@ inline void DeformOnePoint(
   to[2] = y.z;
 }
 
-/// The results of the BlockSize points whose places in their tile's run are `ranks`, copied from `staged` to
-/// `to`, each but the last as 4 Reals (WriteTile()).
-template <typename Real>
-inline void CopyBlock(const std::uint16_t* ranks, const Real* staged, Real* to)
-{
-#pragma GCC unroll 16
-  for (int l = 0; l < BlockSize - 1; ++l)
-  {
-    std::memcpy(to + 3 * l, staged + 3 * std::int64_t(ranks[l]), 4 * sizeof(Real));
-  }
-  std::memcpy(to + 3 * (BlockSize - 1), staged + 3 * std::int64_t(ranks[BlockSize - 1]), 3 * sizeof(Real));
-}
-
 /**
- * Tile t's results, staged in its run's order (DeformGathered()), written out in point order: a whole block by
- * wholeBlock(ranks, to) (CopyBlock(), or through a buffer by non-temporal stores), a partial one point by point.
- * CopyBlock() copies each point but the last as 4 Reals, the fourth landing on the next point's x, which the next
- * copy then writes; `staged` holds one Real past the tile (GatherStaging) for the read of the last staged point's.
- * That and the copies unrolled over the block: one move a point instead of two and no loop per point, the float32
- * gathered pass 1.13-1.20x faster on the 0.4 M-point armadillo, float64 the same (BENCHMARKS.md, 2026-11-23, last).
+ * Tile t's results, staged in its run's order (DeformGathered()), written out in point order. In a whole block each
+ * point but the last is copied as 4 Reals, the fourth landing on the next point's x, which the next copy then
+ * writes; `staged` holds one Real past the tile (GatherStaging) for the read of the last staged point's. That and
+ * the copies unrolled over the block: one move a point instead of two and no loop per point, the float32 gathered
+ * pass 1.13-1.20x faster on the 0.4 M-point armadillo, float64 the same (BENCHMARKS.md, 2026-11-23, last).
  */
-template <typename Real, typename WholeBlock>
-inline void WriteTile(
-  const GatheredPoints& gathered, std::int64_t t, const Real* staged, Real* out, WholeBlock&& wholeBlock)
+template <typename Real>
+inline void WriteTile(const GatheredPoints& gathered, std::int64_t t, const Real* staged, Real* out)
 {
   for (std::int64_t k = gathered.TileSources[std::size_t(t)]; k < gathered.TileSources[std::size_t(t) + 1]; ++k)
   {
@@ -488,7 +473,12 @@ inline void WriteTile(
     Real* to = out + 3 * first;
     if (count == BlockSize)
     {
-      wholeBlock(ranks, to);
+#pragma GCC unroll 16
+      for (int l = 0; l < BlockSize - 1; ++l)
+      {
+        std::memcpy(to + 3 * l, staged + 3 * std::int64_t(ranks[l]), 4 * sizeof(Real));
+      }
+      std::memcpy(to + 3 * (BlockSize - 1), staged + 3 * std::int64_t(ranks[BlockSize - 1]), 3 * sizeof(Real));
       continue;
     }
     for (int l = 0; l < count; ++l)
@@ -834,36 +824,16 @@ inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, 
   }
 }
 
-/**
- * Tile t of the gathered list deformed into staged, then written out (WriteTile(), compiled for the same
- * instruction set: float64 points copied as 4 Reals take one 32-byte move with AVX). With `stream` (out aligned to
- * 64 bytes), each whole block, 3 BlockSize Reals that fill whole cache lines, is copied to a buffer in L1 and
- * written from there by non-temporal stores, so that its lines are not read from memory first.
- */
+/// Tile t of the gathered list deformed into staged, then written out (WriteTile(), compiled for the same
+/// instruction set: float64 points copied as 4 Reals take one 32-byte move with AVX).
 template <int W, typename Deformation, typename Real>
 inline void GatheredInLanes(const Deformation& deformation, const Real* listed, const GatheredPoints& gathered,
-  std::int64_t t, Real* staged, Real* out, bool stream)
+  std::int64_t t, Real* staged, Real* out)
 {
   const std::int64_t first = gathered.TileBlocks[std::size_t(t)], last = gathered.TileBlocks[std::size_t(t) + 1];
   BlocksInPlaceInLanes<W, false>(
     deformation, listed, gathered.Cells.data(), staged, gathered.Blocks, first, last, first * BlockSize);
-  if (!stream)
-  {
-    WriteTile(gathered, t, staged, out, [staged](const std::uint16_t* ranks, Real* to) { CopyBlock(ranks, staged, to); });
-    return;
-  }
-  WriteTile(gathered, t, staged, out, [staged](const std::uint16_t* ranks, Real* to) {
-    using Vector = typename Lanes<Real, W>::Vector;
-    alignas(64) Real block[3 * BlockSize + 1];
-    CopyBlock(ranks, staged, block);
-    for (int q = 0; q < 3 * BlockSize; q += W)
-    {
-      Vector v;
-      std::memcpy(&v, block + q, sizeof(v));
-      Stream(to + q, v);
-    }
-  });
-  _mm_sfence(); // the non-temporal stores are seen by other threads after this
+  WriteTile(gathered, t, staged, out);
 }
 
 // The wide variants of both passes, one function per instruction set (see the file's documentation).
@@ -893,9 +863,9 @@ inline void GatheredInLanes(const Deformation& deformation, const Real* listed, 
   }                                                                                                           \
   template <typename Deformation, typename Real>                                                              \
   Target void Gathered##Suffix(const Deformation& deformation, const Real* listed, const GatheredPoints& gathered, \
-    std::int64_t t, Real* staged, Real* out, bool stream)                                                     \
+    std::int64_t t, Real* staged, Real* out)                                                                  \
   {                                                                                                           \
-    GatheredInLanes<Bytes / sizeof(Real)>(deformation, listed, gathered, t, staged, out, stream);             \
+    GatheredInLanes<Bytes / sizeof(Real)>(deformation, listed, gathered, t, staged, out);                     \
   }
 FFD_LANE_VARIANTS(AVX512, FFD_TARGET_AVX512, 64)
 FFD_LANE_VARIANTS(AVX2, FFD_TARGET_AVX2, 32)
@@ -977,15 +947,12 @@ inline void DeformWithJacobian(SimdLevel level, const Deformation& deformation, 
 /**
  * Second pass: the listed points of tiles [tileBegin, tileEnd) of `gathered` (of GatheredPoints::TileCount()),
  * whose coordinates `listed` holds in listed order (CopyGatheredPoints()), each written to its place in out.
- * `staging` holds GatherStaging Reals, the caller's so that a thread allocates it once. With `stream`
- * (StreamOutput()), and out aligned to 64 bytes, the lanes write whole blocks by non-temporal stores.
+ * `staging` holds GatherStaging Reals, the caller's so that a thread allocates it once.
  */
 template <typename Deformation, typename Real>
 inline void DeformGathered(SimdLevel level, const Deformation& deformation, const Real* listed,
-  const GatheredPoints& gathered, Real* out, std::int64_t tileBegin, std::int64_t tileEnd, Real* staging,
-  bool stream = false)
+  const GatheredPoints& gathered, Real* out, std::int64_t tileBegin, std::int64_t tileEnd, Real* staging)
 {
-  stream = stream && reinterpret_cast<std::uintptr_t>(out) % 64 == 0;
   for (std::int64_t t = tileBegin; t < tileEnd; ++t)
   {
     const std::int64_t first = gathered.TileBlocks[std::size_t(t)], last = gathered.TileBlocks[std::size_t(t) + 1];
@@ -997,13 +964,13 @@ inline void DeformGathered(SimdLevel level, const Deformation& deformation, cons
     {
 #if FFD_HAVE_LANES
       case SimdLevel::AVX512:
-        detail::GatheredAVX512(deformation, listed, gathered, t, staging, out, stream);
+        detail::GatheredAVX512(deformation, listed, gathered, t, staging, out);
         continue;
       case SimdLevel::AVX2:
-        detail::GatheredAVX2(deformation, listed, gathered, t, staging, out, stream);
+        detail::GatheredAVX2(deformation, listed, gathered, t, staging, out);
         continue;
       case SimdLevel::SSE2:
-        detail::GatheredSSE2(deformation, listed, gathered, t, staging, out, stream);
+        detail::GatheredSSE2(deformation, listed, gathered, t, staging, out);
         continue;
 #endif
       default:
@@ -1013,8 +980,7 @@ inline void DeformGathered(SimdLevel level, const Deformation& deformation, cons
     {
       detail::DeformOnePoint(deformation, listed, gathered.Cells.data(), staging, g, first * BlockSize);
     }
-    detail::WriteTile(gathered, t, staging, out,
-      [staging](const std::uint16_t* ranks, Real* to) { detail::CopyBlock(ranks, staging, to); });
+    detail::WriteTile(gathered, t, staging, out);
   }
 }
 

@@ -133,7 +133,7 @@ Vec ClampedReference(Basis b, const GridLattice& lat, const Vec& xd)
 
 /// Both passes over the whole set with blocks in at most maxCells cells in place (`gathered` listed for that
 /// limit), the in-place pass's range of blocks and the gathered pass's range of tiles cut where given (sorted,
-/// within the ranges); with `stream`, into memory aligned to 64 bytes, both passes by non-temporal stores.
+/// within the ranges); with `stream`, into memory aligned to 64 bytes, the in-place pass by non-temporal stores.
 template <typename D, typename Real>
 std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Real>& set,
   const ffd::GatheredPoints& gathered, int maxCells, const std::vector<std::int64_t>& blockCuts = {},
@@ -159,10 +159,10 @@ std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Rea
   begin = 0;
   for (std::int64_t cut : gatheredCuts)
   {
-    ffd::DeformGathered(level, d, copy.data(), gathered, out, begin, cut, staging.data(), stream);
+    ffd::DeformGathered(level, d, copy.data(), gathered, out, begin, cut, staging.data());
     begin = cut;
   }
-  ffd::DeformGathered(level, d, copy.data(), gathered, out, begin, gathered.TileCount(), staging.data(), stream);
+  ffd::DeformGathered(level, d, copy.data(), gathered, out, begin, gathered.TileCount(), staging.data());
   return std::vector<Real>(out, out + set.Values.size());
 }
 
