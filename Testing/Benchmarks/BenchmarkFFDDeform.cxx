@@ -521,10 +521,10 @@ SideBySide MeasureSideBySide(CopyBuffers& copy, vtkFFDDeform* deform, BenchmarkL
 {
   SideBySide measured;
   std::vector<double> times;
+  vtkSMPTools::Initialize(threads); // the copy starts its own threads
   for (int round = 0; round < rounds; ++round)
   {
     measured.Bandwidth = std::max(measured.Bandwidth, copy.Measure(threads, 2));
-    vtkSMPTools::Initialize(threads);
     MoveLattice(lattice.Grid, lattice.Rest, rng);
     deform->Update();
     TimeUpdates(deform, lattice, rng, (minRepeats + rounds - 1) / rounds, minSeconds / rounds, times);
