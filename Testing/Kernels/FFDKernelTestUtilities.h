@@ -367,6 +367,188 @@ double PositionTolerance(double scale, const ffdref::Vec& x, const ffdref::Frame
   return EvaluationTolerance<Real>() * (scale + MaxAbs(x)) + 8.0 * Eps<Real>() * gradient * (MaxAbs(x) + MaxAbs(f.X0));
 }
 
+/// A 3x3 matrix of the reference, by rows.
+using Mat = std::array<ffdref::Vec, 3>;
+
+inline ffdref::Vec Scaled(const ffdref::Vec& a, double s)
+{
+  return { s * a[0], s * a[1], s * a[2] };
+}
+
+inline ffdref::Vec Product(const Mat& a, const ffdref::Vec& v)
+{
+  return { ffdref::Dot(a[0], v), ffdref::Dot(a[1], v), ffdref::Dot(a[2], v) };
+}
+
+inline double Determinant(const Mat& a)
+{
+  return ffdref::Dot(a[0], ffdref::Cross(a[1], a[2]));
+}
+
+/// det(A) A^-T, entry (i, k) = a[i+1][k+1] a[i+2][k+2] - a[i+1][k+2] a[i+2][k+1] (indices mod 3).
+inline Mat Cofactor(const Mat& a)
+{
+  Mat c;
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k)
+    {
+      const int i1 = (i + 1) % 3, i2 = (i + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+      c[i][k] = a[i1][k1] * a[i2][k2] - a[i1][k2] * a[i2][k1];
+    }
+  return c;
+}
+
+/// The float64 Jacobian of a point bound to a grid lattice, and where ffdref::JacobianLocal evaluated it.
+struct ReferenceJacobian
+{
+  Mat J;
+  ffdref::Vec Stu;            ///< the point's parameters, clamped to the frame
+  std::array<int, 3> Voxel;   ///< the voxel along each axis of the cell the kernel bound the point to
+  std::array<bool, 3> Free;   ///< false along the axes the point is clamped along
+};
+
+/**
+ * ffdref::JacobianLocal of the point xd bound to `cell` (BindToGrid()'s flat index) over the displacements the
+ * kernel reads (rounded to Real): in the polynomial of that cell, with the columns of the axes along which the
+ * point lies outside the frame (beyond ParametricTolerance(), as the kernel decides) dropped.
+ */
+template <typename Real>
+ReferenceJacobian JacobianOfPoint(
+  const GridLattice& lat, const std::vector<ffdref::Vec>& displacements, const ffdref::Vec& xd, int cell)
+{
+  ReferenceJacobian ref;
+  ref.Stu = ffdref::Parameters(lat.F, xd);
+  const double tolerance = double(ffd::ParametricTolerance<Real>());
+  for (int a = 0; a < 3; ++a)
+  {
+    ref.Free[a] = ref.Stu[a] >= -tolerance && ref.Stu[a] <= 1.0 + tolerance;
+    ref.Stu[a] = std::min(1.0, std::max(0.0, ref.Stu[a]));
+    const int cells = lat.Basis == ffdref::Basis::Bernstein ? 1 : lat.Divisions[a];
+    ref.Voxel[a] = cell % cells;
+    cell /= cells;
+  }
+  ref.J = ffdref::JacobianLocal(lat.Basis, lat.F, lat.Divisions.data(), displacements, ref.Stu, ref.Voxel, ref.Free);
+  return ref;
+}
+
+/**
+ * A bound on each entry's error of a Jacobian that a kernel computes in Real at the point of `ref`, from a
+ * running error analysis. Its two sources:
+ * - the evaluation: dD/d(stu_a) is a sum of products of derivative weights and displacements, each weight from
+ *   a recurrence of at most 3 roundings per degree, the tensor product and its nested sums 3 (d + 2) more,
+ *   then times the dual vectors (3), plus the identity (1). In all at most m = 6 (d + 2) roundings, each of
+ *   relative size eps, on terms whose absolute sum is ffdref::EvaluateLocalDerivative(..., absolute) (the
+ *   derivative's recurrences with their differences made sums: cancellation is not credited). A local basis
+ *   with a cell table evaluates the power form: its coefficients are the cell's control values mixed by the
+ *   change to monomials, whose absolute column sums reach 2^d times a Bernstein weight's maximum (C(d, i)
+ *   2^(d-i) for B_{i,d}), so the bound is taken 2^d times larger there.
+ * - the parameters: (s, t, u) computed in Real from X err as a world error of 8 eps (|X| + |X0|) would
+ *   (PositionTolerance()), which moves the Jacobian by its derivative along them, the second derivatives'
+ *   absolute sums times the dual vectors.
+ * First order in eps; d is the largest degree along an axis (the divisions for the global basis).
+ */
+template <typename Real>
+Mat JacobianErrorBound(const GridLattice& lat, const std::vector<ffdref::Vec>& displacements, const ffdref::Vec& xd,
+  const ReferenceJacobian& ref, bool powerForm)
+{
+  const double eps = Eps<Real>();
+  int degree = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    degree = std::max(degree, ffdref::Degree(lat.Basis, lat.Divisions[a]));
+  }
+  const double rounding = 6.0 * (degree + 2) * eps * (powerForm ? std::pow(2.0, degree) : 1.0);
+  const std::array<ffdref::Vec, 3> dual = ffdref::DualVectors(lat.F);
+  const double worldError = 8.0 * eps * (MaxAbs(xd) + MaxAbs(lat.F.X0));
+  Mat bound{};
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!ref.Free[a])
+    {
+      continue;
+    }
+    std::array<int, 3> order = { 0, 0, 0 };
+    ++order[a];
+    const ffdref::Vec first = ffdref::EvaluateLocalDerivative(
+      lat.Basis, lat.Divisions.data(), displacements, ref.Stu, order, ref.Voxel, true);
+    ffdref::Vec moved = { 0, 0, 0 }; // |d(dD/d stu_a)| from the parameters' errors
+    for (int b = 0; b < 3; ++b)
+    {
+      if (!ref.Free[b])
+      {
+        continue;
+      }
+      std::array<int, 3> second = order;
+      ++second[b];
+      const ffdref::Vec h = ffdref::EvaluateLocalDerivative(
+        lat.Basis, lat.Divisions.data(), displacements, ref.Stu, second, ref.Voxel, true);
+      const double stuError = worldError * (std::fabs(dual[b][0]) + std::fabs(dual[b][1]) + std::fabs(dual[b][2]));
+      for (int r = 0; r < 3; ++r)
+      {
+        moved[r] += h[r] * stuError;
+      }
+    }
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+      {
+        bound[r][c] += (rounding * first[r] + moved[r]) * std::fabs(dual[a][c]);
+      }
+  }
+  for (int r = 0; r < 3; ++r)
+  {
+    bound[r][r] += rounding;
+  }
+  return bound;
+}
+
+/**
+ * A bound on the error of det(J) computed in Real from a Jacobian within `bound` of j (first order): the
+ * inputs' errors times |d det / dJ| = |cof(J)|, plus the rounding of the three-term expansion (5 roundings on
+ * each of its six triple products).
+ */
+template <typename Real>
+double DeterminantErrorBound(const Mat& j, const Mat& bound)
+{
+  const Mat cof = Cofactor(j);
+  double e = 0.0, products = 0.0;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+    {
+      e += std::fabs(cof[r][c]) * bound[r][c];
+    }
+  const int perms[6][3] = { { 0, 1, 2 }, { 0, 2, 1 }, { 1, 0, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 2, 1, 0 } };
+  for (const auto& p : perms)
+  {
+    products += std::fabs(j[0][p[0]] * j[1][p[1]] * j[2][p[2]]);
+  }
+  return e + 5.0 * Eps<Real>() * products;
+}
+
+/**
+ * A bound on the max-norm error of the unit normal cof(J) n / |cof(J) n| computed in Real from a Jacobian within
+ * `bound` of j (first order; n exact): each cofactor entry, a difference of two products, errs by the inputs'
+ * errors times the other factors plus 2 eps times the products; m = cof(J) n adds 3 eps |cof| |n| a component;
+ * normalising turns an error e of m into at most 2 |e| / |m|, and rounds 5 more times (dot, sqrt, division,
+ * product).
+ */
+template <typename Real>
+double NormalErrorBound(const Mat& j, const Mat& bound, const ffdref::Vec& n)
+{
+  const double eps = Eps<Real>();
+  ffdref::Vec e = { 0, 0, 0 };
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k)
+    {
+      const int i1 = (i + 1) % 3, i2 = (i + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+      const double p = std::fabs(j[i1][k1] * j[i2][k2]), q = std::fabs(j[i1][k2] * j[i2][k1]);
+      const double cofError = std::fabs(j[i1][k1]) * bound[i2][k2] + bound[i1][k1] * std::fabs(j[i2][k2]) +
+        std::fabs(j[i1][k2]) * bound[i2][k1] + bound[i1][k2] * std::fabs(j[i2][k1]) + 2.0 * eps * (p + q);
+      e[i] += (cofError + 3.0 * eps * (p + q)) * std::fabs(n[k]);
+    }
+  const double m = Norm(Product(Cofactor(j), n));
+  return 2.0 * Norm(e) / m + 5.0 * eps;
+}
+
 } // namespace ffdtest
 
 #endif

@@ -199,6 +199,12 @@ TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
   using Real = TypeParam;
   ffdtest::Rng rng(601);
   ffdtest::WorstRatio worst("worst_error_over_tolerance");
+  std::string levels;
+  for (ffd::SimdLevel level : Levels())
+  {
+    levels += (levels.empty() ? "" : " ") + LevelName(level);
+  }
+  ::testing::Test::RecordProperty("simd_levels", levels);
   for (Basis b : ffdtest::AllBases)
   {
     for (int trial = 0; trial < 6; ++trial)
@@ -269,24 +275,40 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
         std::sort(c.begin(), c.end());
         return c;
       };
+      // The lists and the random cuts of each cell limit, drawn once for every level.
+      struct Lists
+      {
+        ffd::GatheredPoints Gathered, ShuffledGathered, OneTile;
+        std::vector<std::int64_t> BlockCuts, TileCuts;
+      };
+      std::vector<Lists> lists;
+      for (int maxCells : MaxCellsToTry())
+      {
+        Lists l;
+        l.Gathered = ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells, TestTile);
+        l.ShuffledGathered =
+          ffd::ListGatheredPoints(shuffled.Cells.data(), shuffled.Size(), CellCount(lat), maxCells, TestTile);
+        l.OneTile = ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells);
+        if (b != Basis::Bernstein && maxCells > 0 && maxCells < ffd::BlockSize) // in one cell, or outside
+        {
+          ASSERT_GT(l.ShuffledGathered.Order.size(), l.Gathered.Order.size()) << lat.Name();
+        }
+        l.BlockCuts = cuts((set.Size() + ffd::BlockSize - 1) / ffd::BlockSize);
+        l.TileCuts = cuts(l.Gathered.TileCount());
+        lists.push_back(std::move(l));
+      }
       for (ffd::SimdLevel level : Levels())
       {
         std::vector<Real> first; // the result of the first cell limit, which the others must give
-        for (int maxCells : MaxCellsToTry())
+        for (std::size_t m = 0; m < lists.size(); ++m)
         {
-          const ffd::GatheredPoints gathered =
-            ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells, TestTile);
-          const ffd::GatheredPoints shuffledGathered =
-            ffd::ListGatheredPoints(shuffled.Cells.data(), shuffled.Size(), CellCount(lat), maxCells, TestTile);
-          const ffd::GatheredPoints oneTile =
-            ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells);
-          if (b != Basis::Bernstein && maxCells > 0 && maxCells < ffd::BlockSize) // in one cell, or outside
-          {
-            ASSERT_GT(shuffledGathered.Order.size(), gathered.Order.size()) << lat.Name();
-          }
+          const int maxCells = MaxCellsToTry()[m];
+          const ffd::GatheredPoints& gathered = lists[m].Gathered;
+          const ffd::GatheredPoints& shuffledGathered = lists[m].ShuffledGathered;
+          const ffd::GatheredPoints& oneTile = lists[m].OneTile;
           const std::vector<Real> whole = DeformAll(level, k.D, set, gathered, maxCells);
-          const std::vector<Real> split = DeformAll(level, k.D, set, gathered, maxCells,
-            cuts((set.Size() + ffd::BlockSize - 1) / ffd::BlockSize), cuts(gathered.TileCount()));
+          const std::vector<Real> split =
+            DeformAll(level, k.D, set, gathered, maxCells, lists[m].BlockCuts, lists[m].TileCuts);
           const std::vector<Real> tiled = DeformAll(level, k.D, set, oneTile, maxCells);
           const std::vector<Real> reordered = DeformAll(level, k.D, shuffled, shuffledGathered, maxCells);
           const std::vector<Real> streamed = DeformAll(level, k.D, set, gathered, maxCells, {}, {}, true);
@@ -314,30 +336,34 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
   }
 }
 
-TYPED_TEST(FFDGridLanesTest, JacobianInLanesMatchesOnePoint)
+TYPED_TEST(FFDGridLanesTest, JacobianAtEveryLevelMatchesReference)
 {
-  // DeformWithJacobian() at every level, every basis, random lattices, 1001 mesh-like points in their order and
-  // shuffled (lane groups in one cell and in many, points outside kept or clamped), split into ranges at random multiples of
-  // BlockSize: positions against ffdref::DeformLocal (at the nearest point of the frame for points clamped to
-  // it) within PositionTolerance() (points outside exactly kept);
-  // the transformed normal and the Jacobian's determinant against the one-point kernel's in Real, which the
-  // tests of TestFFDGridDeformation.cxx check against the reference: within 10 EvaluationTolerance() |J|max^2 /
-  // |cof(J) n| per normal component (points where that length is under 0.1 skipped: the normal is
-  // ill-defined) and 10 EvaluationTolerance() |J|max^3 for the determinant (the two differ by the rounding of
-  // fused multiply-adds).
+  // DeformWithJacobian() at every level (None: one point at a time), every basis, random lattices, 1001
+  // mesh-like points in their order and shuffled (lane groups in one cell and in many, points outside kept or
+  // clamped), split into ranges at random multiples of BlockSize; the inputs (lattice, points, normals, cuts)
+  // are drawn once, before the levels, so that every level of every CPU sees the same ones. Positions against
+  // ffdref::DeformLocal (at the nearest point of the frame for points clamped to it) within PositionTolerance()
+  // (points outside exactly kept); the determinant and the transformed normal against the same functions of
+  // ffdref::JacobianLocal, within the bounds of JacobianErrorBound() carried through them (ffdtest::
+  // DeterminantErrorBound(), ffdtest::NormalErrorBound(); points whose cof(J) n is under 0.1 long are skipped:
+  // the normal is ill-defined there).
   using Real = TypeParam;
   ffdtest::Rng rng(604);
-  ffdtest::WorstRatio worst("worst_error_over_tolerance");
+  ffdtest::WorstRatio worstPosition("worst_position_error_over_tolerance");
+  ffdtest::WorstRatio worstDeterminant("worst_determinant_error_over_bound");
+  ffdtest::WorstRatio worstNormal("worst_normal_error_over_bound");
   for (Basis b : ffdtest::AllBases)
   {
     for (int trial = 0; trial < 4; ++trial)
     {
       const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 5);
       const double scale = ffdtest::LatticeScale(lat.Points);
+      const std::vector<Vec> displacements = ffdtest::RoundLattice<Real>(lat.Displacements()); // as the kernel
       ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
         PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 1001);
-        if (trial >= 2) // clamped to the frame: the points outside lose the Jacobian's columns along which
-        {               // they are clamped
+        const bool clamp = trial >= 2; // the points outside lose the Jacobian's columns they are clamped along
+        if (clamp)
+        {
           for (std::int64_t i = 0; i < set.Size(); ++i)
           {
             set.Cells[i] = k.Bind(ffd::Vec3<Real>::From(&set.Values[3 * i]), true);
@@ -355,19 +381,19 @@ TYPED_TEST(FFDGridLanesTest, JacobianInLanesMatchesOnePoint)
           const double length = std::max(ffdtest::Norm(n), 1e-3);
           normals.insert(normals.end(), { Real(n[0] / length), Real(n[1] / length), Real(n[2] / length) });
         }
+        std::vector<std::int64_t> cuts = { 0, set.Size() };
+        for (int c = 0; c < 4; ++c)
+        {
+          cuts.push_back(
+            ffd::BlockSize * std::uniform_int_distribution<std::int64_t>(0, set.Size() / ffd::BlockSize)(rng));
+        }
+        std::sort(cuts.begin(), cuts.end());
+        const ffd::BlockCells listed = ffd::ListBlockCells(set.Cells.data(), set.Size(), ffd::BlockSize);
         for (ffd::SimdLevel level : Levels())
         {
           const Real nan = std::numeric_limits<Real>::quiet_NaN(); // poisoned outputs
           std::vector<Real> out(set.Values.size(), nan), outNormals(normals.size(), nan),
             determinants(std::size_t(set.Size()), nan);
-          std::vector<std::int64_t> cuts = { 0, set.Size() };
-          for (int c = 0; c < 4; ++c)
-          {
-            cuts.push_back(ffd::BlockSize *
-              std::uniform_int_distribution<std::int64_t>(0, set.Size() / ffd::BlockSize)(rng));
-          }
-          std::sort(cuts.begin(), cuts.end());
-          const ffd::BlockCells listed = ffd::ListBlockCells(set.Cells.data(), set.Size(), ffd::BlockSize);
           for (std::size_t c = 0; c + 1 < cuts.size(); ++c)
           {
             ffd::DeformWithJacobian(level, k.D, set.Values.data(), set.Cells.data(), listed, normals.data(),
@@ -375,42 +401,42 @@ TYPED_TEST(FFDGridLanesTest, JacobianInLanesMatchesOnePoint)
           }
           for (std::int64_t i = 0; i < set.Size(); ++i)
           {
-            const std::string where = lat.Name() + " level " + LevelName(level) + " point " + std::to_string(i);
+            const std::string where = lat.Name() + (clamp ? " clamped" : "") + " level " + LevelName(level) +
+              " point " + std::to_string(i);
             const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&set.Values[3 * i]);
             const ffd::Vec3<Real> y = ffd::Vec3<Real>::From(&out[3 * i]);
-            ffd::Mat3<Real> j = ffd::Mat3<Real>::Identity();
+            const Vec xd = ffdtest::ToRef(x);
+            const Vec n = ffdtest::ToRef(ffd::Vec3<Real>::From(&normals[3 * i]));
+            const Vec gotNormal = ffdtest::ToRef(ffd::Vec3<Real>::From(&outNormals[3 * i]));
             if (set.Cells[i] < 0)
             {
               ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
+              ASSERT_EQ(determinants[i], Real(1)) << where;
+              ASSERT_LE(ffdtest::MaxDiff(gotNormal, n), 4.0 * ffdtest::Eps<Real>()) << where; // n renormalised
+              continue;
             }
-            else
+            const ffdtest::ReferenceJacobian ref =
+              ffdtest::JacobianOfPoint<Real>(lat, displacements, xd, set.Cells[i]);
+            const ffdtest::Mat bound =
+              ffdtest::JacobianErrorBound<Real>(lat, displacements, xd, ref, k.D.CellTable != nullptr);
+            ffd::Mat3<Real> j; // only for PositionTolerance()'s |J - I|
+            k.D.Deform(x, set.Cells[i], j);
+            const Vec want = ClampedReference(b, lat, xd);
+            const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
+            worstPosition.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
+            ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
+
+            const double detBound = ffdtest::DeterminantErrorBound<Real>(ref.J, bound);
+            const double detError = std::fabs(double(determinants[i]) - ffdtest::Determinant(ref.J));
+            worstDeterminant.Add(detError, detBound);
+            ASSERT_LE(detError, detBound) << where;
+            const Vec m = ffdtest::Product(ffdtest::Cofactor(ref.J), n);
+            if (ffdtest::Norm(m) >= 0.1)
             {
-              k.D.Deform(x, set.Cells[i], j);
-              const Vec xd = ffdtest::ToRef(x);
-              const Vec want = ClampedReference(b, lat, xd);
-              const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
-              worst.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
-              ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
-            }
-            double jmax = 1.0;
-            for (int r = 0; r < 3; ++r)
-            {
-              for (int c = 0; c < 3; ++c)
-              {
-                jmax = std::max(jmax, std::fabs(double(j.M[r][c])));
-              }
-            }
-            const double detTol = 10.0 * ffdtest::EvaluationTolerance<Real>() * jmax * jmax * jmax;
-            worst.Add(std::fabs(double(determinants[i]) - double(ffd::Determinant(j))), detTol);
-            ASSERT_LE(std::fabs(double(determinants[i]) - double(ffd::Determinant(j))), detTol) << where;
-            const ffd::Vec3<Real> n = ffd::Vec3<Real>::From(&normals[3 * i]);
-            const double mm = ffdtest::Norm(ffdtest::ToRef(ffd::Cofactor(j) * n));
-            if (mm >= 0.1)
-            {
-              const Vec got = ffdtest::ToRef(ffd::Vec3<Real>::From(&outNormals[3 * i]));
-              const double normalTol = 10.0 * ffdtest::EvaluationTolerance<Real>() * jmax * jmax / mm;
-              worst.Add(ffdtest::MaxDiff(got, ffdtest::ToRef(ffd::TransformNormal(j, n))), normalTol);
-              ASSERT_LE(ffdtest::MaxDiff(got, ffdtest::ToRef(ffd::TransformNormal(j, n))), normalTol) << where;
+              const Vec wantNormal = ffdtest::Scaled(m, 1.0 / ffdtest::Norm(m));
+              const double normalBound = ffdtest::NormalErrorBound<Real>(ref.J, bound, n);
+              worstNormal.Add(ffdtest::MaxDiff(gotNormal, wantNormal), normalBound);
+              ASSERT_LE(ffdtest::MaxDiff(gotNormal, wantNormal), normalBound) << where;
             }
           }
         }

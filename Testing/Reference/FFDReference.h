@@ -180,6 +180,80 @@ inline std::vector<double> AxisWeights(Basis b, int n, double s)
   return w;
 }
 
+/**
+ * The order-th derivative in x of Bernstein(n, k, x), by d/dx B(n, k) = n (B(n-1, k-1) - B(n-1, k)), 0 for k outside
+ * [0, n]. With `absolute`, the same recursion with each difference made a sum (and |B| at order 0): what a
+ * computation of the derivative adds up before its terms cancel, the size that its rounding errors scale with.
+ */
+inline double BernsteinDerivative(int n, int k, double x, int order, bool absolute = false)
+{
+  if (k < 0 || k > n)
+  {
+    return 0.0;
+  }
+  if (order == 0)
+  {
+    return absolute ? std::fabs(Bernstein(n, k, x)) : Bernstein(n, k, x);
+  }
+  const double sign = absolute ? 1.0 : -1.0;
+  return n *
+    (BernsteinDerivative(n - 1, k - 1, x, order - 1, absolute) +
+      sign * BernsteinDerivative(n - 1, k, x, order - 1, absolute));
+}
+
+/// The order-th derivative of UniformBSpline(i, p, x), by d/dx N(i, p) = N(i, p-1) - N(i+1, p-1) on unit knots;
+/// `absolute` as in BernsteinDerivative().
+inline double UniformBSplineDerivative(int i, int p, double x, int order, bool absolute = false)
+{
+  if (order == 0)
+  {
+    return UniformBSpline(i, p, x);
+  }
+  if (p == 0)
+  {
+    return 0.0;
+  }
+  const double sign = absolute ? 1.0 : -1.0;
+  return UniformBSplineDerivative(i, p - 1, x, order - 1, absolute) +
+    sign * UniformBSplineDerivative(i + 1, p - 1, x, order - 1, absolute);
+}
+
+/**
+ * The order-th derivative in s of each of AxisWeights()'s weights (`absolute` as in BernsteinDerivative()).
+ * Bezier bases take the polynomial of voxel `voxel` (-1: the voxel holding s), so that a derivative is that of
+ * the voxel a point was bound to even where rounding puts s a hair into the next one (the derivative jumps there).
+ */
+inline std::vector<double> AxisWeightDerivatives(Basis b, int n, double s, int order, int voxel = -1, bool absolute = false)
+{
+  const int count = PointsAlongAxis(b, n);
+  std::vector<double> w(count, 0.0);
+  const double chain = std::pow(double(n), order); // d(s n)/ds = n per order
+  if (b == Basis::Bernstein)
+  {
+    for (int i = 0; i < count; ++i)
+    {
+      w[i] = BernsteinDerivative(n, i, s, order, absolute);
+    }
+  }
+  else if (b == Basis::CubicBSpline)
+  {
+    for (int i = 0; i < count; ++i)
+    {
+      w[i] = chain * UniformBSplineDerivative(i - 3, 3, s * n, order, absolute);
+    }
+  }
+  else
+  {
+    const int d = Degree(b, n);
+    const int c = voxel >= 0 ? voxel : std::min(int(std::floor(s * n)), n - 1);
+    for (int i = 0; i <= d; ++i)
+    {
+      w[d * c + i] = chain * BernsteinDerivative(d, i, s * n - c, order, absolute);
+    }
+  }
+  return w;
+}
+
 /// Rest positions X0 + RestParameter(i) S + RestParameter(j) T + RestParameter(k) U, VTK order.
 inline std::vector<Vec> RestLattice(Basis b, const Frame& f, const int divisions[3])
 {
@@ -217,6 +291,70 @@ inline Vec EvaluateLocal(Basis b, const int divisions[3], const std::vector<Vec>
         }
       }
   return x;
+}
+
+/**
+ * The derivative of EvaluateLocal()'s sum of orders `order` in (s, t, u) at `stu`, over values v (VTK order), in
+ * the voxels `voxel` (AxisWeightDerivatives()); with `absolute`, the absolute weights times |v| per component.
+ */
+inline Vec EvaluateLocalDerivative(Basis b, const int divisions[3], const std::vector<Vec>& v, const Vec& stu,
+  const std::array<int, 3>& order, const std::array<int, 3>& voxel, bool absolute = false)
+{
+  const std::vector<double> ws = AxisWeightDerivatives(b, divisions[0], stu[0], order[0], voxel[0], absolute);
+  const std::vector<double> wt = AxisWeightDerivatives(b, divisions[1], stu[1], order[1], voxel[1], absolute);
+  const std::vector<double> wu = AxisWeightDerivatives(b, divisions[2], stu[2], order[2], voxel[2], absolute);
+  const int ni = int(ws.size()), nj = int(wt.size());
+  Vec x = { 0, 0, 0 };
+  for (int k = 0; k < int(wu.size()); ++k)
+    for (int j = 0; j < nj; ++j)
+      for (int i = 0; i < ni; ++i)
+      {
+        const double w = ws[i] * wt[j] * wu[k];
+        const Vec& q = v[i + ni * (j + nj * k)];
+        for (int c = 0; c < 3; ++c)
+        {
+          x[c] += w * (absolute ? std::fabs(q[c]) : q[c]);
+        }
+      }
+  return x;
+}
+
+/// The rows of d(s, t, u)/dX (equation 2's dual vectors): (T x U)/(S . T x U), (S x U)/(T . S x U), (S x T)/(U . S x T).
+inline std::array<Vec, 3> DualVectors(const Frame& f)
+{
+  const Vec tu = Cross(f.T, f.U), su = Cross(f.S, f.U), st = Cross(f.S, f.T);
+  const double a = Dot(tu, f.S), b = Dot(su, f.T), c = Dot(st, f.U);
+  return { Vec{ tu[0] / a, tu[1] / a, tu[2] / a }, Vec{ su[0] / b, su[1] / b, su[2] / b },
+    Vec{ st[0] / c, st[1] / c, st[2] / c } };
+}
+
+/**
+ * The Jacobian dY/dX of the displacement form Y = X + D(stu(X)), D = sum w (P - R) over displacements d (VTK
+ * order), at stu in the voxels `voxel`: I + sum over the axes a that are `free` of dD/d(stu_a) (dual vector a)^T.
+ * An axis along which a point is clamped to the frame is not free (D does not change along it). Rows of the
+ * result are rows of the Jacobian.
+ */
+inline std::array<Vec, 3> JacobianLocal(Basis b, const Frame& f, const int divisions[3], const std::vector<Vec>& d,
+  const Vec& stu, const std::array<int, 3>& voxel, const std::array<bool, 3>& free)
+{
+  const std::array<Vec, 3> dual = DualVectors(f);
+  std::array<Vec, 3> j = { Vec{ 1, 0, 0 }, Vec{ 0, 1, 0 }, Vec{ 0, 0, 1 } };
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!free[a])
+    {
+      continue;
+    }
+    std::array<int, 3> order = { 0, 0, 0 };
+    order[a] = 1;
+    const Vec g = EvaluateLocalDerivative(b, divisions, d, stu, order, voxel);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+      {
+        j[r][c] += g[r] * dual[a][c];
+      }
+  }
+  return j;
 }
 
 /// The deformed position of a world point inside the frame: equation 2, then EvaluateLocal. Parameters a
