@@ -5,6 +5,7 @@
 #include "vtkDataSetAttributes.h"
 #include "vtkDoubleArray.h"
 #include "vtkFFDDataContract.h"
+#include "vtkFFDMemory.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkObjectFactory.h"
@@ -140,6 +141,14 @@ int vtkFFDBuildLattice::RequestUpdateExtent(
   return 1;
 }
 
+//------------------------------------------------------------------------------------------------------------
+vtkTypeBool vtkFFDBuildLattice::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  return vtkFFDCatchAllocationFailure(
+    this, outputVector, [&] { return this->Superclass::ProcessRequest(request, inputVector, outputVector); });
+}
+
 //------------------------------------------------------------------------------
 int vtkFFDBuildLattice::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
@@ -198,6 +207,14 @@ int vtkFFDBuildLattice::RequestData(
   // further voxel can add to it.
   const int nI = pointsPerAxis[0], nJ = pointsPerAxis[1], nK = pointsPerAxis[2];
   const vtkIdType numControlPoints = static_cast<vtkIdType>(nI) * nJ * nK;
+  // Per control point: its position and RestPosition (24 bytes each), Active and the ghost array (1 each).
+  std::ostringstream request;
+  request << "A " << GetBasisAsString(this->Basis) << " lattice over " << divisions[0] << "x" << divisions[1]
+          << "x" << divisions[2] << " voxels (" << nI << "x" << nJ << "x" << nK << " control points)";
+  if (!vtkFFDCheckMemory(this, request.str(), 50.0 * double(numControlPoints)))
+  {
+    return 0;
+  }
   vtkUnsignedCharArray* cellGhosts = input->GetCellGhostArray();
   if (cellGhosts && cellGhosts->GetNumberOfValues() != input->GetNumberOfCells())
   {

@@ -2,6 +2,7 @@
 #include "vtkFFDBuildTetrahedralLattice.h"
 
 #include "vtkFFDDataContract.h"
+#include "vtkFFDMemory.h"
 #include "vtkFFDTetrahedralDeformation.h"
 
 #include "vtkCellArray.h"
@@ -27,6 +28,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -206,6 +208,14 @@ int vtkFFDBuildTetrahedralLattice::FillInputPortInformation(int, vtkInformation*
 }
 
 //------------------------------------------------------------------------------------------------------------
+vtkTypeBool vtkFFDBuildTetrahedralLattice::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  return vtkFFDCatchAllocationFailure(
+    this, outputVector, [&] { return this->Superclass::ProcessRequest(request, inputVector, outputVector); });
+}
+
+//------------------------------------------------------------------------------------------------------------
 int vtkFFDBuildTetrahedralLattice::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -286,6 +296,17 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
     }
   }
   this->NumberOfHullFaces = static_cast<vtkIdType>(mesh.Tetrahedra.size() / 4);
+  // A tetrahedron of the result costs about 300 bytes in all: its ids while subdividing (twice 32), the output's
+  // cell arrays (41), the binding of the input's points and the maps of the deformation (about 130), and its
+  // share of the nodes (at most one node per tetrahedron, 3 copies of 24 bytes and the midpoints' index).
+  const double finalTetrahedra = double(this->NumberOfHullFaces) * std::pow(8.0, this->SubdivisionLevels);
+  std::ostringstream request;
+  request << "SubdivisionLevels " << this->SubdivisionLevels << " (" << this->NumberOfHullFaces
+          << " hull faces, so " << finalTetrahedra << " tetrahedra)";
+  if (!vtkFFDCheckMemory(this, request.str(), 300.0 * finalTetrahedra))
+  {
+    return 0;
+  }
   for (int level = 0; level < this->SubdivisionLevels; ++level)
   {
     mesh = Subdivide(mesh);

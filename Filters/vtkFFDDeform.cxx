@@ -6,6 +6,7 @@
 #include "vtkFFDDataContract.h"
 #include "vtkFFDForInChunks.h"
 #include "vtkFFDLatticeDisplacements.h"
+#include "vtkFFDMemory.h"
 #include "vtkFFDTetrahedralDeformation.h"
 
 #include "vtkAOSDataArrayTemplate.h"
@@ -38,11 +39,6 @@ vtkStandardNewMacro(vtkFFDDeform);
 
 namespace
 {
-//------------------------------------------------------------------------------------------------------------
-// Points, and blocks of ffd::BlockSize points, that an SMP task takes at least (vtkFFDForInChunks).
-constexpr vtkIdType PointGrain = 16384;
-constexpr vtkIdType BlockGrain = PointGrain / ffd::BlockSize;
-
 //------------------------------------------------------------------------------------------------------------
 // What the filter needs from a lattice, read and checked once per update.
 struct LatticeView
@@ -98,6 +94,11 @@ std::string ReadLattice(vtkPointSet* lattice, LatticeView& view)
     {
       return "The lattice's Bernstein degree " + std::to_string(view.Divisions[a]) + " exceeds the maximum " +
         std::to_string(ffd::MaxBernsteinDegree) + ".";
+    }
+    if (view.Divisions[a] > (VTK_INT_MAX - 1) / 3) // more control points than an int counts
+    {
+      return "The lattice's FFDDivisions " + std::to_string(view.Divisions[a]) + " along axis " +
+        std::to_string(a) + " is too large." + fix;
     }
     view.Dims[a] = ffd::ControlPointsAlongAxis(view.Basis, view.Divisions[a]);
   }
@@ -160,7 +161,8 @@ struct BindWorker
     PointArrayT* points, const BindSettings& settings, int* cells, vtkAlgorithm* self, bool& completed)
   {
     BindFunctor<PointArrayT> functor{ points, settings, cells };
-    completed = vtkFFDForInChunks(self, points->GetNumberOfTuples(), PointGrain, functor, 0.0, 0.5);
+    const vtkIdType n = points->GetNumberOfTuples();
+    completed = vtkFFDForInChunks(self, n, vtkFFDGrain(n, 2.0), functor, 0.0, 0.5);
   }
 };
 
@@ -190,7 +192,7 @@ struct GridBinding
     if (listed.size() != std::size_t(3 * count))
     {
       listed.resize(std::size_t(3 * count));
-      vtkSMPTools::For(0, count, PointGrain, [&](vtkIdType begin, vtkIdType end) {
+      vtkSMPTools::For(0, count, vtkFFDGrain(count, 1.0), [&](vtkIdType begin, vtkIdType end) {
         ffd::CopyGatheredPoints(inPoints, this->Gathered, begin, end, listed.data());
       });
     }
@@ -394,6 +396,15 @@ struct EvaluateWorker
       { lattice.Dims[0], lattice.Dims[1], lattice.Dims[2] }, displacements,
       ffd::Frame<Real>::FromArray(lattice.Frame), cellTable };
     const vtkIdType n = inPoints->GetNumberOfTuples();
+    // The work of a point: the control points it reads, and 16 for its parameters and output.
+    double reads = 1.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      reads *= ffd::SupportSize(lattice.Basis, lattice.Divisions[a]);
+    }
+    const double cost = reads + 16.0;
+    const vtkIdType pointGrain = vtkFFDGrain(n, cost);
+    const vtkIdType blockGrain = std::max<vtkIdType>(1, pointGrain / ffd::BlockSize);
     if constexpr (std::is_same<PointArrayT, vtkAOSDataArrayTemplate<Real>>::value)
     {
       if (!outNormals && !determinants)
@@ -406,7 +417,7 @@ struct EvaluateWorker
         const vtkIdType gathered = vtkIdType(binding.Gathered.Order.size());
         const double middle = progressBegin + (1.0 - progressBegin) * double(n - gathered) / double(n);
         completed = binding.Blocks.MaxCells <= 0 || // every block gathered
-          vtkFFDForInChunks(self, blocks, BlockGrain, lanes, progressBegin, middle);
+          vtkFFDForInChunks(self, blocks, blockGrain, lanes, progressBegin, middle);
         lanes.GatheredPass = true;
         completed = completed && vtkFFDForInChunks(self, binding.Gathered.TileCount(), 1, lanes, middle, 1.0);
         return;
@@ -420,33 +431,62 @@ struct EvaluateWorker
           n, normalsIn ? normalsIn->GetPointer(0) : nullptr, normalsOut ? normalsOut->GetPointer(0) : nullptr,
           determinants ? determinants->GetPointer(0) : nullptr, deformation };
         completed = vtkFFDForInChunks(
-          self, (n + ffd::BlockSize - 1) / ffd::BlockSize, BlockGrain, jacobian, progressBegin, 1.0);
+          self, (n + ffd::BlockSize - 1) / ffd::BlockSize, blockGrain, jacobian, progressBegin, 1.0);
         return;
       }
     }
     EvaluateFunctor<Deformation, Real, PointArrayT> functor{ inPoints, outPoints->GetPointer(0),
       binding.Cells.data(), deformation, inNormals, outNormals, determinants ? determinants->GetPointer(0) : nullptr };
-    completed = vtkFFDForInChunks(self, inPoints->GetNumberOfTuples(), PointGrain, functor, progressBegin, 1.0);
+    completed = vtkFFDForInChunks(self, n, pointGrain, functor, progressBegin, 1.0);
   }
 };
 
 using PointArrays = vtkArrayDispatch::Reals;
 
 //------------------------------------------------------------------------------------------------------------
-// An output array of `tuples` x `components` values of the class of `like`: `previous`, an array of the last
-// output, where it is of that class and size and nothing but `previous` holds it any more (then nobody can see
-// it change: not the output, which the pipeline emptied, nor a caller), else a new one. Reuse spares the allocation and its page faults at every update: for 6.7 M
-// float points, 80 MB that cost as much as the evaluation itself.
-// A new array's values are aligned to 64 bytes (a float or double array; that of `previous` is, being one such),
-// so that the in-place pass may write them by non-temporal stores (ffd::StreamOutput()).
-vtkSmartPointer<vtkDataArray> OutputArray(
-  const vtkSmartPointer<vtkDataArray>& previous, vtkDataArray* like, int components, vtkIdType tuples)
+// The arrays of one role (points, normals, determinants) of the last outputs, so that an update writes into one
+// that nothing else holds any more (then nobody can see it change: not the output, which the executive emptied
+// before RequestData, nor a caller) instead of a new one: reuse spares the allocation and its page faults, for
+// 6.7 M float points 80 MB that cost as much as the evaluation itself. Two are kept: the last output's, and
+// the one before it where a caller held that one (a numpy view taken at every update): once the caller takes
+// a view of the new output and lets the old one go, the next update writes into the old one.
+struct KeptArrays
 {
-  if (previous && previous->GetReferenceCount() == 1 && std::strcmp(previous->GetClassName(), like->GetClassName()) == 0 &&
-    previous->GetNumberOfComponents() == components && previous->GetNumberOfTuples() == tuples)
+  vtkSmartPointer<vtkDataArray> Last, Spare;
+
+  /// Last or Spare where it is of the class of `like` and that size and nothing else holds it, else nullptr.
+  vtkSmartPointer<vtkDataArray> Free(vtkDataArray* like, int components, vtkIdType tuples) const
   {
-    previous->Modified();
-    return previous;
+    for (vtkDataArray* kept : { this->Last.Get(), this->Spare.Get() })
+    {
+      if (kept && kept->GetReferenceCount() == 1 && std::strcmp(kept->GetClassName(), like->GetClassName()) == 0 &&
+        kept->GetNumberOfComponents() == components && kept->GetNumberOfTuples() == tuples)
+      {
+        kept->Modified();
+        return vtkSmartPointer<vtkDataArray>(kept);
+      }
+    }
+    return nullptr;
+  }
+
+  /// Keeps the array an update wrote (nullptr: none) and, where it is not the last one (a caller held that),
+  /// the last one as the spare; where it is, nobody holds views of the outputs and no spare is kept.
+  void Keep(const vtkSmartPointer<vtkDataArray>& array)
+  {
+    this->Spare = array == this->Last ? nullptr : this->Last;
+    this->Last = array;
+  }
+};
+
+// An output array of `tuples` x `components` values of the class of `like`: a free one of `kept`, else a new
+// one, whose values are aligned to 64 bytes (a float or double array; a kept one is, being one such), so that
+// the in-place pass may write them by non-temporal stores (ffd::StreamOutput()). Its pages are not written
+// here: the evaluation's threads fault them in as they write their part.
+vtkSmartPointer<vtkDataArray> OutputArray(const KeptArrays& kept, vtkDataArray* like, int components, vtkIdType tuples)
+{
+  if (vtkSmartPointer<vtkDataArray> free = kept.Free(like, components, tuples))
+  {
+    return free;
   }
   const auto array = vtk::TakeSmartPointer(like->NewInstance());
   array->SetNumberOfComponents(components);
@@ -479,9 +519,8 @@ struct vtkFFDDeform::vtkInternals
   vtkFFDBindingKey Bound;    // what Grid is for
   vtkFFDCudaBackend Cuda;
   vtkFFDTetrahedralDeformation Tetrahedra; // the binding and evaluation of tetrahedral lattices
-  // The last output's arrays (the executive empties the output before RequestData): the next update writes
-  // into those that nothing else holds any more (OutputArray()).
-  vtkSmartPointer<vtkDataArray> LastPoints, LastNormals, LastDeterminants;
+  // The last outputs' arrays: the next update writes into those that nothing else holds any more (OutputArray()).
+  KeptArrays Points, Normals, Determinants;
 };
 
 //------------------------------------------------------------------------------------------------------------
@@ -509,6 +548,14 @@ int vtkFFDDeform::FillInputPortInformation(int port, vtkInformation* info)
     return 1;
   }
   return this->Superclass::FillInputPortInformation(port, info);
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkTypeBool vtkFFDDeform::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  return vtkFFDCatchAllocationFailure(
+    this, outputVector, [&] { return this->Superclass::ProcessRequest(request, inputVector, outputVector); });
 }
 
 //------------------------------------------------------------------------------------------------------------
@@ -566,15 +613,15 @@ int vtkFFDDeform::RequestData(
   vtkSmartPointer<vtkDataArray> outNormals;
   if (inNormals)
   {
-    outNormals = OutputArray(internals.LastNormals, inNormals, 3, numberOfPoints);
+    outNormals = OutputArray(internals.Normals, inNormals, 3, numberOfPoints);
     outNormals->SetName(inNormals->GetName());
   }
   const vtkSmartPointer<vtkDataArray> realArray = vtk::TakeSmartPointer(vtkDataArray::CreateDataArray(realType));
-  const auto pointsArray = OutputArray(internals.LastPoints, realArray, 3, numberOfPoints);
+  const auto pointsArray = OutputArray(internals.Points, realArray, 3, numberOfPoints);
   vtkSmartPointer<vtkDataArray> determinants;
   if (this->ComputeJacobianDeterminant)
   {
-    determinants = OutputArray(internals.LastDeterminants, realArray, 1, numberOfPoints);
+    determinants = OutputArray(internals.Determinants, realArray, 1, numberOfPoints);
     determinants->SetName(JacobianDeterminantArrayName());
   }
 
@@ -740,9 +787,9 @@ void vtkFFDDeform::FillOutput(vtkPointSet* input, vtkPointSet* output, vtkDataAr
   {
     output->GetPointData()->AddArray(determinants);
   }
-  this->Internals->LastPoints = pointsArray;
-  this->Internals->LastNormals = outNormals;
-  this->Internals->LastDeterminants = determinants;
+  this->Internals->Points.Keep(pointsArray);
+  this->Internals->Normals.Keep(outNormals);
+  this->Internals->Determinants.Keep(determinants);
 }
 
 //------------------------------------------------------------------------------------------------------------

@@ -22,8 +22,9 @@
  * per point in float32, 24 in float64), read in order by every evaluation; each thread stages a tile's
  * results (384 KB in float32, 768 KB in float64) before writing them out in point order.
  *
- * Points outside the frame keep their input position (KEEP_POSITION, the default) or take the displacement of
- * the nearest point of the frame (CLAMP_TO_EDGE, as VTK's Edge border mode and Blender's lattice do);
+ * Points outside the frame keep their input position (KEEP_POSITION, the default) or take the displacement at
+ * the frame point of their parameters clamped to [0, 1] (CLAMP_TO_EDGE; the nearest point of a box frame; not
+ * vtkBSplineTransform's Edge mode, which repeats edge coefficients and so differs outside: see README);
  * non-finite points always keep theirs. Points on a face or corner of the frame are inside. Normals (the
  * input's active point normals) are transformed by the cofactor of the Jacobian (det J times its inverse
  * transpose, the same direction where det J > 0) and renormalized; cell normals, which a non-affine
@@ -150,6 +151,8 @@ protected:
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  /// An allocation that fails becomes an error and an empty output, never an exception out of Update().
+  vtkTypeBool ProcessRequest(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   /// Gives the output the input's structure and data, the deformed points and the transformed normals and det J.
   void FillOutput(vtkPointSet* input, vtkPointSet* output, vtkDataArray* points, vtkDataArray* normals,

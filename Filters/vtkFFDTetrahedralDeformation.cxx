@@ -332,7 +332,9 @@ struct EvaluateWorker
   {
     EvaluateFunctor<Real, PointArrayT> functor{ inPoints, outPoints, cells, maps, inNormals, outNormals,
       determinants };
-    completed = vtkFFDForInChunks(self, inPoints->GetNumberOfTuples(), 16384, functor, progressBegin, progressEnd);
+    const vtkIdType n = inPoints->GetNumberOfTuples();
+    // A point reads its tetrahedron's affine map (12 numbers) and applies it.
+    completed = vtkFFDForInChunks(self, n, vtkFFDGrain(n, 8.0), functor, progressBegin, progressEnd);
   }
 };
 } // namespace
@@ -394,12 +396,33 @@ std::string vtkFFDTetrahedralDeformation::SetLattice(vtkUnstructuredGrid* lattic
   if (cells != this->NodesSource || cells->GetMTime() != this->NodesSourceMTime ||
     this->Nodes.size() != static_cast<size_t>(4 * numberOfCells))
   {
+    // Every cell's point ids are checked here, before anything reads a node through them.
     this->Nodes.resize(4 * numberOfCells);
     for (vtkIdType c = 0; c < numberOfCells; ++c)
     {
       vtkIdType count;
       const vtkIdType* ids;
       cells->GetCellAtId(c, count, ids);
+      const vtkIdType* bad = count == 4
+        ? std::find_if(ids, ids + 4, [numberOfNodes](vtkIdType id) { return id < 0 || id >= numberOfNodes; })
+        : ids;
+      if (bad != ids + 4)
+      {
+        this->Nodes.clear();
+        this->NodesSource = nullptr;
+        std::ostringstream msg;
+        msg << "The tetrahedral lattice's cell " << c;
+        if (count != 4)
+        {
+          msg << " is a tetrahedron of " << count << " point ids instead of 4.";
+        }
+        else
+        {
+          msg << " names point " << *bad << ", but the lattice has " << numberOfNodes << " points (ids 0 to "
+              << numberOfNodes - 1 << ").";
+        }
+        return msg.str() + fix;
+      }
       std::copy(ids, ids + 4, this->Nodes.begin() + 4 * c);
     }
     this->NodesSource = cells;

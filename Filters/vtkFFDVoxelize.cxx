@@ -7,6 +7,7 @@
 #include "vtkDataSetAttributes.h"
 #include "vtkDoubleArray.h"
 #include "vtkFFDDataContract.h"
+#include "vtkFFDMemory.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkObjectFactory.h"
@@ -29,6 +30,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <vector>
 
 vtkStandardNewMacro(vtkFFDVoxelize);
@@ -189,6 +191,7 @@ void vtkFFDVoxelize::SetFrame(const double origin[3], const double s[3], const d
   this->SetFrameS(s[0], s[1], s[2]);
   this->SetFrameT(t[0], t[1], t[2]);
   this->SetFrameU(u[0], u[1], u[2]);
+  this->SetFrameModeToExplicit();
 }
 
 //------------------------------------------------------------------------------
@@ -228,6 +231,14 @@ int vtkFFDVoxelize::RequestInformation(
   return 1;
 }
 
+//------------------------------------------------------------------------------------------------------------
+vtkTypeBool vtkFFDVoxelize::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  return vtkFFDCatchAllocationFailure(
+    this, outputVector, [&] { return this->Superclass::ProcessRequest(request, inputVector, outputVector); });
+}
+
 //------------------------------------------------------------------------------
 int vtkFFDVoxelize::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
@@ -242,6 +253,16 @@ int vtkFFDVoxelize::RequestData(
   }
   vtkDataArray* points = input->GetPoints()->GetData();
   const int nx = this->Divisions[0], ny = this->Divisions[1], nz = this->Divisions[2];
+  // The output is dense: a corner point (24 bytes) per voxel corner and a ghost byte per voxel; the voxel of
+  // each input point takes 12 bytes meanwhile.
+  const double voxelCount = double(nx) * ny * nz, cornerCount = (nx + 1.0) * (ny + 1.0) * (nz + 1.0);
+  std::ostringstream request;
+  request << "Divisions (" << nx << ", " << ny << ", " << nz << "): a voxel grid of " << voxelCount
+          << " voxels and " << cornerCount << " corner points";
+  if (!vtkFFDCheckMemory(this, request.str(), 24.0 * cornerCount + voxelCount + 12.0 * double(numPoints)))
+  {
+    return 0;
+  }
 
   // Phase 1: the frame.
   double frame[12];

@@ -9,7 +9,7 @@
  *   largest extent of the bounds (so flat and linear inputs still get a frame with a volume);
  * - PRINCIPAL_AXES: a box along the eigenvectors of the points' covariance (S the major axis, right-handed),
  *   tight around the points, then padded the same way;
- * - EXPLICIT: the frame set with SetFrame(), any parallelepiped.
+ * - EXPLICIT: the frame set with SetFrame() (which selects this mode), any parallelepiped.
  *
  * The output is a vtkStructuredGrid of (nx+1)(ny+1)(nz+1) voxel corners whose cells are the voxels. A voxel is
  * active when at least one input point lies in it (points on a face shared by two voxels count for the one
@@ -65,7 +65,10 @@ public:
   ///@}
 
   ///@{
-  /// The frame used in EXPLICIT mode: origin X0 and edge vectors S, T, U.
+  /**
+   * The frame used in EXPLICIT mode: origin X0 and edge vectors S, T, U. SetFrame() also selects EXPLICIT mode;
+   * the setters of its parts (SetFrameOrigin() ...) only store them, for a mode chosen apart.
+   */
   void SetFrame(const double origin[3], const double s[3], const double t[3], const double u[3]);
   vtkSetVector3Macro(FrameOrigin, double);
   vtkGetVector3Macro(FrameOrigin, double);
@@ -87,6 +90,8 @@ protected:
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  /// An allocation that fails becomes an error and an empty output, never an exception out of Update().
+  vtkTypeBool ProcessRequest(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   int Divisions[3];
   double Padding;

@@ -9,8 +9,8 @@
  * own precision, so the binding costs 4 bytes per point and loses no digit of a double-precision point.
  *
  * Outside policy: a point outside the frame keeps its position, or, with clamping, takes the displacement of
- * the nearest point of the frame (VTK's Edge border mode, Blender's lattice): the parameters are clamped to
- * [0, 1], and the Jacobian loses the columns of the clamped directions.
+ * the frame point of its parameters clamped to [0, 1] (the nearest point of a box frame), and the Jacobian
+ * loses the columns of the clamped directions.
  */
 #ifndef FFDGridDeformation_h
 #define FFDGridDeformation_h

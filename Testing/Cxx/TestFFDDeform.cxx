@@ -288,6 +288,58 @@ TEST(vtkFFDDeform, OutputArraysAreReusedOnlyWhenNobodyElseHoldsThem)
   EXPECT_EQ(deform->GetNumberOfBindings(), 1);
 }
 
+TEST(vtkFFDDeform, AViewTakenAtEveryUpdateAlternatesBetweenTwoArrays)
+{
+  // A caller that holds a view of each output until the next update's (a numpy view taken at every update)
+  // keeps the last arrays from reuse; the update before's are free again, and an update writes into them
+  // rather than allocating: from the third update on, the outputs alternate between two arrays per role, each
+  // exact, and the held view keeps the values of its own update.
+  std::mt19937 rng(12);
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("bear");
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputData(mesh);
+  normals->SplittingOff();
+  normals->Update();
+  const ffdref::Frame f = FrameOf(Pipeline(mesh, vtkFFDBuildLattice::TRILINEAR, 3, 3, 3).Lattice);
+  const int divisions[3] = { 3, 3, 3 };
+  vtkSmartPointer<vtkStructuredGrid> lattice = ffdtest::MakeLattice(f, vtkFFDBuildLattice::TRILINEAR, divisions);
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(normals->GetOutput());
+  deform->SetLatticeData(lattice);
+  std::vector<vtkDataArray*> points, normalArrays; // each update's arrays (compared as addresses only)
+  vtkSmartPointer<vtkDataArray> viewPoints, viewNormals;
+  std::vector<double> viewed;
+  for (int update = 0; update < 6; ++update)
+  {
+    Perturb(lattice, rng, 0.05);
+    deform->Update();
+    vtkPointSet* out = deform->GetOutput();
+    if (viewPoints) // the view of the last update still has its values
+    {
+      for (vtkIdType v = 0; v < viewPoints->GetNumberOfValues(); v += 997)
+      {
+        ASSERT_EQ(viewPoints->GetComponent(v / 3, v % 3), viewed[std::size_t(v)]) << "update " << update;
+      }
+    }
+    EXPECT_LE(MaxRelativeError(mesh, out, ReferenceOf(lattice)), 1e-12) << "update " << update;
+    points.push_back(out->GetPoints()->GetData());
+    normalArrays.push_back(out->GetPointData()->GetNormals());
+    viewPoints = out->GetPoints()->GetData(); // the new view; the last one is let go
+    viewNormals = out->GetPointData()->GetNormals();
+    viewed.resize(std::size_t(viewPoints->GetNumberOfValues()));
+    for (vtkIdType v = 0; v < viewPoints->GetNumberOfValues(); ++v)
+    {
+      viewed[std::size_t(v)] = viewPoints->GetComponent(v / 3, v % 3);
+    }
+  }
+  for (std::size_t u = 2; u < points.size(); ++u)
+  {
+    EXPECT_EQ(points[u], points[u - 2]) << "update " << u;
+    EXPECT_NE(points[u], points[u - 1]) << "update " << u;
+    EXPECT_EQ(normalArrays[u], normalArrays[u - 2]) << "update " << u;
+  }
+}
+
 namespace
 {
 // dX_ffd/dX of the reference by central differences (step h), as J[r][c] = d y_r / d x_c.

@@ -638,6 +638,17 @@ TEST(vtkFFDDeformTetrahedral, InconsistentLatticesAreErrors)
         vtkNew<vtkCellArray> none;
         g->SetCells(VTK_TETRA, none);
       } },
+    // Point ids outside the lattice, checked before any node is read through them (the id 77 of 4
+    // points, a negative id, and a tetrahedron of three ids).
+    { "id 77", "cell 2 names point 77, but the lattice has",
+      [](vtkUnstructuredGrid* g) { g->GetCells()->ReplaceCellAtId(2, { 0, 1, 77, 3 }); } },
+    { "id -1", "cell 0 names point -1",
+      [](vtkUnstructuredGrid* g) { g->GetCells()->ReplaceCellAtId(0, { 0, -1, 2, 3 }); } },
+    { "three ids", "is a tetrahedron of 3 point ids instead of 4",
+      [](vtkUnstructuredGrid* g) {
+        const vtkIdType three[3] = { 0, 1, 2 };
+        g->InsertNextCell(VTK_TETRA, 3, three);
+      } },
   };
   for (const Case& c : cases)
   {
@@ -825,6 +836,36 @@ TEST(vtkFFDBuildTetrahedralLattice, MarksTheNodesOfTetrahedraHoldingPointsActive
   EXPECT_EQ(build->GetNumberOfActiveNodes(), count);
   EXPECT_LT(count, lattice->GetNumberOfPoints()); // the inner nodes hold no surface point
   EXPECT_TRUE(ghosts);
+}
+
+TEST(vtkFFDBuildTetrahedralLattice, SubdivisionsThatNoMemoryHoldsAreErrors)
+{
+  // 100 000 points on a sphere: about 200 000 hull faces, times 8^5 tetrahedra at SubdivisionLevels 5, the
+  // most it takes: some 2 PB at the estimated 300 bytes a tetrahedron. Refused before subdividing, with what
+  // was asked; the same filter then builds level 1.
+  vtkNew<vtkPoints> points;
+  std::mt19937 rng(68);
+  std::normal_distribution<double> normal;
+  for (int i = 0; i < 100000; ++i)
+  {
+    double x[3] = { normal(rng), normal(rng), normal(rng) };
+    const double r = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    points->InsertNextPoint(x[0] / r, x[1] / r, x[2] / r);
+  }
+  vtkNew<vtkPolyData> mesh;
+  mesh->SetPoints(points);
+  vtkNew<vtkFFDBuildTetrahedralLattice> build;
+  vtkNew<FFDTestErrorObserver> observer;
+  observer->Watch(build);
+  observer->Watch(build->GetExecutive());
+  build->SetInputData(mesh);
+  build->SetSubdivisionLevels(12); // clamped to 5
+  EXPECT_EQ(build->GetSubdivisionLevels(), 5);
+  build->Update();
+  EXPECT_NE(observer->Errors.find("SubdivisionLevels 5"), std::string::npos) << observer->Errors;
+  EXPECT_NE(observer->Errors.find("of memory, but only"), std::string::npos) << observer->Errors;
+  EXPECT_EQ(build->GetOutput()->GetNumberOfCells(), 0);
+  EXPECT_GT(build->GetNumberOfHullFaces(), 100000);
 }
 
 TEST(vtkFFDBuildTetrahedralLattice, FlatOrTooFewPointsAreErrors)

@@ -349,6 +349,33 @@ TEST(vtkFFDVoxelize, ExplicitFrameIgnoresPointsOutside)
   }
 }
 
+TEST(vtkFFDVoxelize, SetFrameSelectsTheExplicitMode)
+{
+  // SetFrame() alone gives that frame (it was ignored until SetFrameModeToExplicit()); the part setters only
+  // store their vectors, and the automatic mode chosen after them is used.
+  vtkSmartPointer<vtkPolyData> cloud = PointCloud({ { 0, 0, 0 }, { 1, 1, 1 } });
+  const double origin[3] = { -1.0, 0.5, 2.0 }, s[3] = { 3.0, 0.4, 0.0 }, t[3] = { 0.5, 2.0, 0.3 },
+               u[3] = { -0.2, 0.6, 1.5 };
+  vtkNew<vtkFFDVoxelize> voxelize;
+  voxelize->SetInputData(cloud);
+  voxelize->SetFrame(origin, s, t, u);
+  EXPECT_EQ(voxelize->GetFrameMode(), vtkFFDVoxelize::EXPLICIT);
+  voxelize->Update();
+  const ffdref::Frame out = FrameOf(voxelize->GetOutput());
+  for (int c = 0; c < 3; ++c)
+  {
+    EXPECT_EQ(out.X0[c], origin[c]);
+    EXPECT_EQ(out.S[c], s[c]);
+    EXPECT_EQ(out.T[c], t[c]);
+    EXPECT_EQ(out.U[c], u[c]);
+  }
+  voxelize->SetFrameModeToAxisAligned();
+  voxelize->SetFrameOrigin(5.0, 5.0, 5.0);
+  EXPECT_EQ(voxelize->GetFrameMode(), vtkFFDVoxelize::AXIS_ALIGNED);
+  voxelize->Update();
+  EXPECT_LT(FrameOf(voxelize->GetOutput()).X0[0], 0.0); // the padded bounds of the cloud
+}
+
 TEST(vtkFFDVoxelize, PointsOnFacesGoToTheHigherVoxel)
 {
   const double origin[3] = { 0, 0, 0 }, s[3] = { 2, 0, 0 }, t[3] = { 0, 2, 0 }, u[3] = { 0, 0, 2 };

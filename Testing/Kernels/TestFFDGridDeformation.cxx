@@ -461,7 +461,7 @@ TYPED_TEST(FFDGridDeformationTest, BindToGridOutsideAndNonFinite)
 
 TYPED_TEST(FFDGridDeformationTest, ClampingGivesEdgeDisplacement)
 {
-  // The clamping policy (VTK's Edge border mode): a point outside takes the displacement of the frame point of
+  // The clamping policy: a point outside takes the displacement of the frame point of
   // clamped parameters, X + D(clamp(s, t, u)), checked against the reference at that frame point (tolerance
   // PositionTolerance()). Its Jacobian drops the clamped directions: against central
   // differences of the reference's clamped map (GradientTolerance() times max(1, |J|)), and exactly along the

@@ -202,6 +202,64 @@ class TestPipeline(unittest.TestCase):
         self.assertTrue(any("RestPosition" in message for message in errors.messages), errors.messages)
         self.assertEqual(self.deform.GetOutput().GetNumberOfPoints(), 0)
 
+    def expect_error(self, algorithm, needle):
+        """Updates algorithm and asserts that it failed with an error containing needle and an empty output."""
+        errors = ErrorCatcher()
+        algorithm.AddObserver("ErrorEvent", errors)
+        algorithm.GetExecutive().AddObserver("ErrorEvent", ErrorCatcher())
+        self.assertEqual(algorithm.GetExecutive().Update(), 0)
+        self.assertTrue(any(needle in message for message in errors.messages), errors.messages)
+        self.assertEqual(algorithm.GetOutputDataObject(0).GetNumberOfPoints(), 0)
+
+    def test_sizes_that_no_memory_holds_are_errors(self):
+        # The issue's abort: a voxel grid far beyond any machine's memory is refused before anything is
+        # allocated, with what it needs; the interpreter goes on, and the filter works again with sane sizes.
+        for divisions in [(100000, 100000, 100000), (2**31 - 1, 2**31 - 1, 1)]:
+            self.voxelize.SetDivisions(*divisions)
+            self.expect_error(self.voxelize, "of memory, but only")
+        self.voxelize.SetDivisions(2, 3, 4)
+        self.voxelize.Update()
+        self.assertEqual(self.voxelize.GetOutput().GetNumberOfCells(), 24)
+
+    @unittest.skipIf("LD_PRELOAD" in os.environ, "the sanitizers' runtime reserves more address space than the limit")
+    def test_an_allocation_that_fails_is_an_error_not_an_abort(self):
+        # Under an address-space limit of 512 MB above what the interpreter has mapped, divisions that the
+        # machine's memory would hold (1.3 GB of corners estimated) cannot be allocated: VTK throws std::bad_alloc, which the filter turns into an error
+        # and an empty output. In a child process, so that the limit stays there; before the fix the child died
+        # of SIGABRT.
+        script = """
+import resource, sys
+import vtkffd
+from vtkmodules.vtkCommonDataModel import vtkPolyData
+from vtkmodules.vtkCommonCore import vtkPoints
+size = next(int(line.split()[1]) for line in open("/proc/self/status") if line.startswith("VmSize:"))
+limit = size * 1024 + (512 << 20)
+resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+points = vtkPoints()
+points.InsertNextPoint(0, 0, 0)
+points.InsertNextPoint(1, 1, 1)
+cloud = vtkPolyData()
+cloud.SetPoints(points)
+voxelize = vtkffd.vtkFFDVoxelize()
+voxelize.SetInputData(cloud)
+voxelize.SetDivisions(380, 380, 380)
+messages = []
+class Catcher:
+    CallDataType = "string0"
+    def __call__(self, caller, event, message):
+        messages.append(message)
+catcher = Catcher()
+voxelize.AddObserver("ErrorEvent", catcher)
+voxelize.GetExecutive().AddObserver("ErrorEvent", Catcher())
+status = voxelize.GetExecutive().Update()
+print(status, voxelize.GetOutput().GetNumberOfPoints(), any("Out of memory" in m for m in messages))
+"""
+        import subprocess
+        import sys
+        result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+        self.assertEqual(result.returncode, 0, result.stderr[-2000:])
+        self.assertEqual(result.stdout.split(), ["0", "0", "True"], result.stdout + result.stderr[-2000:])
+
     def test_lattice_actor_sizes_points_from_the_current_lattice(self):
         actor = vtkffd.vtkFFDLatticeActor()
         actor.SetInputData(self.lattice)
