@@ -87,27 +87,27 @@ bool Run(ffd::cuda::ResidentPoints& device, NormalsOnDevice& normalsOnDevice, bo
   if (outNormals && (normals != normalsOnDevice.Array || normals->GetMTime() != normalsOnDevice.MTime))
   {
     normalsOnDevice = NormalsOnDevice();
-    std::vector<float> copy;
+    std::vector<Real> copy; // in the evaluation's precision, as the CPU transforms them
     if (!device.SetNormals(Contiguous(normals, copy)))
     {
       return false;
     }
     normalsOnDevice = { normals, normals->GetMTime() };
   }
-  std::vector<float> normalsCopy;
-  auto* floatNormals = outNormals ? vtkAOSDataArrayTemplate<float>::FastDownCast(outNormals) : nullptr;
-  if (outNormals && !floatNormals)
+  std::vector<Real> normalsCopy;
+  auto* realNormals = outNormals ? vtkAOSDataArrayTemplate<Real>::FastDownCast(outNormals) : nullptr;
+  if (outNormals && !realNormals)
   {
     normalsCopy.resize(3 * static_cast<size_t>(points->GetNumberOfPoints()));
   }
-  float* normalsTarget = floatNormals ? floatNormals->GetPointer(0) : (outNormals ? normalsCopy.data() : nullptr);
+  Real* normalsTarget = realNormals ? realNormals->GetPointer(0) : (outNormals ? normalsCopy.data() : nullptr);
   if (!evaluate(outNormals != nullptr, outDeterminants != nullptr) ||
     !device.Download(outPoints->GetPointer(0), normalsTarget,
       outDeterminants ? outDeterminants->GetPointer(0) : nullptr))
   {
     return false;
   }
-  if (outNormals && !floatNormals)
+  if (outNormals && !realNormals)
   {
     auto values = vtk::DataArrayValueRange<3>(outNormals);
     std::copy(normalsCopy.begin(), normalsCopy.end(), values.begin());

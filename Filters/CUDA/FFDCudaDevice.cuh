@@ -104,7 +104,7 @@ struct Buffer
 template <typename Deformer, typename Real, bool WithJacobian>
 __global__ void __launch_bounds__(ThreadsPerBlock, WithJacobian ? 4 : 6) DeformKernel(const Real* __restrict__ points,
   const int* __restrict__ cells, std::int64_t count, Deformer deformation,
-  Real* __restrict__ outPoints, const float* __restrict__ normals, float* __restrict__ outNormals,
+  Real* __restrict__ outPoints, const Real* __restrict__ normals, Real* __restrict__ outNormals,
   Real* __restrict__ determinants)
 {
   constexpr int PointsPerThread = WithJacobian ? 1 : 4;
@@ -137,9 +137,9 @@ __global__ void __launch_bounds__(ThreadsPerBlock, WithJacobian ? 4 : 6) DeformK
     if (outNormals)
     {
       const ffd::Vec3<Real> n = ffd::TransformNormal(jacobian, ffd::Vec3<Real>::From(normals + 3 * i));
-      outNormals[3 * i] = float(n.x);
-      outNormals[3 * i + 1] = float(n.y);
-      outNormals[3 * i + 2] = float(n.z);
+      outNormals[3 * i] = n.x;
+      outNormals[3 * i + 1] = n.y;
+      outNormals[3 * i + 2] = n.z;
     }
     if (determinants)
     {
@@ -195,7 +195,7 @@ __global__ void __launch_bounds__(ThreadsPerBlock, 4) DeformPointsKernel(const f
 // for.
 template <typename Deformer, typename Real>
 void LaunchDeform(const Deformer& deformation, const Real* points, const int* cells, std::int64_t count,
-  Real* outPoints, const float* normals, float* outNormals, Real* determinants, cudaStream_t stream)
+  Real* outPoints, const Real* normals, Real* outNormals, Real* determinants, cudaStream_t stream)
 {
   if (outNormals || determinants)
   {
@@ -297,7 +297,7 @@ struct ResidentPoints::State
     this->OutPoints.Reserve(std::size_t(this->Count) * 3 * sizeof(Real), "allocating the deformed points");
     if (withNormals)
     {
-      this->OutNormals.Reserve(std::size_t(this->Count) * 3 * sizeof(float), "allocating the normals");
+      this->OutNormals.Reserve(std::size_t(this->Count) * 3 * sizeof(Real), "allocating the normals");
     }
     if (withDeterminants)
     {
@@ -313,7 +313,10 @@ struct ResidentPoints::State
   void FinishEvaluation(bool withNormals, bool withDeterminants, bool withLatticeKernels);
 
   template <typename Real>
-  void RunDownload(Real* outPoints, float* outNormals, Real* outDeterminants);
+  void SetNormals(const Real* normals);
+
+  template <typename Real>
+  void RunDownload(Real* outPoints, Real* outNormals, Real* outDeterminants);
 
   /// Copies `bytes` from the device to pageable host memory through the two pinned buffers, so that the host
   /// copy of one chunk overlaps the transfer of the next.

@@ -504,7 +504,7 @@ struct GridDeformer::Impl : ResidentPoints::State
     this->UploadLattice(latticeBytes);
 
     this->BeginEvaluation<Real>(withNormals, withDeterminants);
-    float* normalsOut = withNormals ? this->OutNormals.As<float>() : nullptr;
+    Real* normalsOut = withNormals ? this->OutNormals.As<Real>() : nullptr;
     Real* determinantsOut = withDeterminants ? this->OutDeterminants.As<Real>() : nullptr;
     if constexpr (std::is_same<Real, float>::value)
     {
@@ -556,7 +556,7 @@ struct GridDeformer::Impl : ResidentPoints::State
   // DeformKernel on a lattice of 3 numbers per control point: with the Jacobian, float64 points, and float32
   // points without the Jacobian on the local bases of 3 or 4 control points per axis.
   template <typename Real>
-  void LaunchGeneric(const Real* d, const int dims[3], float* normalsOut, Real* determinantsOut)
+  void LaunchGeneric(const Real* d, const int dims[3], Real* normalsOut, Real* determinantsOut)
   {
     const ffd::Frame<Real> frame = ffd::Frame<Real>::FromArray(this->Frame);
     this->WithStaticBasis([&](auto maxCount, auto basis) {
@@ -564,7 +564,7 @@ struct GridDeformer::Impl : ResidentPoints::State
       const Deformer deformation{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
         { dims[0], dims[1], dims[2] }, d, frame };
       detail::LaunchDeform(deformation, this->Points.As<Real>(), this->Cells.As<int>(), this->Count,
-        this->OutPoints.As<Real>(), this->Normals.As<float>(), normalsOut, determinantsOut, this->Stream);
+        this->OutPoints.As<Real>(), this->Normals.As<Real>(), normalsOut, determinantsOut, this->Stream);
     });
   }
 

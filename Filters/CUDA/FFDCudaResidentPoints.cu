@@ -154,7 +154,21 @@ void ResidentPoints::State::Download(const void* device, void* host, std::size_t
 }
 
 template <typename Real>
-void ResidentPoints::State::RunDownload(Real* outPoints, float* outNormals, Real* outDeterminants)
+void ResidentPoints::State::SetNormals(const Real* normals)
+{
+  if (this->IsDouble != (sizeof(Real) == sizeof(double)))
+  {
+    throw CudaError{ cudaErrorInvalidValue, "uploading the normals: not in the precision of the points" };
+  }
+  const std::size_t bytes = std::size_t(this->Count) * 3 * sizeof(Real);
+  this->Normals.Reserve(bytes, "allocating the normals");
+  Check(cudaMemcpy(this->Normals.Data, normals, bytes, cudaMemcpyHostToDevice), "uploading the normals");
+  this->HasNormals = true;
+  ++this->Counts.NormalUploads;
+}
+
+template <typename Real>
+void ResidentPoints::State::RunDownload(Real* outPoints, Real* outNormals, Real* outDeterminants)
 {
   if (!this->Evaluated || (this->IsDouble != (sizeof(Real) == sizeof(double))) ||
     (outNormals && !this->EvaluatedNormals) || (outDeterminants && !this->EvaluatedDeterminants))
@@ -166,7 +180,7 @@ void ResidentPoints::State::RunDownload(Real* outPoints, float* outNormals, Real
   this->Download(this->OutPoints.Data, outPoints, std::size_t(this->Count) * 3 * sizeof(Real));
   if (outNormals)
   {
-    this->Download(this->OutNormals.Data, outNormals, std::size_t(this->Count) * 3 * sizeof(float));
+    this->Download(this->OutNormals.Data, outNormals, std::size_t(this->Count) * 3 * sizeof(Real));
   }
   if (outDeterminants)
   {
@@ -197,13 +211,12 @@ bool ResidentPoints::SetPoints(const double* xyz, std::int64_t count)
 
 bool ResidentPoints::SetNormals(const float* normals)
 {
-  return this->S->Guard([&] {
-    const std::size_t bytes = std::size_t(this->S->Count) * 3 * sizeof(float);
-    this->S->Normals.Reserve(bytes, "allocating the normals");
-    Check(cudaMemcpy(this->S->Normals.Data, normals, bytes, cudaMemcpyHostToDevice), "uploading the normals");
-    this->S->HasNormals = true;
-    ++this->S->Counts.NormalUploads;
-  });
+  return this->S->Guard([&] { this->S->SetNormals(normals); });
+}
+
+bool ResidentPoints::SetNormals(const double* normals)
+{
+  return this->S->Guard([&] { this->S->SetNormals(normals); });
 }
 
 bool ResidentPoints::Download(float* outPoints, float* outNormals, float* outDeterminants)
@@ -211,7 +224,7 @@ bool ResidentPoints::Download(float* outPoints, float* outNormals, float* outDet
   return this->S->Guard([&] { this->S->RunDownload(outPoints, outNormals, outDeterminants); });
 }
 
-bool ResidentPoints::Download(double* outPoints, float* outNormals, double* outDeterminants)
+bool ResidentPoints::Download(double* outPoints, double* outNormals, double* outDeterminants)
 {
   return this->S->Guard([&] { this->S->RunDownload(outPoints, outNormals, outDeterminants); });
 }

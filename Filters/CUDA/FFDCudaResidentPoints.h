@@ -65,14 +65,18 @@ public:
   bool SetPoints(const double* xyz, std::int64_t count);
   ///@}
 
-  /// Uploads unit normals (3 floats per point) to transform with the deformation.
+  ///@{
+  /// Uploads unit normals (3 per point) to transform with the deformation, in the precision of the points (that
+  /// of the evaluation: a float64 mesh's normals are transformed as accurately as on the CPU).
   bool SetNormals(const float* normals);
+  bool SetNormals(const double* normals);
+  ///@}
 
   ///@{
   /// Downloads the last evaluation: the deformed points (3 per point, the precision of SetPoints()) into
   /// outPoints, and the normals and determinants into the others when not null (they must have been evaluated).
   bool Download(float* outPoints, float* outNormals, float* outDeterminants);
-  bool Download(double* outPoints, float* outNormals, double* outDeterminants);
+  bool Download(double* outPoints, double* outNormals, double* outDeterminants);
   ///@}
 
   /// Frees every device and pinned buffer.

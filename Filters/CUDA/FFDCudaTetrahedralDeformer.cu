@@ -132,7 +132,7 @@ struct TetrahedralDeformer::Impl : ResidentPoints::State
     }
     this->LatticeKernelsDone();
     const TetrahedralDeformation<Real> deformation{ maps };
-    float* normalsOut = withNormals ? this->OutNormals.As<float>() : nullptr;
+    Real* normalsOut = withNormals ? this->OutNormals.As<Real>() : nullptr;
     Real* determinantsOut = withDeterminants ? this->OutDeterminants.As<Real>() : nullptr;
     // Float32 points alone (an ordinary update) take the kernel of 16-byte point loads and stores, as trilinear
     // grids do: 95 % of the copy roofline at 16 M points on an H100 (BENCHMARKS.md).
@@ -147,7 +147,7 @@ struct TetrahedralDeformer::Impl : ResidentPoints::State
       }
     }
     detail::LaunchDeform(deformation, this->Points.As<Real>(), this->Cells.As<int>(), this->Count,
-      this->OutPoints.As<Real>(), this->Normals.As<float>(), normalsOut, determinantsOut, this->Stream);
+      this->OutPoints.As<Real>(), this->Normals.As<Real>(), normalsOut, determinantsOut, this->Stream);
     this->FinishEvaluation(withNormals, withDeterminants, true);
   }
 };

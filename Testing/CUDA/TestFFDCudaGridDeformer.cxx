@@ -164,18 +164,19 @@ TYPED_TEST(CudaGridDeformerTest, MatchesCpuForEveryBasis)
       const std::vector<Real> points(p.Points.begin(), p.Points.end());
       ffd::cuda::GridDeformer gpu;
       ASSERT_TRUE(gpu.SetPoints(points.data(), p.Count())) << gpu.GetLastError();
-      ASSERT_TRUE(gpu.SetNormals(p.Normals.data())) << gpu.GetLastError();
+      const std::vector<Real> normals(p.Normals.begin(), p.Normals.end()); // in the points' precision
+      ASSERT_TRUE(gpu.SetNormals(normals.data())) << gpu.GetLastError();
       ASSERT_TRUE(gpu.Bind(p.Frame, basis, p.Divisions, clamp)) << gpu.GetLastError();
       const Real poison = Real(-12345.0);
       std::vector<Real> outPoints(points.size(), poison), outDeterminants(p.Count(), poison);
-      std::vector<float> outNormals(points.size(), float(poison));
+      std::vector<Real> outNormals(points.size(), poison);
       ASSERT_TRUE(gpu.Evaluate(p.Displacements.data(), p.ControlPoints(), true, true)) << gpu.GetLastError();
       ASSERT_TRUE(gpu.Download(outPoints.data(), outNormals.data(), outDeterminants.data())) << gpu.GetLastError();
 
       // Normals and det(J) carry the rounding of the Jacobian, which the conditioning of J amplifies: det(J)
       // within 1e-5 in float32 (1e-12 in double) of the size of its terms, |J e0||J e1||J e2|; unit normals
       // within 1e-5 times the ratio of that size to |det J| (a bound on J's condition number) in float32, and
-      // 1e-6 in double (normals cross the bus as float32).
+      // 1e-12 times it in double (normals are uploaded, transformed and downloaded in the points' precision).
       const bool single = sizeof(Real) == sizeof(float);
       std::int64_t wrong = 0;
       std::string firstWrong;
@@ -195,7 +196,8 @@ TYPED_TEST(CudaGridDeformerTest, MatchesCpuForEveryBasis)
         {
           check("position", i, double(outPoints[3 * i + c]), cpuPoints[3 * i + c], tolerance);
           const double conditioning = jacobianScales[i] / std::max(std::fabs(cpuDeterminants[i]), 1e-300);
-          check("normal", i, outNormals[3 * i + c], cpuNormals[3 * i + c], single ? 1e-5 * conditioning : 1e-6);
+          check("normal", i, double(outNormals[3 * i + c]), cpuNormals[3 * i + c],
+            (single ? 1e-5 : 1e-12) * conditioning);
         }
         check("det", i, double(outDeterminants[i]), cpuDeterminants[i],
           (single ? 1e-5 : 1e-12) * std::max(1.0, jacobianScales[i]));

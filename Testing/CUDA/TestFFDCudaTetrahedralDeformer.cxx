@@ -220,8 +220,8 @@ TYPED_TEST_SUITE(CudaTetrahedralDeformerTest, RealTypes);
 // The device against the float64 reference, each in the precision of the points (the reference starts from the
 // points as the device has them). Tolerances, relative to the mesh's size (3): positions 1e-5 in float32 (the
 // issue's bound) and 1e-12 in float64; det J within the same of the size of its terms, |J e0||J e1||J e2|; unit
-// normals within 1e-5 times J's conditioning in float32, and 1e-6 in float64 (normals cross the bus as
-// float32). Kept points exactly. With and without normals and det J (different kernels), points in mesh and in
+// normals within 1e-5 times J's conditioning in float32, and 1e-12 times it in float64 (normals are uploaded,
+// transformed and downloaded in the points' precision). Kept points exactly. With and without normals and det J (different kernels), points in mesh and in
 // random order; outputs poisoned first, so unwritten values are caught.
 TYPED_TEST(CudaTetrahedralDeformerTest, MatchesFloat64Reference)
 {
@@ -242,7 +242,8 @@ TYPED_TEST(CudaTetrahedralDeformerTest, MatchesFloat64Reference)
     const std::vector<Real> points(p.Points.begin(), p.Points.end());
     ffd::cuda::TetrahedralDeformer gpu;
     ASSERT_TRUE(gpu.SetPoints(points.data(), p.Count())) << gpu.GetLastError();
-    ASSERT_TRUE(gpu.SetNormals(p.Normals.data())) << gpu.GetLastError();
+    const std::vector<Real> normals(p.Normals.begin(), p.Normals.end()); // in the points' precision
+    ASSERT_TRUE(gpu.SetNormals(normals.data())) << gpu.GetLastError();
     ASSERT_TRUE(p.Bind(gpu)) << gpu.GetLastError();
 
     std::vector<Reference> expected;
@@ -255,7 +256,7 @@ TYPED_TEST(CudaTetrahedralDeformerTest, MatchesFloat64Reference)
     {
       const Real poison = Real(-12345.0);
       std::vector<Real> outPoints(points.size(), poison), outDeterminants(p.Count(), poison);
-      std::vector<float> outNormals(points.size(), float(poison));
+      std::vector<Real> outNormals(points.size(), poison);
       ASSERT_TRUE(gpu.Evaluate(p.Displacements.data(), p.Mesh.NumberOfNodes(), withJacobian, withJacobian))
         << gpu.GetLastError();
       ASSERT_TRUE(gpu.Download(outPoints.data(), withJacobian ? outNormals.data() : nullptr,
@@ -285,7 +286,7 @@ TYPED_TEST(CudaTetrahedralDeformerTest, MatchesFloat64Reference)
           worst = std::max(worst, std::fabs(got - r.Point[c]) / p.Size);
           if (withJacobian)
           {
-            check("normal", i, outNormals[3 * i + c], r.Normal[c], single ? 1e-5 * r.Conditioning : 1e-6);
+            check("normal", i, double(outNormals[3 * i + c]), r.Normal[c], (single ? 1e-5 : 1e-12) * r.Conditioning);
           }
         }
         if (withJacobian && p.Cells[i] >= 0)
