@@ -65,7 +65,22 @@ bool LatticePointsPerAxis(int basis, const int divisions[3], int points[3], std:
       why = msg.str();
       return false;
     }
+    if (divisions[a] > (VTK_INT_MAX - 1) / 3)
+    {
+      why = "its " + std::to_string(divisions[a]) + " divisions along axis " + std::to_string(a) +
+        " would need more control points than an int counts.";
+      return false;
+    }
     points[a] = ffd::ControlPointsAlongAxis(grid, divisions[a]);
+  }
+  // The deformation's kernels index control points by int.
+  if (double(points[0]) * points[1] * points[2] > double(VTK_INT_MAX))
+  {
+    std::ostringstream msg;
+    msg << "the " << vtkFFDBuildLattice::GetBasisAsString(basis) << " lattice over " << divisions[0] << "x"
+        << divisions[1] << "x" << divisions[2] << " voxels would have more than 2^31 - 1 control points.";
+    why = msg.str();
+    return false;
   }
   return true;
 }
@@ -177,10 +192,16 @@ int vtkFFDBuildLattice::RequestData(
   }
   int dims[3];
   input->GetDimensions(dims);
-  if (dims[0] != divisions[0] + 1 || dims[1] != divisions[1] + 1 || dims[2] != divisions[2] + 1)
+  bool dimsMatch = input->GetNumberOfPoints() == vtkIdType(dims[0]) * dims[1] * dims[2];
+  for (int a = 0; a < 3; ++a)
   {
-    vtkErrorMacro(<< "The input's dimensions (" << dims[0] << ", " << dims[1] << ", " << dims[2]
-                  << ") do not match its " << vtkFFDDataContract::DivisionsArrayName() << " ("
+    dimsMatch = dimsMatch && vtkIdType(dims[a]) == vtkIdType(divisions[a]) + 1;
+  }
+  if (!dimsMatch)
+  {
+    vtkErrorMacro(<< "The input's dimensions (" << dims[0] << ", " << dims[1] << ", " << dims[2] << ") and "
+                  << input->GetNumberOfPoints() << " points do not match its "
+                  << vtkFFDDataContract::DivisionsArrayName() << " ("
                   << divisions[0] << ", " << divisions[1] << ", " << divisions[2]
                   << ") plus one: connect the output of vtkFFDVoxelize.");
     return 0;

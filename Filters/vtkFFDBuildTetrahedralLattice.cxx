@@ -303,6 +303,12 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   std::ostringstream request;
   request << "SubdivisionLevels " << this->SubdivisionLevels << " (" << this->NumberOfHullFaces
           << " hull faces, so " << finalTetrahedra << " tetrahedra)";
+  if (finalTetrahedra > double((VTK_INT_MAX - 3) / 4)) // the deformation numbers faces and tetrahedra by int
+  {
+    vtkErrorMacro(<< request.str() << " exceeds the " << (VTK_INT_MAX - 3) / 4
+                  << " tetrahedra a lattice may have: choose fewer levels.");
+    return 0;
+  }
   if (!vtkFFDCheckMemory(this, request.str(), 300.0 * finalTetrahedra))
   {
     return 0;

@@ -102,6 +102,13 @@ std::string ReadLattice(vtkPointSet* lattice, LatticeView& view)
     }
     view.Dims[a] = ffd::ControlPointsAlongAxis(view.Basis, view.Divisions[a]);
   }
+  // The kernels index control points and cells by int: the product is checked in double, where it cannot wrap.
+  if (double(view.Dims[0]) * view.Dims[1] * view.Dims[2] > double(VTK_INT_MAX))
+  {
+    return "The lattice's FFDDivisions " + std::to_string(view.Divisions[0]) + "x" +
+      std::to_string(view.Divisions[1]) + "x" + std::to_string(view.Divisions[2]) +
+      " need more than 2^31 - 1 control points." + fix;
+  }
   const vtkIdType expected = vtkIdType(view.Dims[0]) * view.Dims[1] * view.Dims[2];
   const vtkIdType count = lattice->GetNumberOfPoints();
   if (count != expected)
@@ -605,9 +612,12 @@ int vtkFFDDeform::RequestData(
     (this->OutputPointsPrecision == vtkAlgorithm::DEFAULT_PRECISION && inPoints->GetDataType() == VTK_DOUBLE);
   const int realType = useDouble ? VTK_DOUBLE : VTK_FLOAT;
   vtkDataArray* inNormals = this->TransformNormals ? input->GetPointData()->GetNormals() : nullptr;
-  if (inNormals && inNormals->GetNumberOfComponents() != 3)
+  if (inNormals && (inNormals->GetNumberOfComponents() != 3 || inNormals->GetNumberOfTuples() != numberOfPoints))
   {
-    vtkWarningMacro("The input's point normals do not have 3 components; they are not transformed.");
+    vtkWarningMacro("The input's point normals have " << inNormals->GetNumberOfTuples() << " tuples of "
+                                                      << inNormals->GetNumberOfComponents() << " components for "
+                                                      << numberOfPoints
+                                                      << " points, not one of 3 per point; they are not transformed.");
     inNormals = nullptr;
   }
   vtkSmartPointer<vtkDataArray> outNormals;

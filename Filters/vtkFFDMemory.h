@@ -19,6 +19,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <iomanip>
@@ -27,27 +28,42 @@
 #include <stdexcept>
 #include <string>
 
-/// The bytes the system can still give: MemAvailable of /proc/meminfo, else the physical memory.
+/**
+ * The bytes this process can still be given: the lesser of the system's MemAvailable (/proc/meminfo; else the
+ * physical memory) and the room left under its control group's memory.max (a container's limit, past which
+ * the kernel kills the process rather than failing an allocation). An address-space limit (RLIMIT_AS) makes
+ * allocations fail instead, which the filters catch (vtkFFDCatchAllocationFailure()).
+ */
 inline double vtkFFDAvailableMemory()
 {
-  if (FILE* meminfo = std::fopen("/proc/meminfo", "r"))
-  {
+  auto readNumber = [](const char* path, const char* format, double& value) {
+    FILE* file = std::fopen(path, "r");
+    if (!file)
+    {
+      return false;
+    }
     char line[256];
-    double kilobytes = -1.0;
-    while (std::fgets(line, sizeof(line), meminfo))
+    bool found = false;
+    while (!found && std::fgets(line, sizeof(line), file))
     {
-      if (std::sscanf(line, "MemAvailable: %lf kB", &kilobytes) == 1)
-      {
-        break;
-      }
+      found = std::sscanf(line, format, &value) == 1;
     }
-    std::fclose(meminfo);
-    if (kilobytes >= 0.0)
-    {
-      return kilobytes * 1024.0;
-    }
+    std::fclose(file);
+    return found;
+  };
+  double available = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGESIZE));
+  double value;
+  if (readNumber("/proc/meminfo", "MemAvailable: %lf kB", value))
+  {
+    available = value * 1024.0;
   }
-  return double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGESIZE));
+  double used;
+  if (readNumber("/sys/fs/cgroup/memory.max", "%lf", value) &&
+    readNumber("/sys/fs/cgroup/memory.current", "%lf", used)) // "max" (no limit) reads as no number
+  {
+    available = std::min(available, std::max(0.0, value - used));
+  }
+  return available;
 }
 
 /// "12.3 GB" and the like.

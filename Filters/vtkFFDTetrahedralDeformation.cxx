@@ -391,10 +391,20 @@ std::string vtkFFDTetrahedralDeformation::SetLattice(vtkUnstructuredGrid* lattic
   {
     return "Tetrahedral lattice point " + std::to_string(notFinite) + " or its RestPosition is not finite.";
   }
-  // The connectivity is read again only when its array changed (an update usually moves nodes only).
+  // The binding numbers faces and tetrahedra by int.
+  if (numberOfCells > (VTK_INT_MAX - 3) / 4)
+  {
+    return "The tetrahedral lattice has " + std::to_string(numberOfCells) + " tetrahedra; at most " +
+      std::to_string((VTK_INT_MAX - 3) / 4) + " are supported.";
+  }
+  // The connectivity is read again only when it changed (an update usually moves nodes only): the cell array,
+  // or its arrays edited in place (vtkCellArray's time does not follow theirs), or the count of nodes its ids
+  // must stay below.
   vtkCellArray* cells = lattice->GetCells();
-  if (cells != this->NodesSource || cells->GetMTime() != this->NodesSourceMTime ||
-    this->Nodes.size() != static_cast<size_t>(4 * numberOfCells))
+  const vtkMTimeType cellsTime = std::max(
+    { cells->GetMTime(), cells->GetConnectivityArray()->GetMTime(), cells->GetOffsetsArray()->GetMTime() });
+  if (cells != this->NodesSource || cellsTime != this->NodesSourceMTime ||
+    numberOfNodes != this->NodesSourceNodeCount || this->Nodes.size() != static_cast<size_t>(4 * numberOfCells))
   {
     // Every cell's point ids are checked here, before anything reads a node through them.
     this->Nodes.resize(4 * numberOfCells);
@@ -426,7 +436,8 @@ std::string vtkFFDTetrahedralDeformation::SetLattice(vtkUnstructuredGrid* lattic
       std::copy(ids, ids + 4, this->Nodes.begin() + 4 * c);
     }
     this->NodesSource = cells;
-    this->NodesSourceMTime = cells->GetMTime();
+    this->NodesSourceMTime = cellsTime;
+    this->NodesSourceNodeCount = numberOfNodes;
     this->NodesRead = true;
   }
   return std::string();

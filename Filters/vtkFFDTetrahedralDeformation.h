@@ -154,8 +154,9 @@ private:
   std::vector<double> RestValues;    // 3 per node: RestPosition
   std::vector<double> Displacements; // 3 per node: the node minus RestPosition
   std::vector<vtkIdType> Nodes;      // 4 per tetrahedron
-  const void* NodesSource = nullptr; // the cell array Nodes was read from, and its modification time
-  vtkMTimeType NodesSourceMTime = 0;
+  const void* NodesSource = nullptr; // the cell array Nodes was read from, its and its arrays' latest
+  vtkMTimeType NodesSourceMTime = 0; // modification time, and the lattice's count of nodes then
+  vtkIdType NodesSourceNodeCount = 0;
   bool NodesRead = false; // Nodes were read again since the last Bind()
 
   // The binding and what it is for.

@@ -380,7 +380,7 @@ int vtkFFDVoxelize::RequestData(
     }
   }
 
-  const vtkIdType numCorners = static_cast<vtkIdType>(nx + 1) * (ny + 1) * (nz + 1);
+  const vtkIdType cx = vtkIdType(nx) + 1, cy = vtkIdType(ny) + 1, numCorners = cx * cy * (vtkIdType(nz) + 1);
   vtkNew<vtkPoints> corners;
   corners->SetDataTypeToDouble();
   corners->SetNumberOfPoints(numCorners);
@@ -388,7 +388,7 @@ int vtkFFDVoxelize::RequestData(
   vtkSMPTools::For(0, numCorners, [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType id = begin; id < end; ++id)
     {
-      const vtkIdType i = id % (nx + 1), j = (id / (nx + 1)) % (ny + 1), k = id / ((nx + 1) * (ny + 1));
+      const vtkIdType i = id % cx, j = (id / cx) % cy, k = id / (cx * cy);
       const ffd::Vec3<double> x =
         bound.ToWorld({ static_cast<double>(i) / nx, static_cast<double>(j) / ny, static_cast<double>(k) / nz });
       cornerArray->SetTypedTuple(id, &x.x);

@@ -6,6 +6,7 @@
 #include "vtkDataSet.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkGenericCell.h"
+#include "vtkIdList.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkNew.h"
@@ -73,13 +74,32 @@ int vtkFFDCellEdges::RequestData(
     }
   };
   vtkUnsignedCharArray* ghosts = input->GetCellGhostArray();
-  vtkNew<vtkGenericCell> cell;
   const vtkIdType numberOfCells = input->GetNumberOfCells();
+  if (ghosts && ghosts->GetNumberOfValues() != numberOfCells)
+  {
+    vtkErrorMacro(<< "The input's cell ghost array has " << ghosts->GetNumberOfValues() << " values for "
+                  << numberOfCells << " cells.");
+    output->Initialize();
+    return 0;
+  }
+  vtkNew<vtkGenericCell> cell;
+  vtkNew<vtkIdList> ids;
   for (vtkIdType cellId = 0; cellId < numberOfCells; ++cellId)
   {
     if (ghosts && (ghosts->GetValue(cellId) & vtkDataSetAttributes::HIDDENCELL))
     {
       continue;
+    }
+    input->GetCellPoints(cellId, ids); // checked before GetCell() reads the points they name
+    for (vtkIdType p = 0; p < ids->GetNumberOfIds(); ++p)
+    {
+      if (ids->GetId(p) < 0 || ids->GetId(p) >= numberOfPoints)
+      {
+        vtkErrorMacro(<< "The input's cell " << cellId << " names point " << ids->GetId(p) << ", but it has "
+                      << numberOfPoints << " points.");
+        output->Initialize();
+        return 0;
+      }
     }
     input->GetCell(cellId, cell);
     if (cell->GetCellDimension() == 1)

@@ -573,6 +573,21 @@ TEST(vtkFFDDeform, BadLatticesAreRefusedWithAClearError)
       "RestPosition" },
     { "non-finite control point",
       [](vtkStructuredGrid* l) { l->GetPoints()->SetPoint(5, 0.0, std::nan(""), 0.0); }, "not finite" },
+    // Divisions whose counts wrap in 32 or 64 bits (a product that wrapped to 0 once passed the point count).
+    { "divisions beyond an int",
+      [](vtkStructuredGrid* l) {
+        const int huge[3] = { 1431655765, 1, 1 };
+        vtkFFDDataContract::SetBasis(l, vtkFFDBuildLattice::TRICUBIC_BEZIER);
+        vtkFFDDataContract::SetDivisions(l, huge);
+      },
+      "is too large" },
+    { "a product that wraps",
+      [](vtkStructuredGrid* l) {
+        const int wrapping[3] = { 4194303, 2097151, 2097151 };
+        vtkFFDDataContract::SetBasis(l, vtkFFDBuildLattice::TRILINEAR);
+        vtkFFDDataContract::SetDivisions(l, wrapping);
+      },
+      "more than 2^31 - 1 control points" },
   };
   vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
   for (const Case& c : cases)
@@ -590,6 +605,31 @@ TEST(vtkFFDDeform, BadLatticesAreRefusedWithAClearError)
       << c.Name << ": got \"" << observer->Errors << "\"";
     EXPECT_EQ(deform->GetOutput()->GetNumberOfPoints(), 0) << c.Name;
   }
+}
+
+TEST(vtkFFDDeform, NormalsOfAnotherLengthAreWarnedAboutAndNotTransformed)
+{
+  // Point normals with one tuple for the whole mesh (read past their end before): a warning, the normals are
+  // passed through untransformed, the points are deformed as without normals.
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("bear");
+  vtkNew<vtkPolyData> withShortNormals;
+  withShortNormals->ShallowCopy(mesh);
+  vtkNew<vtkFloatArray> normals;
+  normals->SetNumberOfComponents(3);
+  normals->InsertNextTuple3(0.0, 0.0, 1.0);
+  withShortNormals->GetPointData()->SetNormals(normals);
+  Pipeline pipeline(mesh, vtkFFDBuildLattice::TRILINEAR, 2, 2, 2);
+  std::mt19937 rng(13);
+  Perturb(pipeline.Lattice, rng, 0.05);
+  vtkNew<vtkFFDDeform> deform;
+  vtkNew<FFDTestErrorObserver> observer;
+  observer->Watch(deform);
+  deform->SetInputData(withShortNormals);
+  deform->SetLatticeData(pipeline.Lattice);
+  deform->Update();
+  EXPECT_NE(observer->Warnings.find("1 tuples of 3 components"), std::string::npos) << observer->Warnings;
+  EXPECT_TRUE(observer->Errors.empty()) << observer->Errors;
+  EXPECT_LE(MaxRelativeError(mesh, deform->GetOutput(), ReferenceOf(pipeline.Lattice)), 1e-12);
 }
 
 TEST(vtkFFDDeform, ReportsProgress)

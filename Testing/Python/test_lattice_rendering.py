@@ -200,6 +200,17 @@ class LatticeActorTest(unittest.TestCase):
         self.assertTrue(any("RestPosition" in m for m in errors.messages), errors.messages)
         self.assertEqual(control.GetOutput().GetNumberOfPoints(), 0)
 
+    def test_cell_naming_a_missing_point_is_an_error(self):
+        # A tetrahedron naming point 100000 of 8: refused before any point is read through it (it crashed).
+        grid = cube_tetrahedra()
+        grid.GetCells().ReplaceCellAtId(1, 4, [0, 1, 100000, 3])
+        edges = vtkffd.vtkFFDCellEdges()
+        edges.SetInputData(grid)
+        errors = catch_errors(edges)
+        edges.Update()
+        self.assertTrue(any("names point 100000" in m for m in errors.messages), errors.messages)
+        self.assertEqual(edges.GetOutput().GetNumberOfLines(), 0)
+
     def test_no_input_renders_nothing_and_does_not_fail(self):
         actor = vtkffd.vtkFFDLatticeActor()
         self.assertIn("Lattice: (none)", str(actor))
