@@ -4,25 +4,33 @@
 # The README's two Quick start commands:
 #   Utilities/setup.sh demo [demo options]   set up, build, run the main demo (Examples/Python/deform_mesh.py)
 #   Utilities/setup.sh test [ctest options]  set up, build, run every test through ctest
+# and the sanitizer run that CI adds (README, Tests):
+#   Utilities/setup.sh sanitize [ctest options]  the same set-up, then every test of an ASan + UBSan build
 # Set-up = install the missing Debian 12 packages, fetch the real meshes, configure once, build. Every step is
 # skipped when its result is already there, so a second run only costs a no-op ninja.
 #
-# Environment: VOXELFFD_BUILD_DIR (default <repository>/build).
+# Environment: VOXELFFD_BUILD_DIR (default <repository>/build, or <repository>/build-sanitize for sanitize).
 set -euo pipefail
 
 usage() {
   echo "usage:" >&2
-  sed -n '5,6s/^#//p' "$0" >&2 # the two command lines of the header above
+  sed -n '5,6s/^#//p;8s/^#//p' "$0" >&2 # the command lines of the header above
   exit 2
 }
 
 [[ $# -ge 1 ]] || usage
 action=$1
 shift
-[[ $action == demo || $action == test ]] || usage
+[[ $action == demo || $action == test || $action == sanitize ]] || usage
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-build=${VOXELFFD_BUILD_DIR:-$root/build}
+if [[ $action == sanitize ]]; then
+  build=${VOXELFFD_BUILD_DIR:-$root/build-sanitize}
+  configure_options=(-DCMAKE_BUILD_TYPE=Debug "-DVOXELFFD_SANITIZE=address;undefined")
+else
+  build=${VOXELFFD_BUILD_DIR:-$root/build}
+  configure_options=(-DCMAKE_BUILD_TYPE=Release)
+fi
 mesh_dir=$root/Testing/Data/Meshes
 # Debian's interpreter: it has VTK's Python (vtkmodules) and numpy, which another python3 on PATH may lack.
 python=/usr/bin/python3
@@ -99,7 +107,7 @@ fi
 step "Build in ${build}"
 # Configure only when there is no build system yet (also after a configure that failed half-way).
 if [[ ! -f $build/build.ninja ]]; then
-  cmake -G Ninja -S "$root" -B "$build" -DPython3_EXECUTABLE="$python" -DCMAKE_BUILD_TYPE=Release
+  cmake -G Ninja -S "$root" -B "$build" -DPython3_EXECUTABLE="$python" "${configure_options[@]}"
 fi
 # Ninja re-runs CMake by itself when a CMakeLists.txt changed.
 cmake --build "$build"
@@ -117,5 +125,15 @@ case $action in
     step "Tests: ctest"
     # One X display for the whole suite (the caller's, or one virtual server): the tests that render use it.
     "$root/Utilities/with-display.sh" ctest --test-dir "$build" --output-on-failure "$@"
+    ;;
+  sanitize)
+    step "Tests under AddressSanitizer and UndefinedBehaviorSanitizer: ctest"
+    # Any finding fails its test (halt_on_error; the build has -fno-sanitize-recover). Leaks of third-party
+    # code are suppressed by Utilities/sanitizers/lsan.supp, each with its reason.
+    sanitizers=$root/Utilities/sanitizers
+    ASAN_OPTIONS=halt_on_error=1:detect_leaks=1:strict_string_checks=1:check_initialization_order=1 \
+      UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+      LSAN_OPTIONS=suppressions=$sanitizers/lsan.supp:print_suppressions=0 \
+      "$root/Utilities/with-display.sh" ctest --test-dir "$build" --output-on-failure "$@"
     ;;
 esac
