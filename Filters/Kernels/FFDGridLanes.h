@@ -34,6 +34,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <vector>
 
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(__CUDACC__)
@@ -58,21 +60,37 @@ enum class SimdLevel
   AVX512 = 3,
 };
 
-/// The widest level this CPU runs (None where lanes are not compiled in).
+/**
+ * The widest level this CPU runs (None where lanes are not compiled in), at most the one that the environment
+ * variable VOXELFFD_MAX_SIMD names (none, sse2, avx2 or avx512) where it is set: so that a machine runs its
+ * tests, or a user's case, as a CPU without AVX-512 or AVX2 would.
+ */
 inline SimdLevel SimdLevelOfCpu()
 {
 #if FFD_HAVE_LANES
   __builtin_cpu_init();
+  SimdLevel level = SimdLevel::SSE2;
   if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
     __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw"))
   {
-    return SimdLevel::AVX512;
+    level = SimdLevel::AVX512;
   }
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi2"))
+  else if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi2"))
   {
-    return SimdLevel::AVX2;
+    level = SimdLevel::AVX2;
   }
-  return SimdLevel::SSE2;
+  if (const char* cap = std::getenv("VOXELFFD_MAX_SIMD"))
+  {
+    const char* names[] = { "none", "sse2", "avx2", "avx512" };
+    for (int l = 0; l < int(level); ++l)
+    {
+      if (std::strcmp(cap, names[l]) == 0)
+      {
+        return SimdLevel(l);
+      }
+    }
+  }
+  return level;
 #else
   return SimdLevel::None;
 #endif
