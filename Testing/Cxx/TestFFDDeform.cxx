@@ -226,21 +226,37 @@ TEST(vtkFFDDeform, BindingIsCachedUntilPointsOrRestFrameChange)
   EXPECT_LE(MaxRelativeError(mesh, deform->GetOutput(), reshaped), 1e-12);
 }
 
+namespace
+{
+/// The mesh with point normals (vtkPolyDataNormals without splitting: the same points).
+vtkSmartPointer<vtkPolyData> WithPointNormals(vtkPolyData* mesh)
+{
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputData(mesh);
+  normals->SplittingOff();
+  normals->Update();
+  return normals->GetOutput();
+}
+
+/// A TRILINEAR lattice over 3x3x3 voxels in the frame that vtkFFDVoxelize gives the mesh.
+vtkSmartPointer<vtkStructuredGrid> TrilinearLatticeAround(vtkPolyData* mesh)
+{
+  const ffdref::Frame f = FrameOf(Pipeline(mesh, vtkFFDBuildLattice::TRILINEAR, 3, 3, 3).Lattice);
+  const int divisions[3] = { 3, 3, 3 };
+  return ffdtest::MakeLattice(f, vtkFFDBuildLattice::TRILINEAR, divisions);
+}
+}
+
 TEST(vtkFFDDeform, OutputArraysAreReusedOnlyWhenNobodyElseHoldsThem)
 {
   // An update writes into the last output's arrays when nothing else holds them (to spare the allocation);
   // arrays that a caller kept must keep the values of their own update.
   std::mt19937 rng(11);
   vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("bear");
-  vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputData(mesh);
-  normals->SplittingOff(); // the same points as the mesh
-  normals->Update();
-  const ffdref::Frame f = FrameOf(Pipeline(mesh, vtkFFDBuildLattice::TRILINEAR, 3, 3, 3).Lattice);
-  const int divisions[3] = { 3, 3, 3 };
-  vtkSmartPointer<vtkStructuredGrid> lattice = ffdtest::MakeLattice(f, vtkFFDBuildLattice::TRILINEAR, divisions);
+  vtkSmartPointer<vtkPolyData> withNormals = WithPointNormals(mesh);
+  vtkSmartPointer<vtkStructuredGrid> lattice = TrilinearLatticeAround(mesh);
   vtkNew<vtkFFDDeform> deform;
-  deform->SetInputData(normals->GetOutput());
+  deform->SetInputData(withNormals);
   deform->SetLatticeData(lattice);
   deform->ComputeJacobianDeterminantOn();
   Perturb(lattice, rng, 0.05);
@@ -296,15 +312,10 @@ TEST(vtkFFDDeform, AViewTakenAtEveryUpdateAlternatesBetweenTwoArrays)
   // exact, and the held view keeps the values of its own update.
   std::mt19937 rng(12);
   vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("bear");
-  vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputData(mesh);
-  normals->SplittingOff();
-  normals->Update();
-  const ffdref::Frame f = FrameOf(Pipeline(mesh, vtkFFDBuildLattice::TRILINEAR, 3, 3, 3).Lattice);
-  const int divisions[3] = { 3, 3, 3 };
-  vtkSmartPointer<vtkStructuredGrid> lattice = ffdtest::MakeLattice(f, vtkFFDBuildLattice::TRILINEAR, divisions);
+  vtkSmartPointer<vtkPolyData> withNormals = WithPointNormals(mesh);
+  vtkSmartPointer<vtkStructuredGrid> lattice = TrilinearLatticeAround(mesh);
   vtkNew<vtkFFDDeform> deform;
-  deform->SetInputData(normals->GetOutput());
+  deform->SetInputData(withNormals);
   deform->SetLatticeData(lattice);
   std::vector<vtkDataArray*> points, normalArrays; // each update's arrays (compared as addresses only)
   vtkSmartPointer<vtkDataArray> viewPoints, viewNormals;

@@ -145,42 +145,6 @@ inline double UniformBSpline(int i, int p, double x)
 }
 
 /**
- * Weights of all PointsAlongAxis() control points along an axis of n voxels at the parameter s in [0, 1].
- * Bezier: voxel c = floor(s n) (n - 1 at s = 1), local coordinate r = s n - c, weight C(d,i) r^i (1-r)^(d-i)
- * on control point d c + i. B-spline: in voxel units x = s n the knots are the integers, control point i's
- * cubic spans the knots i-3 .. i+1 (centred on its rest parameter (i-1)/n), so its weight is N(i-3, 3, x).
- */
-inline std::vector<double> AxisWeights(Basis b, int n, double s)
-{
-  const int count = PointsAlongAxis(b, n);
-  std::vector<double> w(count, 0.0);
-  if (b == Basis::Bernstein)
-  {
-    for (int i = 0; i < count; ++i)
-    {
-      w[i] = Bernstein(n, i, s);
-    }
-  }
-  else if (b == Basis::CubicBSpline)
-  {
-    for (int i = 0; i < count; ++i)
-    {
-      w[i] = UniformBSpline(i - 3, 3, s * n);
-    }
-  }
-  else
-  {
-    const int d = Degree(b, n);
-    const int c = std::min(int(std::floor(s * n)), n - 1);
-    for (int i = 0; i <= d; ++i)
-    {
-      w[d * c + i] = Bernstein(d, i, s * n - c);
-    }
-  }
-  return w;
-}
-
-/**
  * The order-th derivative in x of Bernstein(n, k, x), by d/dx B(n, k) = n (B(n-1, k-1) - B(n-1, k)), 0 for k outside
  * [0, n]. With `absolute`, the same recursion with each difference made a sum (and |B| at order 0): what a
  * computation of the derivative adds up before its terms cancel, the size that its rounding errors scale with.
@@ -254,6 +218,17 @@ inline std::vector<double> AxisWeightDerivatives(Basis b, int n, double s, int o
   return w;
 }
 
+/**
+ * Weights of all PointsAlongAxis() control points along an axis of n voxels at the parameter s in [0, 1].
+ * Bezier: voxel c = floor(s n) (n - 1 at s = 1), local coordinate r = s n - c, weight C(d,i) r^i (1-r)^(d-i)
+ * on control point d c + i. B-spline: in voxel units x = s n the knots are the integers, control point i's
+ * cubic spans the knots i-3 .. i+1 (centred on its rest parameter (i-1)/n), so its weight is N(i-3, 3, x).
+ */
+inline std::vector<double> AxisWeights(Basis b, int n, double s)
+{
+  return AxisWeightDerivatives(b, n, s, 0);
+}
+
 /// Rest positions X0 + RestParameter(i) S + RestParameter(j) T + RestParameter(k) U, VTK order.
 inline std::vector<Vec> RestLattice(Basis b, const Frame& f, const int divisions[3])
 {
@@ -268,29 +243,6 @@ inline std::vector<Vec> RestLattice(Basis b, const Frame& f, const int divisions
           f.X0[2] + a * f.S[2] + e * f.T[2] + c * f.U[2] });
       }
   return p;
-}
-
-/// sum_ijk w_i(s) w_j(t) w_k(u) P_ijk over the whole lattice (absolute control points, VTK order), for
-/// parameters in [0, 1].
-inline Vec EvaluateLocal(Basis b, const int divisions[3], const std::vector<Vec>& p, const Vec& stu)
-{
-  const std::vector<double> ws = AxisWeights(b, divisions[0], stu[0]);
-  const std::vector<double> wt = AxisWeights(b, divisions[1], stu[1]);
-  const std::vector<double> wu = AxisWeights(b, divisions[2], stu[2]);
-  const int ni = int(ws.size()), nj = int(wt.size());
-  Vec x = { 0, 0, 0 };
-  for (int k = 0; k < int(wu.size()); ++k)
-    for (int j = 0; j < nj; ++j)
-      for (int i = 0; i < ni; ++i)
-      {
-        const double w = ws[i] * wt[j] * wu[k];
-        const Vec& q = p[i + ni * (j + nj * k)];
-        for (int c = 0; c < 3; ++c)
-        {
-          x[c] += w * q[c];
-        }
-      }
-  return x;
 }
 
 /**
@@ -317,6 +269,13 @@ inline Vec EvaluateLocalDerivative(Basis b, const int divisions[3], const std::v
         }
       }
   return x;
+}
+
+/// sum_ijk w_i(s) w_j(t) w_k(u) P_ijk over the whole lattice (absolute control points, VTK order), for
+/// parameters in [0, 1].
+inline Vec EvaluateLocal(Basis b, const int divisions[3], const std::vector<Vec>& p, const Vec& stu)
+{
+  return EvaluateLocalDerivative(b, divisions, p, stu, { 0, 0, 0 }, { -1, -1, -1 });
 }
 
 /// The rows of d(s, t, u)/dX (equation 2's dual vectors): (T x U)/(S . T x U), (S x U)/(T . S x U), (S x T)/(U . S x T).
