@@ -3,7 +3,7 @@
  * @class   vtkFFDDataContract
  * @brief   names and accessors of the arrays that voxel grids and lattices carry
  *
- * vtkFFDVoxelize, vtkFFDBuildLattice and vtkFFDDeform agree on a small data contract (ARCHITECTURE.md):
+ * vtkFFDVoxelize, vtkFFDBuildLattice and vtkFFDDeform agree on a small data contract (README, "Data contract"):
  *
  * | name           | where                 | what                                                         |
  * |----------------|-----------------------|--------------------------------------------------------------|

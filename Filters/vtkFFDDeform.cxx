@@ -453,8 +453,8 @@ using PointArrays = vtkArrayDispatch::Reals;
 //------------------------------------------------------------------------------------------------------------
 // The arrays of one role (points, normals, determinants) of the last outputs, so that an update writes into one
 // that nothing else holds any more (then nobody can see it change: not the output, which the executive emptied
-// before RequestData, nor a caller) instead of a new one: reuse spares the allocation and its page faults, for
-// 6.7 M float points 80 MB that cost as much as the evaluation itself. Two are kept: the last output's, and
+// before RequestData, nor a caller) instead of a new one: reuse spares the allocation and its page faults
+// (BENCHMARKS.md measures them). Two are kept: the last output's, and
 // the one before it where a caller held that one (a numpy view taken at every update): once the caller takes
 // a view of the new output and lets the old one go, the next update writes into the old one.
 struct KeptArrays

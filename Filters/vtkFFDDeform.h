@@ -16,11 +16,9 @@
  * newer modification time or another count), when the lattice's rest frame, divisions or basis change, or
  * when the outside policy changes; moving lattice points only re-runs the evaluation, which for a local basis
  * touches only the 8, 27 or 64 control points of the point's voxel. GetNumberOfBindings() counts the bindings.
- * An input whose vertex order is spatially random also keeps, with its binding, the points of its blocks of
- * 16 in several voxels listed by voxel within tiles of 32768 points (10.5 bytes per point: its index, voxel
- * and place in the list) and, from the first evaluation, a copy of their coordinates in that order (12 bytes
- * per point in float32, 24 in float64), read in order by every evaluation; each thread stages a tile's
- * results (384 KB in float32, 768 KB in float64) before writing them out in point order.
+ * An input whose vertex order is spatially random keeps more with its binding: a copy of its points in the
+ * order they are evaluated in, about 23 bytes a point in float32 (35 in float64), and a few hundred KB a
+ * thread (README, "What the filters do", says how it is used).
  *
  * Points outside the frame keep their input position (KEEP_POSITION, the default) or take the displacement at
  * the frame point of their parameters clamped to [0, 1] (CLAMP_TO_EDGE; the nearest point of a box frame; not
