@@ -27,8 +27,6 @@
 
 vtkStandardNewMacro(vtkFFDBuildLattice);
 
-namespace
-{
 // The filter's enum and the kernels' enum name the same bases: the `FFDBasis` field array holds either.
 static_assert(int(ffd::GridBasis::Bernstein) == vtkFFDBuildLattice::BERNSTEIN &&
     int(ffd::GridBasis::Trilinear) == vtkFFDBuildLattice::TRILINEAR &&
@@ -37,18 +35,16 @@ static_assert(int(ffd::GridBasis::Bernstein) == vtkFFDBuildLattice::BERNSTEIN &&
     int(ffd::GridBasis::CubicBSpline) == vtkFFDBuildLattice::CUBIC_BSPLINE,
   "vtkFFDBuildLattice::Bases and ffd::GridBasis disagree");
 
-/**
- * The control points per axis of `basis` over `divisions` voxels; false with the reason (and its remedy) in
- * `why`. The per-basis formulas (points per axis, rest parameters, supports) live in FFDGridBasis.h, shared
- * with the deformation kernels, so that the lattice and its evaluation cannot disagree.
- */
-bool LatticePointsPerAxis(int basis, const int divisions[3], int points[3], std::string& why)
+//------------------------------------------------------------------------------
+// The per-basis formulas (points per axis, rest parameters, supports) live in FFDGridBasis.h, shared with the
+// deformation kernels, so that the lattice and its evaluation cannot disagree.
+bool vtkFFDBuildLattice::GetControlPointsPerAxis(int basis, const int divisions[3], int points[3], std::string& why)
 {
   if (!ffd::IsGridBasis(basis))
   {
     std::ostringstream msg;
-    msg << "unknown basis " << basis << ": use one of BERNSTEIN (" << vtkFFDBuildLattice::BERNSTEIN
-        << ") to CUBIC_BSPLINE (" << vtkFFDBuildLattice::CUBIC_BSPLINE << ").";
+    msg << "unknown basis " << basis << ": use one of BERNSTEIN (" << BERNSTEIN
+        << ") to CUBIC_BSPLINE (" << CUBIC_BSPLINE << ").";
     why = msg.str();
     return false;
   }
@@ -60,15 +56,15 @@ bool LatticePointsPerAxis(int basis, const int divisions[3], int points[3], std:
     {
       std::ostringstream msg;
       msg << "the BERNSTEIN basis would have degree " << divisions[a] << " along axis " << a
-          << ", above the maximum " << ffd::MaxBernsteinDegree << ": give vtkFFDVoxelize at most "
-          << ffd::MaxBernsteinDegree << " divisions per axis, or use a local basis (e.g. SetBasisToTrilinear()).";
+          << ", above the maximum " << ffd::MaxBernsteinDegree << ": use at most " << ffd::MaxBernsteinDegree
+          << " divisions per axis, or a local basis (e.g. TRILINEAR).";
       why = msg.str();
       return false;
     }
     if (divisions[a] > (VTK_INT_MAX - 1) / 3)
     {
-      why = "its " + std::to_string(divisions[a]) + " divisions along axis " + std::to_string(a) +
-        " would need more control points than an int counts.";
+      why = "the divisions " + std::to_string(divisions[a]) + " along axis " + std::to_string(a) +
+        " is too large: more control points than an int counts.";
       return false;
     }
     points[a] = ffd::ControlPointsAlongAxis(grid, divisions[a]);
@@ -77,14 +73,13 @@ bool LatticePointsPerAxis(int basis, const int divisions[3], int points[3], std:
   if (double(points[0]) * points[1] * points[2] > double(VTK_INT_MAX))
   {
     std::ostringstream msg;
-    msg << "the " << vtkFFDBuildLattice::GetBasisAsString(basis) << " lattice over " << divisions[0] << "x"
+    msg << "the " << GetBasisAsString(basis) << " lattice over " << divisions[0] << "x"
         << divisions[1] << "x" << divisions[2] << " voxels would have more than 2^31 - 1 control points.";
     why = msg.str();
     return false;
   }
   return true;
 }
-} // namespace
 
 //------------------------------------------------------------------------------
 vtkFFDBuildLattice::vtkFFDBuildLattice()
@@ -130,7 +125,7 @@ int vtkFFDBuildLattice::RequestInformation(
   }
   int points[3];
   std::string why;
-  if (!LatticePointsPerAxis(this->Basis, divisions, points, why))
+  if (!GetControlPointsPerAxis(this->Basis, divisions, points, why))
   {
     vtkErrorMacro(<< "Cannot build the lattice: " << why);
     return 0;
@@ -215,7 +210,7 @@ int vtkFFDBuildLattice::RequestData(
   }
   int pointsPerAxis[3];
   std::string why;
-  if (!LatticePointsPerAxis(this->Basis, divisions, pointsPerAxis, why))
+  if (!GetControlPointsPerAxis(this->Basis, divisions, pointsPerAxis, why))
   {
     vtkErrorMacro(<< "Cannot build the lattice: " << why);
     return 0;

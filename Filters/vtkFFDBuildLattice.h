@@ -42,6 +42,9 @@
 
 #include "vtkFFDFiltersModule.h" // For export macro
 #include "vtkStructuredGridAlgorithm.h"
+#include "vtkWrappingHints.h" // For VTK_WRAPEXCLUDE
+
+#include <string> // For GetControlPointsPerAxis
 
 class VTKFFDFILTERS_EXPORT vtkFFDBuildLattice : public vtkStructuredGridAlgorithm
 {
@@ -71,6 +74,14 @@ public:
   const char* GetBasisAsString() { return GetBasisAsString(this->Basis); }
   static const char* GetBasisAsString(int basis);
   ///@}
+
+  /**
+   * The control points per axis of a lattice of `basis` over `divisions` voxels: false, with the reason and its
+   * remedy in `why`, for an unknown basis, a BERNSTEIN degree above the maximum, or more control points than the
+   * deformation indexes (2^31 - 1). This filter and vtkFFDDeform check lattices by it.
+   */
+  VTK_WRAPEXCLUDE static bool GetControlPointsPerAxis(
+    int basis, const int divisions[3], int points[3], std::string& why);
 
   /// Number of control points marked active by the last execution.
   vtkGetMacro(NumberOfActiveControlPoints, vtkIdType);

@@ -303,9 +303,9 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   std::ostringstream request;
   request << "SubdivisionLevels " << this->SubdivisionLevels << " (" << this->NumberOfHullFaces
           << " hull faces, so " << finalTetrahedra << " tetrahedra)";
-  if (finalTetrahedra > double((VTK_INT_MAX - 3) / 4)) // the deformation numbers faces and tetrahedra by int
+  if (finalTetrahedra > double(vtkFFDTetrahedralDeformation::MaxTetrahedra))
   {
-    vtkErrorMacro(<< request.str() << " exceeds the " << (VTK_INT_MAX - 3) / 4
+    vtkErrorMacro(<< request.str() << " exceeds the " << vtkFFDTetrahedralDeformation::MaxTetrahedra
                   << " tetrahedra a lattice may have: choose fewer levels.");
     return 0;
   }

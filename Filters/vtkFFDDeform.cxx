@@ -88,26 +88,10 @@ std::string ReadLattice(vtkPointSet* lattice, LatticeView& view)
     return "The lattice's FFDBasis " + std::to_string(basis) + " is not a known basis." + fix;
   }
   view.Basis = static_cast<ffd::GridBasis>(basis);
-  for (int a = 0; a < 3; ++a)
+  std::string why;
+  if (!vtkFFDBuildLattice::GetControlPointsPerAxis(basis, view.Divisions, view.Dims, why))
   {
-    if (view.Basis == ffd::GridBasis::Bernstein && view.Divisions[a] > ffd::MaxBernsteinDegree)
-    {
-      return "The lattice's Bernstein degree " + std::to_string(view.Divisions[a]) + " exceeds the maximum " +
-        std::to_string(ffd::MaxBernsteinDegree) + ".";
-    }
-    if (view.Divisions[a] > (VTK_INT_MAX - 1) / 3) // more control points than an int counts
-    {
-      return "The lattice's FFDDivisions " + std::to_string(view.Divisions[a]) + " along axis " +
-        std::to_string(a) + " is too large." + fix;
-    }
-    view.Dims[a] = ffd::ControlPointsAlongAxis(view.Basis, view.Divisions[a]);
-  }
-  // The kernels index control points and cells by int: the product is checked in double, where it cannot wrap.
-  if (double(view.Dims[0]) * view.Dims[1] * view.Dims[2] > double(VTK_INT_MAX))
-  {
-    return "The lattice's FFDDivisions " + std::to_string(view.Divisions[0]) + "x" +
-      std::to_string(view.Divisions[1]) + "x" + std::to_string(view.Divisions[2]) +
-      " need more than 2^31 - 1 control points." + fix;
+    return "The lattice's FFDDivisions do not fit its FFDBasis: " + why;
   }
   const vtkIdType expected = vtkIdType(view.Dims[0]) * view.Dims[1] * view.Dims[2];
   const vtkIdType count = lattice->GetNumberOfPoints();

@@ -391,11 +391,10 @@ std::string vtkFFDTetrahedralDeformation::SetLattice(vtkUnstructuredGrid* lattic
   {
     return "Tetrahedral lattice point " + std::to_string(notFinite) + " or its RestPosition is not finite.";
   }
-  // The binding numbers faces and tetrahedra by int.
-  if (numberOfCells > (VTK_INT_MAX - 3) / 4)
+  if (numberOfCells > MaxTetrahedra)
   {
     return "The tetrahedral lattice has " + std::to_string(numberOfCells) + " tetrahedra; at most " +
-      std::to_string((VTK_INT_MAX - 3) / 4) + " are supported.";
+      std::to_string(MaxTetrahedra) + " are supported.";
   }
   // The connectivity is read again only when it changed (an update usually moves nodes only): the cell array,
   // or its arrays edited in place (vtkCellArray's time does not follow theirs), or the count of nodes its ids

@@ -64,14 +64,17 @@ public:
     EXTRAPOLATE = 2
   };
 
+  /// The most tetrahedra a lattice may have: the binding numbers their faces (4 a tetrahedron) by int.
+  static constexpr vtkIdType MaxTetrahedra = (VTK_INT_MAX - 3) / 4;
+
   /// Whether `lattice` is meant as a tetrahedral lattice: a vtkUnstructuredGrid without the `FFDFrame` of grid
   /// lattices (SetLattice() then says what else is wrong with it, if anything).
   static bool IsTetrahedralLattice(vtkDataObject* lattice);
 
   /**
    * Reads and checks a tetrahedral lattice and keeps its nodes' displacements for Evaluate(). Returns an empty
-   * string, or what is wrong: cells other than tetrahedra, no or a malformed `RestPosition`, non-finite
-   * positions, no cells.
+   * string, or what is wrong: cells other than tetrahedra or more than MaxTetrahedra, point ids outside the
+   * lattice, no or a malformed `RestPosition`, non-finite positions, no cells.
    */
   std::string SetLattice(vtkUnstructuredGrid* lattice);
 
