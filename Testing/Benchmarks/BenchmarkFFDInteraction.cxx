@@ -20,24 +20,22 @@
  * Utilities/with-display.sh build/bin/BenchmarkFFDInteraction)
  */
 #include "vtkActor.h"
+#include "FFDBenchmarkMeshes.h"
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDeform.h"
 #include "vtkFFDLatticeActor.h"
 #include "vtkFFDLatticeRepresentation.h"
 #include "vtkFFDVoxelize.h"
-#include "vtkLinearSubdivisionFilter.h"
 #include "vtkMath.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkPolyData.h"
 #include "vtkPolyDataMapper.h"
-#include "vtkPolyDataNormals.h"
 #include "vtkProperty.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkSMPTools.h"
 #include "vtkStructuredGrid.h"
-#include "vtkXMLPolyDataReader.h"
 
 #include <algorithm>
 #include <chrono>
@@ -89,17 +87,7 @@ int main(int argc, char* argv[])
     }
   }
 
-  vtkNew<vtkXMLPolyDataReader> reader;
-  reader->SetFileName(meshPath.c_str());
-  vtkNew<vtkLinearSubdivisionFilter> subdivide;
-  subdivide->SetInputConnection(reader->GetOutputPort());
-  subdivide->SetNumberOfSubdivisions(levels);
-  vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputConnection(levels > 0 ? subdivide->GetOutputPort() : reader->GetOutputPort());
-  normals->SplittingOff();
-  normals->Update();
-  vtkNew<vtkPolyData> mesh;
-  mesh->ShallowCopy(normals->GetOutput());
+  const vtkSmartPointer<vtkPolyData> mesh = ShadedSubdividedMesh(meshPath, levels);
   if (mesh->GetNumberOfPoints() == 0)
   {
     std::fprintf(stderr, "%s: no points (run Utilities/setup.sh to fetch the meshes)\n", meshPath.c_str());

@@ -14,23 +14,21 @@
  *
  * Usage: SoakFFD [--mesh FILE.vtp] [--updates N]   (default 10000)
  */
+#include "FFDBenchmarkMeshes.h"
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDBuildTetrahedralLattice.h"
 #include "vtkFFDDeform.h"
 #include "vtkFFDLatticeRepresentation.h"
 #include "vtkFFDVoxelize.h"
-#include "vtkLinearSubdivisionFilter.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
-#include "vtkPolyDataNormals.h"
 #include "vtkSMPTools.h"
 #include "vtkSmartPointer.h"
 #include "vtkStructuredGrid.h"
 #include "vtkUnstructuredGrid.h"
-#include "vtkXMLPolyDataReader.h"
 
 #include <unistd.h>
 
@@ -85,17 +83,7 @@ int main(int argc, char* argv[])
       updates = std::max(1001, std::atoi(argv[a + 1]));
     }
   }
-  vtkNew<vtkXMLPolyDataReader> reader;
-  reader->SetFileName(meshPath.c_str());
-  vtkNew<vtkLinearSubdivisionFilter> subdivide;
-  subdivide->SetInputConnection(reader->GetOutputPort());
-  subdivide->SetNumberOfSubdivisions(2);
-  vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputConnection(subdivide->GetOutputPort());
-  normals->SplittingOff();
-  normals->Update();
-  vtkNew<vtkPolyData> mesh;
-  mesh->ShallowCopy(normals->GetOutput());
+  const vtkSmartPointer<vtkPolyData> mesh = ShadedSubdividedMesh(meshPath, 2);
   if (mesh->GetNumberOfPoints() == 0)
   {
     std::fprintf(stderr, "%s: no points (run Utilities/setup.sh to fetch the meshes)\n", meshPath.c_str());
