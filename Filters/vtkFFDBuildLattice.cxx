@@ -94,17 +94,17 @@ const char* vtkFFDBuildLattice::GetBasisAsString(int basis)
   switch (basis)
   {
     case BERNSTEIN:
-      return "BERNSTEIN";
+      return "Bernstein";
     case TRILINEAR:
-      return "TRILINEAR";
+      return "Trilinear";
     case TRIQUADRATIC_BEZIER:
-      return "TRIQUADRATIC_BEZIER";
+      return "TriquadraticBezier";
     case TRICUBIC_BEZIER:
-      return "TRICUBIC_BEZIER";
+      return "TricubicBezier";
     case CUBIC_BSPLINE:
-      return "CUBIC_BSPLINE";
+      return "CubicBSpline";
     default:
-      return "UNKNOWN";
+      return "Unknown";
   }
 }
 

@@ -15,28 +15,6 @@
 #include <algorithm>
 #include <vector>
 
-//------------------------------------------------------------------------------------------------------------
-vtkFFDBindingKey vtkFFDBindingKey::Of(
-  vtkPoints* points, const double frame[12], const int divisions[3], int basis, int outsidePolicy)
-{
-  vtkFFDBindingKey key;
-  key.Points = points;
-  key.PointsMTime = points->GetMTime();
-  key.NumberOfPoints = points->GetNumberOfPoints();
-  std::copy(frame, frame + 12, key.Frame.begin());
-  std::copy(divisions, divisions + 3, key.Divisions.begin());
-  key.Basis = basis;
-  key.OutsidePolicy = outsidePolicy;
-  return key;
-}
-
-bool vtkFFDBindingKey::operator==(const vtkFFDBindingKey& other) const
-{
-  return this->Points == other.Points && this->PointsMTime == other.PointsMTime &&
-    this->NumberOfPoints == other.NumberOfPoints && this->Frame == other.Frame &&
-    this->Divisions == other.Divisions && this->Basis == other.Basis && this->OutsidePolicy == other.OutsidePolicy;
-}
-
 #ifdef VOXELFFD_HAS_CUDA
 namespace
 {
@@ -140,7 +118,7 @@ struct vtkFFDCudaBackend::vtkState
     this->GridKey = vtkFFDBindingKey(); // valid again once everything succeeded
     if (!Run(
           this->Grid, this->GridNormals, rebind, rebind, points, normals, outPoints, outNormals, outDeterminants,
-          [&] { return this->Grid.Bind(key.Frame.data(), key.Basis, key.Divisions.data(), key.OutsidePolicy != 0); },
+          [&] { return this->Grid.Bind(key.Frame.data(), key.Basis, key.Divisions.data(), key.ClampsOutside()); },
           [&](bool withNormals, bool withDeterminants) {
             return this->Grid.Evaluate(displacements, controlPoints, withNormals, withDeterminants);
           }))

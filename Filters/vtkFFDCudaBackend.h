@@ -16,35 +16,15 @@
 #ifndef vtkFFDCudaBackend_h
 #define vtkFFDCudaBackend_h
 
+#include "vtkFFDBindingKey.h"
 #include "vtkType.h"
 
-#include <array>
 #include <memory>
 #include <string>
 
 class vtkDataArray;
 class vtkFFDTetrahedralDeformation;
 class vtkPoints;
-
-/// What a binding was computed for: the input's points (identity, modification time, count), the lattice's rest
-/// frame, divisions and basis, and the outside policy. Points are compared by identity and modification time (a
-/// new vtkPoints at a recycled address has a newer MTime); the lattice by values, so that a rebuilt but
-/// identical lattice keeps the binding.
-struct vtkFFDBindingKey
-{
-  const vtkPoints* Points = nullptr;
-  vtkMTimeType PointsMTime = 0;
-  vtkIdType NumberOfPoints = -1;
-  std::array<double, 12> Frame{};
-  std::array<int, 3> Divisions{};
-  int Basis = -1;
-  int OutsidePolicy = -1;
-
-  static vtkFFDBindingKey Of(
-    vtkPoints* points, const double frame[12], const int divisions[3], int basis, int outsidePolicy);
-  bool operator==(const vtkFFDBindingKey& other) const;
-  bool operator!=(const vtkFFDBindingKey& other) const { return !(*this == other); }
-};
 
 class vtkFFDCudaBackend
 {

@@ -62,9 +62,12 @@
 #include "vtkFFDFiltersModule.h" // For export macro
 #include "vtkPointSetAlgorithm.h"
 
-#include <memory> // For std::unique_ptr
+#include <functional> // For std::function
+#include <memory>     // For std::unique_ptr
+#include <string>     // For std::string
 
 class vtkDataArray;
+class vtkPoints;
 
 class VTKFFDFILTERS_EXPORT vtkFFDDeform : public vtkPointSetAlgorithm
 {
@@ -153,8 +156,7 @@ protected:
   vtkTypeBool ProcessRequest(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   /// Gives the output the input's structure and data, the deformed points and the transformed normals and det J.
-  void FillOutput(vtkPointSet* input, vtkPointSet* output, vtkDataArray* points, vtkDataArray* normals,
-    vtkDataArray* determinants);
+  void FillOutput(vtkPointSet* input, vtkPointSet* output);
 
   int OutsidePolicy;
   int Backend;
@@ -167,6 +169,15 @@ protected:
 private:
   vtkFFDDeform(const vtkFFDDeform&) = delete;
   void operator=(const vtkFFDDeform&) = delete;
+
+  // The steps of RequestData().
+  vtkDataArray* GetNormalsToTransform(vtkPointSet* input);
+  void MakeOutputArrays(vtkPoints* points, vtkDataArray* normals);
+  bool DeformByGrid(vtkPoints* points, vtkDataArray* normals);
+  bool DeformByTetrahedra(vtkPoints* points, vtkDataArray* normals);
+  /// True when `deform` deformed on the GPU, where the Backend setting and a device allow it; false when the
+  /// CPU must, with a warning where CUDA was asked for and cannot run, or failed.
+  bool DeformedOnCuda(const std::function<bool(std::string& why)>& deform);
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

@@ -2,6 +2,7 @@
 #include "vtkFFDTetrahedralDeformation.h"
 
 #include "vtkFFDDataContract.h"
+#include "vtkFFDDeformPoints.h"
 #include "vtkFFDForInChunks.h"
 #include "vtkFFDLatticeDisplacements.h"
 
@@ -277,51 +278,6 @@ Seeds MakeSeeds(const std::vector<double>& rest, const Walker& walk)
 }
 
 //------------------------------------------------------------------------------------------------------------
-// Evaluation in the precision Real of the output points.
-template <typename Real, typename PointArrayT>
-struct EvaluateFunctor
-{
-  PointArrayT* InPoints;
-  Real* OutPoints;
-  const int* Cells;
-  const ffd::TetrahedronMap<Real>* Maps;
-  vtkDataArray* InNormals; // nullptr: no normals to transform
-  vtkDataArray* OutNormals;
-  Real* Determinants; // nullptr: not asked for
-
-  void operator()(vtkIdType begin, vtkIdType end)
-  {
-    const auto inPoints = vtk::DataArrayTupleRange<3>(this->InPoints, begin, end);
-    vtkIdType id = begin;
-    for (const auto x : inPoints)
-    {
-      const ffd::Vec3<Real> xr = { Real(x[0]), Real(x[1]), Real(x[2]) };
-      const int cell = this->Cells[id];
-      const ffd::Vec3<Real> y = cell >= 0 ? this->Maps[cell].Deform(xr) : xr;
-      Real* out = this->OutPoints + 3 * id;
-      out[0] = y.x;
-      out[1] = y.y;
-      out[2] = y.z;
-      if (this->OutNormals || this->Determinants)
-      {
-        const ffd::Mat3<Real> jacobian = cell >= 0 ? this->Maps[cell].Jacobian() : ffd::Mat3<Real>::Identity();
-        if (this->OutNormals)
-        {
-          double n[3];
-          this->InNormals->GetTuple(id, n);
-          const ffd::Vec3<Real> m = ffd::TransformNormal(jacobian, ffd::Vec3<Real>::From(n));
-          this->OutNormals->SetTuple3(id, m.x, m.y, m.z);
-        }
-        if (this->Determinants)
-        {
-          this->Determinants[id] = ffd::Determinant(jacobian);
-        }
-      }
-      ++id;
-    }
-  }
-};
-
 template <typename Real>
 struct EvaluateWorker
 {
@@ -330,11 +286,10 @@ struct EvaluateWorker
     vtkDataArray* inNormals, vtkDataArray* outNormals, Real* outPoints, Real* determinants, vtkAlgorithm* self,
     double progressBegin, double progressEnd, bool& completed)
   {
-    EvaluateFunctor<Real, PointArrayT> functor{ inPoints, outPoints, cells, maps, inNormals, outNormals,
-      determinants };
     const vtkIdType n = inPoints->GetNumberOfTuples();
     // A point reads its tetrahedron's affine map (12 numbers) and applies it.
-    completed = vtkFFDForInChunks(self, n, vtkFFDGrain(n, 8.0), functor, progressBegin, progressEnd);
+    completed = vtkFFDDeformPoints(inPoints, cells, ffd::TetrahedralDeformation<Real>{ maps }, inNormals,
+      outNormals, outPoints, determinants, self, vtkFFDGrain(n, 8.0), progressBegin, progressEnd);
   }
 };
 } // namespace

@@ -25,11 +25,11 @@ const char* vtkFFDControlPoints::GetSelectionAsString()
   switch (this->Selection)
   {
     case ACTIVE:
-      return "ACTIVE";
+      return "Active";
     case CULLED:
-      return "CULLED";
+      return "Culled";
     default:
-      return "ALL";
+      return "All";
   }
 }
 

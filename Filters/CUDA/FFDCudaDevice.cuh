@@ -13,7 +13,7 @@
 
 #include "FFDCudaResidentPoints.h"
 
-#include "FFDVector.h"
+#include "FFDDeformPoint.h"
 
 #include <cuda_runtime.h>
 
@@ -93,17 +93,15 @@ struct Buffer
 };
 
 //------------------------------------------------------------------------------------------------------------
-// With the Jacobian (normals, determinants) one point a thread; without, four points a thread, ThreadsPerBlock
-// apart (consecutive threads, consecutive points), so that their independent lattice gathers overlap, and an
-// instantiation that needs fewer registers. Launch bounds keep at least 4 (6) blocks of 256 threads on a
-// multiprocessor: the gathers are dependent loads, and more threads in flight hide their latency. Trilinear on
-// an H200: 58-62 % of the copy roofline with one point a thread, 64-70 % with four. (Staging the points through
-// shared memory was slower.) For float32 without the Jacobian DeformPointsKernel is faster on trilinear grids and
-// tetrahedra; for the local bases of 3 or 4 control points per axis its layout, the float4 lattice or CellSplit
-// were up to 20 % slower on an H200 (BENCHMARKS.md), so they stay on this kernel.
-template <typename Deformer, typename Real, bool WithJacobian>
+// Points one at a time through ffd::DeformBoundPoint, the CPU's per-point function. With the Jacobian
+// (normals, determinants) one point a thread; without, four points a thread, ThreadsPerBlock apart (consecutive
+// threads, consecutive points), so that their independent lattice gathers overlap. Launch bounds keep at least
+// 4 (6) blocks of 256 threads on a multiprocessor: the gathers are dependent loads, and more threads in flight
+// hide their latency. DeformPointsKernel is the faster choice only for float32 trilinear grids and tetrahedra
+// (BENCHMARKS.md).
+template <typename Deformation, typename Real, bool WithJacobian>
 __global__ void __launch_bounds__(ThreadsPerBlock, WithJacobian ? 4 : 6) DeformKernel(const Real* __restrict__ points,
-  const int* __restrict__ cells, std::int64_t count, Deformer deformation,
+  const int* __restrict__ cells, std::int64_t count, Deformation deformation,
   Real* __restrict__ outPoints, const Real* __restrict__ normals, Real* __restrict__ outNormals,
   Real* __restrict__ determinants)
 {
@@ -117,45 +115,18 @@ __global__ void __launch_bounds__(ThreadsPerBlock, WithJacobian ? 4 : 6) DeformK
     {
       return;
     }
-    const Real* p = points + 3 * i;
-    const ffd::Vec3<Real> x = { p[0], p[1], p[2] };
-    const int cell = cells[i];
-    ffd::Vec3<Real> y = x;
-    ffd::Mat3<Real> jacobian = ffd::Mat3<Real>::Identity();
-    if (cell >= 0)
-    {
-      y = WithJacobian ? deformation.Deform(x, cell, jacobian) : deformation.Deform(x, cell);
-    }
-    Real* out = outPoints + 3 * i;
-    out[0] = y.x;
-    out[1] = y.y;
-    out[2] = y.z;
-    if (!WithJacobian)
-    {
-      continue;
-    }
-    if (outNormals)
-    {
-      const ffd::Vec3<Real> n = ffd::TransformNormal(jacobian, ffd::Vec3<Real>::From(normals + 3 * i));
-      outNormals[3 * i] = n.x;
-      outNormals[3 * i + 1] = n.y;
-      outNormals[3 * i + 2] = n.z;
-    }
-    if (determinants)
-    {
-      determinants[i] = ffd::Determinant(jacobian);
-    }
+    ffd::DeformBoundPoint<WithJacobian>(deformation, ffd::Vec3<Real>::From(points + 3 * i), cells[i],
+      outPoints + 3 * i, outNormals ? normals + 3 * i : nullptr, outNormals ? outNormals + 3 * i : nullptr,
+      determinants ? determinants + i : nullptr);
   }
 }
 
 // Float32 points without the Jacobian (the common update): each thread deforms four consecutive points, read as
 // three 16-byte words (and their cells as one) with streaming hints (they are touched once) and written alike.
-// Launch bounds allow 64 registers: all four points' loads are issued before the first lattice gather. Trilinear
-// on an H200, 16 M points: 0.158-0.161 ms with DeformKernel, 0.135-0.139 ms so (BENCHMARKS.md says what each part
-// gave; the grid's deformation object there also splits the cell by multiplications and reads a float4 lattice).
-template <typename Deformer>
+// Launch bounds allow 64 registers, so that all four points' loads are issued before the first lattice gather.
+template <typename Deformation>
 __global__ void __launch_bounds__(ThreadsPerBlock, 4) DeformPointsKernel(const float* __restrict__ points,
-  const int* __restrict__ cells, std::int64_t count, Deformer deformation, float* __restrict__ outPoints)
+  const int* __restrict__ cells, std::int64_t count, Deformation deformation, float* __restrict__ outPoints)
 {
   auto deform = [&](ffd::Vec3<float>& x, int cell) {
     if (cell >= 0)
@@ -193,29 +164,29 @@ __global__ void __launch_bounds__(ThreadsPerBlock, 4) DeformPointsKernel(const f
 
 // Launches DeformKernel over `count` points on `stream`: with the Jacobian where normals or determinants are asked
 // for.
-template <typename Deformer, typename Real>
-void LaunchDeform(const Deformer& deformation, const Real* points, const int* cells, std::int64_t count,
+template <typename Deformation, typename Real>
+void LaunchDeform(const Deformation& deformation, const Real* points, const int* cells, std::int64_t count,
   Real* outPoints, const Real* normals, Real* outNormals, Real* determinants, cudaStream_t stream)
 {
   if (outNormals || determinants)
   {
-    DeformKernel<Deformer, Real, true><<<BlocksFor(count), ThreadsPerBlock, 0, stream>>>(
+    DeformKernel<Deformation, Real, true><<<BlocksFor(count), ThreadsPerBlock, 0, stream>>>(
       points, cells, count, deformation, outPoints, normals, outNormals, determinants);
   }
   else
   {
-    DeformKernel<Deformer, Real, false><<<BlocksFor((count + 3) / 4), ThreadsPerBlock, 0, stream>>>(
+    DeformKernel<Deformation, Real, false><<<BlocksFor((count + 3) / 4), ThreadsPerBlock, 0, stream>>>(
       points, cells, count, deformation, outPoints, nullptr, nullptr, nullptr);
   }
 }
 
 // Launches DeformPointsKernel over `count` float32 points on `stream`.
-template <typename Deformer>
+template <typename Deformation>
 void LaunchDeformPoints(
-  const Deformer& deformation, const float* points, const int* cells, std::int64_t count, float* outPoints,
+  const Deformation& deformation, const float* points, const int* cells, std::int64_t count, float* outPoints,
   cudaStream_t stream)
 {
-  DeformPointsKernel<Deformer><<<BlocksFor((count + 3) / 4), ThreadsPerBlock, 0, stream>>>(
+  DeformPointsKernel<Deformation><<<BlocksFor((count + 3) / 4), ThreadsPerBlock, 0, stream>>>(
     points, cells, count, deformation, outPoints);
 }
 } // namespace detail

@@ -31,59 +31,18 @@ using detail::Check;
 using detail::CudaError;
 using detail::ThreadsPerBlock;
 
-// The binding's flat cell index ci + cx (cj + cy ck) taken apart with multiplications instead of the integer
-// divisions of GridDeformation::CellIndices() (some 30 instructions a point less; same indices). n / d is
-// (n M) >> S with S = 31 + ceil(log2 d) and M = ceil(2^S / d) < 2^32, exact for every 0 <= n < 2^31 (Granlund and
-// Montgomery, "Division by invariant integers using multiplication", 1994: M d - 2^S < d <= 2^(S - 31)).
-struct CellSplit
-{
-  unsigned M[2];
-  int S[2];
-  int D[2];
-
-  static CellSplit For(ffd::GridBasis basis, const int divisions[3])
-  {
-    CellSplit split;
-    for (int a = 0; a < 2; ++a)
-    {
-      const int d = ffd::BindingCells(basis, divisions[a]);
-      int log2 = 0;
-      while ((std::uint64_t(1) << log2) < std::uint64_t(d))
-      {
-        ++log2;
-      }
-      split.S[a] = 31 + log2;
-      split.M[a] = unsigned(((std::uint64_t(1) << split.S[a]) + std::uint64_t(d) - 1) / std::uint64_t(d));
-      split.D[a] = d;
-    }
-    return split;
-  }
-
-  __device__ __forceinline__ void Apply(int cell, int c[3]) const
-  {
-    FFD_UNROLL
-    for (int a = 0; a < 2; ++a)
-    {
-      const int q = int((unsigned long long)unsigned(cell) * this->M[a] >> this->S[a]);
-      c[a] = cell - q * this->D[a];
-      cell = q;
-    }
-    c[2] = cell;
-  }
-};
-
-// A grid's deformation on a float4 lattice whose cells are split by CellSplit, for DeformPointsKernel.
-template <typename Deformer>
+// A grid's deformation on a float4 lattice whose cells are split by ffd::CellSplit, for DeformPointsKernel.
+template <typename GridDeformationT>
 struct SplitCellDeformation
 {
-  Deformer Deformation;
-  CellSplit Split;
+  GridDeformationT Grid;
+  ffd::CellSplit Split;
 
   __device__ __forceinline__ ffd::Vec3<float> Deform(const ffd::Vec3<float>& x, int cell) const
   {
     int c[3];
-    this->Split.Apply(cell, c);
-    return this->Deformation.DeformInCell(x, c);
+    this->Split.Split(cell, c);
+    return this->Grid.DeformInCell(x, c);
   }
 };
 
@@ -104,12 +63,12 @@ __global__ void BindKernel(const Real* points, std::int64_t count, ffd::Frame<do
 }
 
 // The global basis without Jacobian on small lattices (under 400 control points; BernsteinTensorKernel takes the
-// larger ones): the lattice sits in shared memory as float4 (one 16-byte broadcast load per control point), each
-// thread evaluates four points (each lattice value loaded serves all four, twelve FMAs; two points per thread ran
-// at 3.1 G points/s, four at 3.6 for 11^3 on an H200), and the weights of the first axis stay in registers
-// (MaxCount bounds the control points per axis at compile time). The same function as
-// ffd::GridDeformation::Deform (the tests compare the two): x + sum_ijk B_i(s) B_j(t) B_k(u) D_ijk at the clamped
-// parameters of a bound point.
+// larger ones). It computes ffd::GridDeformation::Deform's function, x + sum_ijk B_i(s) B_j(t) B_k(u) D_ijk at
+// the clamped parameters of a bound point, with the same weights (ffd::BernsteinBasisBounded), but not through
+// that function, for speed: the lattice sits in shared memory as float4 (one 16-byte broadcast load per control
+// point), each thread evaluates four points so that each lattice value loaded serves all four, and the weights
+// of the first axis stay in registers (MaxCount bounds the control points per axis at compile time).
+// CUDA.CudaGridDeformer.GlobalBasisInFloatMatchesDouble and MatchesCpuForEveryBasis compare it with the CPU.
 template <int MaxCount>
 __global__ void __launch_bounds__(ThreadsPerBlock) BernsteinKernel(const float* __restrict__ points,
   const int* __restrict__ cells, std::int64_t count, ffd::Frame<float> frame, int dimS, int dimT, int dimU,
@@ -193,24 +152,23 @@ __global__ void __launch_bounds__(ThreadsPerBlock) BernsteinKernel(const float* 
 }
 
 //------------------------------------------------------------------------------------------------------------
-// The global basis on the tensor cores. The sum x + sum_ijk Bs_i Bt_j Bu_k D_ijk over the lattice's control
-// points (the same function as BernsteinKernel and ffd::GridDeformation, whose weights it computes with the same
-// ffd::BernsteinBasisBounded) is, for a tile of points, the matrix product
+// The global basis on the tensor cores. It computes ffd::GridDeformation::Deform's function with the same weights
+// (ffd::BernsteinBasisBounded) but not through that function, for speed: the sum x + sum_ijk Bs_i Bt_j Bu_k D_ijk
+// over the lattice's control points is, for a tile of points, the matrix product
 //   P[p, (j, c)] = sum_{i, k} (Bs_i Bu_k)[p] D[(i, k), (j, c)]
 // followed by out[p, c] = x[p, c] + sum_j Bt_j[p] P[p, (j, c)]. The product runs as mma.sync m16n8k8 in TF32 with
 // error compensation (3xTF32): each operand is split into a TF32 part and the float32 rest, and
 // hi*hi + hi*lo + lo*hi is accumulated in float32, which leaves an error of about 2^-20 of each product instead of
-// TF32's 2^-11: the results stay within float32 rounding of float64 (BENCHMARKS.md). K runs over i (padded to
-// 8 KS) for each k, N over (j, c) = 3 j + c (padded to 8 NT).
+// TF32's 2^-11, so that the results stay within float32 rounding of float64. K runs over i (padded to 8 KS) for
+// each k, N over (j, c) = 3 j + c (padded to 8 NT). CUDA.CudaGridDeformer.GlobalBasisInFloatMatchesDouble
+// compares it with the CPU's float64 evaluation.
 //
 // The lattice is stored in shared memory as the mma's B fragments, hi and lo of both rows of a lane in one
 // float4, so a lane loads them with one 16-byte load. Each warp takes tiles of 32 points (two m16 tiles sharing
 // every B fragment) from a persistent grid: lanes compute the three axes' weights of the tile's points into a
 // per-warp table, then the k loop builds A = Bs_i Bu_k (split by truncation: hi = the top 19 bits, lo = the exact
-// rest) and issues 3 mma per (k-step, n-tile, m-tile); the epilogue weights the columns by Bt_j and sums the
-// four lanes of each row. 11^3 control points on an H200, 16 M points: 4.75 G points/s against 3.57 for
-// BernsteinKernel. (Converting A with cvt.rna, which sm_90 emulates in 4 instructions, ran at 3.5; one m16 tile a
-// warp at 3.9; 4 warps a block at 4.0; the k loop unrolled 4 times at 4.3.)
+// rest; cvt.rna, emulated on sm_90, is slower) and issues 3 mma per (k-step, n-tile, m-tile); the epilogue
+// weights the columns by Bt_j and sums the four lanes of each row.
 constexpr int TensorWarps = 8;       // warps per block
 constexpr int TensorTilePoints = 32; // points per warp tile: two m16 tiles
 constexpr int TensorTableFloats = TensorTilePoints * 17 * 2 + 16 * TensorTilePoints + 4 * TensorTilePoints;
@@ -524,44 +482,15 @@ struct GridDeformer::Impl : ResidentPoints::State
     this->FinishEvaluation(withNormals, withDeterminants, false);
   }
 
-  // Calls launch(maxCount, basis) with the basis as a compile-time constant (one kernel per basis, see
-  // ffd::GridDeformation's StaticBasis) and the most control points per axis that influence a point: every one
-  // for the global basis, at most 4 for a local one.
-  template <typename Launch>
-  void WithStaticBasis(Launch&& launch)
-  {
-    using ffd::GridBasis;
-    using Local = std::integral_constant<int, 4>;
-    switch (this->Basis)
-    {
-      case GridBasis::Bernstein:
-        launch(std::integral_constant<int, ffd::MaxBernsteinDegree + 1>(),
-          std::integral_constant<int, int(GridBasis::Bernstein)>());
-        break;
-      case GridBasis::Trilinear:
-        launch(Local(), std::integral_constant<int, int(GridBasis::Trilinear)>());
-        break;
-      case GridBasis::TriquadraticBezier:
-        launch(Local(), std::integral_constant<int, int(GridBasis::TriquadraticBezier)>());
-        break;
-      case GridBasis::TricubicBezier:
-        launch(Local(), std::integral_constant<int, int(GridBasis::TricubicBezier)>());
-        break;
-      case GridBasis::CubicBSpline:
-        launch(Local(), std::integral_constant<int, int(GridBasis::CubicBSpline)>());
-        break;
-    }
-  }
-
   // DeformKernel on a lattice of 3 numbers per control point: with the Jacobian, float64 points, and float32
   // points without the Jacobian on the local bases of 3 or 4 control points per axis.
   template <typename Real>
   void LaunchGeneric(const Real* d, const int dims[3], Real* normalsOut, Real* determinantsOut)
   {
     const ffd::Frame<Real> frame = ffd::Frame<Real>::FromArray(this->Frame);
-    this->WithStaticBasis([&](auto maxCount, auto basis) {
-      using Deformer = ffd::GridDeformation<decltype(maxCount)::value, Real, decltype(basis)::value>;
-      const Deformer deformation{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
+    ffd::WithStaticBasis(this->Basis, [&](auto maxCount, auto basis) {
+      using Deformation = ffd::GridDeformation<decltype(maxCount)::value, Real, decltype(basis)::value>;
+      const Deformation deformation{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
         { dims[0], dims[1], dims[2] }, d, frame };
       detail::LaunchDeform(deformation, this->Points.As<Real>(), this->Cells.As<int>(), this->Count,
         this->OutPoints.As<Real>(), this->Normals.As<Real>(), normalsOut, determinantsOut, this->Stream);
@@ -573,12 +502,12 @@ struct GridDeformer::Impl : ResidentPoints::State
   void LaunchFloat4(const float4* d, const int dims[3])
   {
     const ffd::Frame<float> frame = ffd::Frame<float>::FromArray(this->Frame);
-    const CellSplit split = CellSplit::For(this->Basis, this->Divisions);
+    const ffd::CellSplit split = ffd::CellSplit::For(this->Basis, this->Divisions);
     auto launch = [&](auto maxCount, auto basis) {
-      using Deformer = ffd::GridDeformation<decltype(maxCount)::value, float4, decltype(basis)::value, float>;
-      const Deformer grid{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
+      using Deformation = ffd::GridDeformation<decltype(maxCount)::value, float4, decltype(basis)::value, float>;
+      const Deformation grid{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
         { dims[0], dims[1], dims[2] }, d, frame };
-      detail::LaunchDeformPoints(SplitCellDeformation<Deformer>{ grid, split }, this->Points.As<float>(),
+      detail::LaunchDeformPoints(SplitCellDeformation<Deformation>{ grid, split }, this->Points.As<float>(),
         this->Cells.As<int>(), this->Count, this->OutPoints.As<float>(), this->Stream);
     };
     if (this->Basis == ffd::GridBasis::Trilinear)
@@ -594,8 +523,7 @@ struct GridDeformer::Impl : ResidentPoints::State
 
   // The global basis's own kernels, when they apply (at most 16 control points per axis): on the tensor cores
   // (BernsteinTensorKernel) from 400 control points on, below that BernsteinKernel, which is faster on small
-  // lattices (H200, G points/s, BernsteinKernel against BernsteinTensorKernel: 6^3 16 against 11.5, 7^3 11.0
-  // against 10.8, 8^3 8.4 against 10.1). False otherwise.
+  // lattices (BENCHMARKS.md). False otherwise.
   bool LaunchBernstein(const float4* displacements, const int dims[3])
   {
     const int largest = std::max(dims[0], std::max(dims[1], dims[2]));

@@ -34,25 +34,6 @@ __global__ void MapKernel(const ffd::Frame<double>* __restrict__ frames, const i
   maps[t] = ffd::MakeTetrahedronMap(frames[t], d(n.x), d(n.y), d(n.z), d(n.w)).template As<Real>();
 }
 
-// The deformation of points bound to tetrahedra, with ffd::GridDeformation's interface for the shared kernels
-// (FFDCudaDevice.cuh): a point moves by the affine map of its tetrahedron.
-template <typename Real>
-struct TetrahedralDeformation
-{
-  const ffd::TetrahedronMap<Real>* Maps;
-
-  __device__ __forceinline__ ffd::Vec3<Real> Deform(const ffd::Vec3<Real>& x, int cell) const
-  {
-    return this->Maps[cell].Deform(x);
-  }
-
-  __device__ __forceinline__ ffd::Vec3<Real> Deform(const ffd::Vec3<Real>& x, int cell, ffd::Mat3<Real>& jacobian) const
-  {
-    const ffd::TetrahedronMap<Real>& map = this->Maps[cell];
-    jacobian = map.Jacobian();
-    return map.Deform(x);
-  }
-};
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -131,11 +112,11 @@ struct TetrahedralDeformer::Impl : ResidentPoints::State
         this->Lattice.As<double>(), maps);
     }
     this->LatticeKernelsDone();
-    const TetrahedralDeformation<Real> deformation{ maps };
+    const ffd::TetrahedralDeformation<Real> deformation{ maps };
     Real* normalsOut = withNormals ? this->OutNormals.As<Real>() : nullptr;
     Real* determinantsOut = withDeterminants ? this->OutDeterminants.As<Real>() : nullptr;
     // Float32 points alone (an ordinary update) take the kernel of 16-byte point loads and stores, as trilinear
-    // grids do: 95 % of the copy roofline at 16 M points on an H100 (BENCHMARKS.md).
+    // grids do (BENCHMARKS.md).
     if constexpr (std::is_same<Real, float>::value)
     {
       if (!withNormals && !withDeterminants)

@@ -28,6 +28,8 @@
 #include "FFDBernstein.h"
 #include "FFDFrame.h"
 
+#include <cstdint>
+
 namespace ffd
 {
 
@@ -103,6 +105,52 @@ FFD_INLINE int BindingCells(GridBasis basis, int voxels)
 {
   return basis == GridBasis::Bernstein ? 1 : voxels;
 }
+
+/**
+ * BindToGrid()'s flat cell index ci + cx (cj + cy ck) taken apart by multiplications: the same indices as
+ * GridDeformation::CellIndices(), whose two integer divisions by run-time divisors cost as much as the rest of a
+ * point's set-up in the CPU's lane groups and the GPU's float32 kernel. n / d is (n M) >> S with
+ * S = 31 + ceil(log2 d) and M = ceil(2^S / d) < 2^32, exact for every 0 <= n < 2^31 (Granlund and Montgomery,
+ * "Division by invariant integers using multiplication", 1994: M d - 2^S < d <= 2^(S - 31)).
+ */
+struct CellSplit
+{
+  std::uint32_t M[2];
+  int S[2];
+  int D[2];
+
+  /// The split for a lattice of `voxels` divisions of that basis.
+  FFD_INLINE static CellSplit For(GridBasis basis, const int voxels[3])
+  {
+    CellSplit split{};
+    for (int a = 0; a < 2; ++a)
+    {
+      const int d = BindingCells(basis, voxels[a]);
+      int log2 = 0;
+      while ((std::uint64_t(1) << log2) < std::uint64_t(d))
+      {
+        ++log2;
+      }
+      split.S[a] = 31 + log2;
+      split.M[a] = std::uint32_t(((std::uint64_t(1) << split.S[a]) + std::uint64_t(d) - 1) / std::uint64_t(d));
+      split.D[a] = d;
+    }
+    return split;
+  }
+
+  /// The indices along the three axes of a cell (0 <= cell < 2^31).
+  FFD_INLINE void Split(int cell, int c[3]) const
+  {
+    FFD_UNROLL
+    for (int a = 0; a < 2; ++a)
+    {
+      const int q = int(std::uint64_t(std::uint32_t(cell)) * this->M[a] >> this->S[a]);
+      c[a] = cell - q * this->D[a];
+      cell = q;
+    }
+    c[2] = cell;
+  }
+};
 
 /// The cell of parameter s in [0, 1] along an axis of `cells` cells; s = 1 belongs to the last cell.
 template <typename Real>

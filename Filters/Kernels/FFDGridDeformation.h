@@ -19,6 +19,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <type_traits>
 
 namespace ffd
 {
@@ -94,186 +95,10 @@ FFD_INLINE constexpr int CellTableStride(int degree)
 }
 
 /**
- * A local basis's displacement in each of its cells [cellBegin, cellEnd) (flat indices, as BindToGrid()
- * numbers them) in power form: at local coordinates (a, b, c) in [0, 1]^3 of the cell,
- * D = sum over i, j, k <= degree of C_ijk a^i b^j c^k, the C from the cell's (degree + 1)^3 control points by the
- * basis's change to monomials along each axis, in double. Horner's rule then takes (degree + 1)^3 - 1
- * multiply-adds a component, against about 1.3 times that and the weights for the weighted sum of the control
- * points (a half, and 14 against 7, for the trilinear basis), which bounded the CPU's evaluation
- * (BENCHMARKS.md). The rest lattice's coefficients are all 0, so it stays exactly the identity. `displacements`
- * as GridDeformation::Displacements on a grid of `dims`; `table` holds CellTableStride(CellDegree(basis)) Reals
- * per cell.
- */
-namespace detail
-{
-/// The change to monomials along an axis of a local basis: M[j][a], the coefficient of r^j in the basis function
-/// of the cell's control point a.
-template <GridBasis Basis>
-struct ToMonomials
-{
-  static constexpr int N = CellDegree(Basis) + 1;
-  double M[4][4] = {};
-
-  constexpr ToMonomials()
-  {
-    if (Basis == GridBasis::CubicBSpline)
-    {
-      const double m[4][4] = { { 1, 4, 1, 0 }, { -3, 0, 3, 0 }, { 3, -6, 3, 0 }, { -1, 3, -3, 1 } };
-      for (int j = 0; j < 4; ++j)
-      {
-        for (int a = 0; a < 4; ++a)
-        {
-          this->M[j][a] = m[j][a] / 6.0;
-        }
-      }
-      return;
-    }
-    // Bernstein: C(d, a) r^a (1 - r)^(d - a) = sum over j >= a of C(d, a) C(d - a, j - a) (-1)^(j - a) r^j.
-    const int d = N - 1;
-    for (int a = 0; a <= d; ++a)
-    {
-      for (int j = a; j <= d; ++j)
-      {
-        this->M[j][a] = Choose(d, a) * Choose(d - a, j - a) * ((j - a) % 2 == 0 ? 1.0 : -1.0);
-      }
-    }
-  }
-
-  static constexpr double Choose(int m, int k)
-  {
-    double c = 1.0;
-    for (int i = 1; i <= k; ++i)
-    {
-      c = c * (m - k + i) / i;
-    }
-    return c;
-  }
-};
-
-/// v (N^3 points of 3 components, x fastest) with its axis of stride Stride (1, N or N^2) changed to monomials
-/// by M (ToMonomials). M is a compile-time constant, so that its zeros and ones cost nothing: with the three
-/// components together, a table took half the time (trilinear over 9^3 voxels: 15 us instead of 24, at every
-/// update).
-template <int N, int Stride>
-inline void ToMonomialsAlong(const double (&m)[4][4], double (&v)[N * N * N][3])
-{
-  for (int outer = 0; outer < N * N * N; outer += N * Stride) // the axes above
-  {
-    for (int inner = 0; inner < Stride; ++inner) // the axes below
-    {
-      double out[N][3];
-      for (int j = 0; j < N; ++j)
-      {
-        for (int k = 0; k < 3; ++k)
-        {
-          double sum = 0.0;
-          for (int a = 0; a < N; ++a)
-          {
-            sum += m[j][a] * v[outer + a * Stride + inner][k];
-          }
-          out[j][k] = sum;
-        }
-      }
-      for (int j = 0; j < N; ++j)
-      {
-        for (int k = 0; k < 3; ++k)
-        {
-          v[outer + j * Stride + inner][k] = out[j][k];
-        }
-      }
-    }
-  }
-}
-
-/// FillCellTable() for one local basis.
-template <GridBasis Basis, typename Real>
-inline void FillCellTableOf(
-  const Real* displacements, const int voxels[3], const int dims[3], Real* table, int cellBegin, int cellEnd)
-{
-  static constexpr ToMonomials<Basis> toMonomials;
-  constexpr int N = ToMonomials<Basis>::N;
-  constexpr int stride = CellTableStride(N - 1);
-  int c[3] = { cellBegin % voxels[0], cellBegin / voxels[0] % voxels[1], cellBegin / (voxels[0] * voxels[1]) };
-  for (int cell = cellBegin; cell < cellEnd; ++cell)
-  {
-    int first[3], count;
-    for (int a = 0; a < 3; ++a)
-    {
-      VoxelSupport(Basis, voxels[a], c[a], first[a], count);
-    }
-    Real* entry = table + std::size_t(cell) * stride;
-    for (int u = 0; u < 8; ++u)
-    {
-      entry[u] = Real(u < 3 ? c[u] : 0);
-    }
-    // The control points (x fastest), changed to monomials along x, then y, then z.
-    const Real* corner = displacements + 3 * (first[0] + dims[0] * (first[1] + dims[1] * first[2]));
-    double v[N * N * N][3];
-    for (int z = 0; z < N; ++z)
-    {
-      for (int y = 0; y < N; ++y)
-      {
-        for (int x = 0; x < N; ++x)
-        {
-          for (int k = 0; k < 3; ++k)
-          {
-            v[x + N * (y + N * z)][k] = double(corner[3 * (x + dims[0] * (y + dims[1] * z)) + k]);
-          }
-        }
-      }
-    }
-    ToMonomialsAlong<N, 1>(toMonomials.M, v);
-    ToMonomialsAlong<N, N>(toMonomials.M, v);
-    ToMonomialsAlong<N, N * N>(toMonomials.M, v);
-    for (int i = 0; i < N * N * N; ++i)
-    {
-      for (int k = 0; k < 3; ++k)
-      {
-        entry[8 + 3 * i + k] = Real(v[i][k]);
-      }
-    }
-    // The next cell's indices (x fastest).
-    if (++c[0] == voxels[0])
-    {
-      c[0] = 0;
-      if (++c[1] == voxels[1])
-      {
-        c[1] = 0;
-        ++c[2];
-      }
-    }
-  }
-}
-} // namespace detail
-
-template <typename Real>
-inline void FillCellTable(GridBasis basis, const Real* displacements, const int voxels[3], const int dims[3],
-  Real* table, int cellBegin, int cellEnd)
-{
-  switch (basis)
-  {
-    case GridBasis::Trilinear:
-      return detail::FillCellTableOf<GridBasis::Trilinear>(displacements, voxels, dims, table, cellBegin, cellEnd);
-    case GridBasis::TriquadraticBezier:
-      return detail::FillCellTableOf<GridBasis::TriquadraticBezier>(
-        displacements, voxels, dims, table, cellBegin, cellEnd);
-    case GridBasis::TricubicBezier:
-      return detail::FillCellTableOf<GridBasis::TricubicBezier>(
-        displacements, voxels, dims, table, cellBegin, cellEnd);
-    case GridBasis::CubicBSpline:
-      return detail::FillCellTableOf<GridBasis::CubicBSpline>(
-        displacements, voxels, dims, table, cellBegin, cellEnd);
-    case GridBasis::Bernstein: // one cell: no table
-      break;
-  }
-}
-
-/**
  * D of FillCellTable() (a basis of degree Degree) at local coordinates r[g] of the cell whose entry is `entry`, for
  * G lane groups g at once, by Horner's rule, into d[g], and, where dDdr is not null, its derivatives into dDdr[g]:
- * column a is dD/dr[a]. Each coefficient is read (broadcast to the lanes) once for all G groups: in a hand-written
- * AVX-512 loop of a trilinear cell in float64 the broadcasts took about a third of the time (BENCHMARKS.md,
- * 2026-11-23, late).
+ * column a is dD/dr[a]. Each coefficient is read (broadcast to the lanes) once for all G groups: the broadcasts
+ * are a large part of a cell's cost.
  */
 template <int Degree, int G, typename Lane, typename Real>
 FFD_INLINE void PowerForm(const Real* entry, const Lane (*r)[3], Vec3<Lane>* d, Mat3<Lane>* dDdr)
@@ -396,7 +221,7 @@ struct LatticeValues<detail::GroupValues<Real, Group>>
  * control points per axis that influence a point: 4 covers every local basis (and global ones up to degree 3),
  * MaxBernsteinDegree + 1 every global one; callers pick it from the basis (vtkFFDDeform, the CUDA backend).
  * StaticBasis, when not -1, is the basis known at compile time (it must equal Basis): the compiler then drops
- * the other bases' branches and unrolls the fixed-size sums, which made the local bases 2-3 times faster.
+ * the other bases' branches and unrolls the fixed-size sums (WithStaticBasis() instantiates one per basis).
  * Real is the displacements' type; Lane, the arithmetic's, is Real too, or on the host a Lanes type
  * (FFDLanes.h) that deforms several points of one cell at once through these same functions (WithLanes()).
  * A deformation of a local basis WithCellTable evaluates each cell in power form from CellTable (FillCellTable()
@@ -736,6 +561,36 @@ private:
     }
   }
 };
+
+/**
+ * Calls f(MaxCount, StaticBasis) with the GridDeformation template arguments of `basis` as
+ * std::integral_constant values: the global basis sums over at most MaxBernsteinDegree + 1 control points an
+ * axis, a local one over at most 4. One instantiation per basis, for the CPU and the CUDA backend alike.
+ */
+template <typename F>
+inline void WithStaticBasis(GridBasis basis, F&& f)
+{
+  using Local = std::integral_constant<int, 4>;
+  switch (basis)
+  {
+    case GridBasis::Bernstein:
+      f(std::integral_constant<int, MaxBernsteinDegree + 1>(),
+        std::integral_constant<int, int(GridBasis::Bernstein)>());
+      break;
+    case GridBasis::Trilinear:
+      f(Local(), std::integral_constant<int, int(GridBasis::Trilinear)>());
+      break;
+    case GridBasis::TriquadraticBezier:
+      f(Local(), std::integral_constant<int, int(GridBasis::TriquadraticBezier)>());
+      break;
+    case GridBasis::TricubicBezier:
+      f(Local(), std::integral_constant<int, int(GridBasis::TricubicBezier)>());
+      break;
+    case GridBasis::CubicBSpline:
+      f(Local(), std::integral_constant<int, int(GridBasis::CubicBSpline)>());
+      break;
+  }
+}
 
 } // namespace ffd
 

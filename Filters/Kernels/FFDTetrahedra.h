@@ -131,6 +131,24 @@ FFD_INLINE TetrahedronMap<double> MakeTetrahedronMap(const Frame<double>& rest, 
   return m;
 }
 
+/// The deformation of points bound to tetrahedra (the cell is the tetrahedron): a point moves by its
+/// tetrahedron's map. It has GridDeformation's interface, so that DeformBoundPoint() and the CUDA kernels serve
+/// both lattice kinds.
+template <typename Real>
+struct TetrahedralDeformation
+{
+  const TetrahedronMap<Real>* Maps;
+
+  FFD_INLINE Vec3<Real> Deform(const Vec3<Real>& x, int cell) const { return this->Maps[cell].Deform(x); }
+
+  FFD_INLINE Vec3<Real> Deform(const Vec3<Real>& x, int cell, Mat3<Real>& jacobian) const
+  {
+    const TetrahedronMap<Real>& map = this->Maps[cell];
+    jacobian = map.Jacobian();
+    return map.Deform(x);
+  }
+};
+
 /**
  * d(closest point)/dX for a point outside the lattice whose nearest point of the control mesh has weights
  * `stu` in tetrahedron `rest`, and lies on the boundary feature where `tolerance` or fewer of its four weights

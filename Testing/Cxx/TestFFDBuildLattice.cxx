@@ -316,8 +316,8 @@ TEST(vtkFFDBuildLattice, OutputFollowsTheDataContract)
   int basis = -1;
   ASSERT_TRUE(vtkFFDDataContract::GetBasis(lattice, basis));
   EXPECT_EQ(basis, vtkFFDBuildLattice::BERNSTEIN);
-  EXPECT_STREQ(build->GetBasisAsString(), "BERNSTEIN");
-  EXPECT_STREQ(vtkFFDBuildLattice::GetBasisAsString(vtkFFDBuildLattice::CUBIC_BSPLINE), "CUBIC_BSPLINE");
+  EXPECT_STREQ(build->GetBasisAsString(), "Bernstein");
+  EXPECT_STREQ(vtkFFDBuildLattice::GetBasisAsString(vtkFFDBuildLattice::CUBIC_BSPLINE), "CubicBSpline");
 }
 
 TEST(vtkFFDBuildLattice, GlobalBasisKeepsEveryControlPointOfAnActiveGrid)

@@ -8,6 +8,7 @@
 #ifndef FFDKernelTestUtilities_h
 #define FFDKernelTestUtilities_h
 
+#include "FFDCellTable.h"
 #include "FFDFrame.h"
 #include "FFDGridDeformation.h"
 #include "FFDReference.h"

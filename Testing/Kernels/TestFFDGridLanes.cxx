@@ -586,7 +586,7 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
 
 TEST(FFDGridLanes, CellSplitTakesTheFlatIndexApart)
 {
-  // The in-place pass takes a cell index apart by multiplications (detail::CellSplit): the same indices as
+  // The in-place pass takes a cell index apart by multiplications (ffd::CellSplit): the same indices as
   // GridDeformation::CellIndices()'s divisions, for small, prime and large divisors, at the ends of the range.
   ffdtest::Rng rng(603);
   for (int dx : { 1, 2, 3, 7, 9, 255, 1000, 46340 })
@@ -598,7 +598,7 @@ TEST(FFDGridLanes, CellSplitTakesTheFlatIndexApart)
       d.Voxels[0] = dx;
       d.Voxels[1] = dy;
       d.Voxels[2] = 1;
-      const ffd::detail::CellSplit split(d);
+      const ffd::CellSplit split = ffd::CellSplit::For(d.Basis, d.Voxels);
       std::vector<int> cells = { 0, 1, dx - 1, dx, dx * dy - 1, std::numeric_limits<int>::max(),
         std::numeric_limits<int>::max() - 1 };
       for (int k = 0; k < 1000; ++k)

@@ -16,8 +16,8 @@
  *   staging buffer that stays in cache, then writes the tile's results out in point order, each read from its
  *   place in the buffer.
  * A mesh whose vertices come in a spatially coherent order has most of its groups in one cell and a few in two
- * or three: it is deformed in place. A mesh in random vertex order (the 0.4 M-point armadillo of BENCHMARKS.md,
- * 4.5 cells a block on average) would evaluate several cells a group: all its blocks are gathered.
+ * or three: it is deformed in place. A mesh in random vertex order (several cells a block on average) would
+ * evaluate several cells a group: all its blocks are gathered.
  * Every lane's result depends only on its own point and cell, so a point is deformed the same whichever pass
  * takes it and however the work is split among threads. The one-point code (SimdLevel::None) computes the same
  * function; it may differ in the last bit, where the wide code fuses a multiply and an add.
@@ -30,7 +30,9 @@
 #ifndef FFDGridLanes_h
 #define FFDGridLanes_h
 
+#include "FFDDeformPoint.h"
 #include "FFDGridDeformation.h"
+#include "FFDPointBlocks.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -96,368 +98,6 @@ inline SimdLevel SimdLevelOfCpu()
 #endif
 }
 
-/// Consecutive points that DeformBlocksInPlace() takes together: a multiple of every level's lanes (16 floats).
-constexpr int BlockSize = 16;
-
-/// The number of cells (-1 counts as one) that the points of block b (a whole one) lie in.
-inline int CellsOfBlock(const int* cells, std::int64_t b)
-{
-  const int* block = cells + b * BlockSize;
-  int count = 0;
-  for (int l = 0; l < BlockSize; ++l)
-  {
-    bool seen = false;
-    for (int k = 0; k < l; ++k)
-    {
-      seen |= block[k] == block[l];
-    }
-    count += seen ? 0 : 1;
-  }
-  return count;
-}
-
-/// The mean of CellsOfBlock() over the whole blocks of n points (1 where there is none).
-inline double MeanCellsPerBlock(const int* cells, std::int64_t n)
-{
-  const std::int64_t blocks = n / BlockSize;
-  std::int64_t sum = 0;
-  for (std::int64_t b = 0; b < blocks; ++b)
-  {
-    sum += CellsOfBlock(cells, b);
-  }
-  return blocks > 0 ? double(sum) / double(blocks) : 1.0;
-}
-
-/**
- * True when a deformation of `points` points over `cells` cells of a local basis is worth a CellTable
- * (FillCellTable(), rebuilt at every update): when building the table costs less than it saves, that is with
- * at least 8 points a cell for the trilinear basis, 64 for the triquadratic one and 256 for the cubic
- * B-spline (a cell's table costs about as much as deforming 6, 40 and 150 of its points). Never for the
- * tricubic Bezier basis: its monomial coefficients reach 8 times its control points along each axis, and the
- * power form lost up to 2 more bits than the weighted sum in float32 (beyond the tests' tolerance), where the
- * B-spline's (at most its control points) and the triquadratic's (4 times) stayed within it.
- */
-inline bool WorthCellTable(GridBasis basis, std::int64_t cells, std::int64_t points)
-{
-  const int degree = CellDegree(basis);
-  const std::int64_t pointsPerCell = degree == 1 ? 8 : (degree == 2 ? 64 : 256);
-  return degree > 0 && basis != GridBasis::TricubicBezier && cells * pointsPerCell <= points;
-}
-
-/**
- * True when the in-place pass should write an output of `bytes` bytes by non-temporal stores
- * (DeformBlocksInPlace()): when it is larger than the last-level caches of most CPUs (64 MB), which it would
- * leave anyway. Such stores write whole cache lines without reading them first: 1.1 to 1.3 times faster on the
- * 6.7 M-point armadillo (BENCHMARKS.md). A smaller output stays in the caches for whoever reads it next.
- */
-inline bool StreamOutput(std::int64_t bytes)
-{
-  return bytes >= (std::int64_t(64) << 20);
-}
-
-/**
- * The most cells a block's points may lie in for the block to be deformed in place (BlockInPlace(), GatheredBlocks()),
- * chosen for a binding from its mean number of cells per block. In place reads and writes memory in order, but a lane
- * group in several cells evaluates each of its cells in all its lanes; the gathered pass reads a copy of its points in
- * order, sorted by cell within tiles (GatherTile), evaluates whole lane groups of one cell into a tile's staging
- * buffer, and writes the tile out in point order from there. Below the crossover every block is deformed in place
- * (BlockSize), above it every block is gathered (0), those in one cell too: the gathered pass reads them in order with
- * the others, where the in-place pass would read them at random. The 0.4 M-point armadillo of BENCHMARKS.md, in random
- * vertex order, has 4.5 cells a block over 9^3 voxels: gathered. The 6.7 M-point one, in a spatially coherent order,
- * has 1.4 to 1.5: in place for the trilinear basis, gathered for the others, whose cells cost more. The crossovers were
- * measured on both meshes reordered to means in between (BENCHMARKS.md, 2026-11-23, again for the staged gathered
- * pass); they are lower for float64 than for float32 (trilinear with its table: 1.5 against 2.1), and these are in
- * between.
- */
-inline int MaxCellsInPlace(GridBasis basis, double meanCellsPerBlock, bool cellTable)
-{
-  double crossover = 1.2; // the triquadratic and cubic bases: 27 or 64 control points a cell
-  if (basis == GridBasis::Bernstein)
-  {
-    return BlockSize; // one cell
-  }
-  if (basis == GridBasis::Trilinear)
-  {
-    crossover = cellTable ? 2.0 : 1.7; // 7 multiply-adds a component, or 8 control points
-  }
-  return meanCellsPerBlock <= crossover ? BlockSize : 0;
-}
-
-/// True when block b (of n points) is deformed in place: it is whole and its points lie in at most maxCells
-/// cells (MaxCellsInPlace()).
-inline bool BlockInPlace(const int* cells, std::int64_t n, std::int64_t b, int maxCells)
-{
-  const std::int64_t first = b * BlockSize;
-  if (first + BlockSize > n)
-  {
-    return false; // the last, partial block goes to the gathered points
-  }
-  if (maxCells >= BlockSize)
-  {
-    return true;
-  }
-  if (maxCells <= 0)
-  {
-    return false;
-  }
-  if (maxCells == 1)
-  {
-    bool one = true;
-    for (int l = 1; l < BlockSize; ++l)
-    {
-      one &= cells[first + l] == cells[first];
-    }
-    return one;
-  }
-  return CellsOfBlock(cells, b) <= maxCells;
-}
-
-/**
- * The cells of a binding's whole blocks, listed once per binding so that deforming a block in several cells does
- * not search them again (a chain of dependent compares per cell, which cost more than the cell's sum): Entry[b]
- * is -1 for block b when its points all lie in the cell of its first point (-1 included), else the offset in
- * List of: the number of its cells other than -1, its CellsOfBlock(), then each cell other than -1 and the bits
- * of the block's points in it (bit l for point b BlockSize + l). Blocks in more than MaxCells cells are left to
- * the gathered pass.
- */
-struct BlockCells
-{
-  int MaxCells = BlockSize;
-  std::vector<int> Entry;
-  std::vector<int> List;
-
-  /// True when whole block b is deformed in place (BlockInPlace()). The limits MaxCellsInPlace() gives, 0 and
-  /// BlockSize, need no look at the block.
-  bool InPlace(std::int64_t b) const
-  {
-    if (this->MaxCells <= 0 || this->MaxCells >= BlockSize)
-    {
-      return this->MaxCells > 0;
-    }
-    const int entry = this->Entry[std::size_t(b)];
-    return entry < 0 || this->List[std::size_t(entry) + 1] <= this->MaxCells; // a listed block: 2 cells or more
-  }
-};
-
-/// The BlockCells of n points bound to `cells`, with blocks in more than maxCells cells gathered.
-inline BlockCells ListBlockCells(const int* cells, std::int64_t n, int maxCells)
-{
-  BlockCells blocks;
-  blocks.MaxCells = maxCells;
-  blocks.Entry.resize(std::size_t(n / BlockSize));
-  for (std::size_t b = 0; b < blocks.Entry.size(); ++b)
-  {
-    const int* block = cells + b * BlockSize;
-    unsigned others = 0;
-    for (int l = 0; l < BlockSize; ++l)
-    {
-      others |= block[l] != block[0] ? 1u << l : 0u;
-    }
-    if (others == 0)
-    {
-      blocks.Entry[b] = -1;
-      continue;
-    }
-    const std::size_t entry = blocks.List.size();
-    blocks.Entry[b] = int(entry);
-    blocks.List.push_back(0);
-    blocks.List.push_back(0);
-    unsigned bound = 0; // the points in a listed cell
-    for (int l = 0; l < BlockSize; ++l)
-    {
-      bool seen = block[l] < 0;
-      for (int k = 0; k < l; ++k)
-      {
-        seen |= block[k] == block[l];
-      }
-      if (!seen)
-      {
-        unsigned bits = 0;
-        for (int m = l; m < BlockSize; ++m)
-        {
-          bits |= block[m] == block[l] ? 1u << m : 0u;
-        }
-        blocks.List.push_back(block[l]);
-        blocks.List.push_back(int(bits));
-        ++blocks.List[entry];
-        bound |= bits;
-      }
-    }
-    // CellsOfBlock(): the listed cells, and -1 where some point is in none.
-    blocks.List[entry + 1] = blocks.List[entry] + (bound != (1u << BlockSize) - 1 ? 1 : 0);
-  }
-  return blocks;
-}
-
-/**
- * Consecutive points among which GatherByCell() sorts by cell (a multiple of BlockSize, at most 2^16: see
- * GatheredPoints::Ranks). The gathered pass stages a tile's results (384 KB in float32, 768 KB in float64: a
- * core's L2 cache) and reads them from there at random, instead of writing them at random across the output,
- * whose lines a write at random reads from memory first. Larger tiles leave fewer lane groups in two cells.
- */
-constexpr int GatherTile = 32768;
-
-/// Reals in a staging buffer of DeformGathered(): a tile's results, and one more that the write-out may read past
-/// the last (detail::WriteTile()).
-constexpr std::size_t GatherStaging = 3 * std::size_t(GatherTile) + 1;
-
-/// The blocks of n points bound to `cells` that are not deformed in place (BlockInPlace() with maxCells), in
-/// order.
-inline std::vector<std::int64_t> GatheredBlocks(const int* cells, std::int64_t n, int maxCells)
-{
-  std::vector<std::int64_t> gathered;
-  for (std::int64_t b = 0; b < (n + BlockSize - 1) / BlockSize; ++b)
-  {
-    if (!BlockInPlace(cells, n, b, maxCells))
-    {
-      gathered.push_back(b);
-    }
-  }
-  return gathered;
-}
-
-/**
- * The points of the blocks `sources` (GatheredBlocks(): those not deformed in place), tile by tile (of `tile`
- * points, GatherTile but in tests), each tile's sorted by cell: cell -1 first, then by cell, each cell's points
- * in input order (two stable counting sorts: by cell, then by tile). For DeformGathered(); `cellCount` is the
- * number of cells of the binding.
- */
-inline std::vector<int> GatherByCell(const int* cells, std::int64_t n, int cellCount,
-  const std::vector<std::int64_t>& sources, int tile = GatherTile)
-{
-  std::vector<std::int64_t> offsets(std::size_t(cellCount) + 2, 0);
-  for (std::int64_t b : sources)
-  {
-    for (std::int64_t i = b * BlockSize; i < n && i < (b + 1) * BlockSize; ++i)
-    {
-      ++offsets[std::size_t(cells[i] + 2)];
-    }
-  }
-  for (std::size_t c = 1; c < offsets.size(); ++c)
-  {
-    offsets[c] += offsets[c - 1];
-  }
-  std::vector<int> byCell(std::size_t(offsets.back()));
-  for (std::int64_t b : sources)
-  {
-    for (std::int64_t i = b * BlockSize; i < n && i < (b + 1) * BlockSize; ++i)
-    {
-      byCell[std::size_t(offsets[std::size_t(cells[i] + 1)]++)] = int(i);
-    }
-  }
-  std::vector<std::int64_t> tiles(std::size_t((n + tile - 1) / tile) + 1, 0);
-  for (int i : byCell)
-  {
-    ++tiles[std::size_t(i / tile) + 1];
-  }
-  for (std::size_t t = 1; t < tiles.size(); ++t)
-  {
-    tiles[t] += tiles[t - 1];
-  }
-  std::vector<int> gathered(byCell.size());
-  for (int i : byCell)
-  {
-    gathered[std::size_t(tiles[std::size_t(i / tile)]++)] = i;
-  }
-  return gathered;
-}
-
-/**
- * The points that the gathered pass deforms (DeformGathered()), listed once per binding, with where each result goes.
- * The list, Order, is GatherByCell()'s, each tile's run of it padded to whole blocks by repeating its last point (so
- * that every listed point is deformed in lanes, as bit for bit as the in-place pass); Cells, their cells in that order;
- * Blocks, the BlockCells of that order (every block in place); TileBlocks, the blocks of each tile's run: tile t's are
- * [TileBlocks[t], TileBlocks[t + 1]). The pass reads the points' coordinates in that order from a copy
- * (CopyGatheredPoints()), so that it reads memory in order and deforms whole lane groups of one cell. For the writing:
- * Sources, GatheredBlocks(), in point order, tile t's being [TileSources[t], TileSources[t + 1]); Ranks, for point l of
- * the k-th of them, at k BlockSize + l, its place in its tile's run.
- */
-struct GatheredPoints
-{
-  std::int64_t Points = 0; ///< the binding's points
-  std::vector<int> Order;
-  std::vector<int> Cells;
-  BlockCells Blocks;
-  std::vector<std::int64_t> TileBlocks;
-  std::vector<std::int64_t> Sources;
-  std::vector<std::int64_t> TileSources;
-  std::vector<std::uint16_t> Ranks;
-
-  /// The tiles of the binding's points (some may list no point).
-  std::int64_t TileCount() const { return std::int64_t(this->TileBlocks.size()) - 1; }
-};
-
-/// The GatheredPoints of n points bound to `cells` (a binding of cellCount cells) with blocks in more than
-/// maxCells cells gathered, in tiles of `tile` points (GatherTile but in tests: a multiple of BlockSize, at most
-/// GatherTile, the points a staging buffer of DeformGathered() holds).
-inline GatheredPoints ListGatheredPoints(
-  const int* cells, std::int64_t n, int cellCount, int maxCells, int tile = GatherTile)
-{
-  static_assert(GatherTile % BlockSize == 0 && GatherTile <= 65536, "tiles of whole blocks, ranks of 16 bits");
-  tile = std::max(BlockSize, std::min(GatherTile, tile / BlockSize * BlockSize));
-  GatheredPoints gathered;
-  gathered.Points = n;
-  gathered.Sources = GatheredBlocks(cells, n, maxCells);
-  const std::vector<int> byCell = GatherByCell(cells, n, cellCount, gathered.Sources, tile);
-  const std::int64_t tiles = (n + tile - 1) / tile;
-  const std::int64_t blocks = (n + BlockSize - 1) / BlockSize;
-  gathered.TileSources.assign(std::size_t(tiles) + 1, 0);
-  for (std::int64_t b : gathered.Sources)
-  {
-    ++gathered.TileSources[std::size_t(b * BlockSize / tile) + 1];
-  }
-  for (std::size_t t = 1; t < gathered.TileSources.size(); ++t)
-  {
-    gathered.TileSources[t] += gathered.TileSources[t - 1];
-  }
-  // Each point's place in its tile's run, found through its block's place among Sources.
-  std::vector<std::int64_t> sourceOfBlock(std::size_t(blocks), -1);
-  for (std::size_t k = 0; k < gathered.Sources.size(); ++k)
-  {
-    sourceOfBlock[std::size_t(gathered.Sources[k])] = std::int64_t(k);
-  }
-  gathered.Ranks.assign(gathered.Sources.size() * BlockSize, 0);
-  gathered.TileBlocks.assign(std::size_t(tiles) + 1, 0);
-  std::size_t next = 0;
-  for (std::int64_t t = 0; t < tiles; ++t)
-  {
-    const std::size_t runFirst = gathered.Order.size();
-    for (; next < byCell.size() && byCell[next] / tile == t; ++next)
-    {
-      const int i = byCell[next];
-      gathered.Ranks[std::size_t(sourceOfBlock[std::size_t(i / BlockSize)] * BlockSize + i % BlockSize)] =
-        std::uint16_t(gathered.Order.size() - runFirst);
-      gathered.Order.push_back(i);
-    }
-    while ((gathered.Order.size() - runFirst) % BlockSize != 0)
-    {
-      gathered.Order.push_back(gathered.Order.back());
-    }
-    gathered.TileBlocks[std::size_t(t) + 1] = std::int64_t(gathered.Order.size()) / BlockSize;
-  }
-  gathered.Cells.reserve(gathered.Order.size());
-  for (int i : gathered.Order)
-  {
-    gathered.Cells.push_back(cells[i]);
-  }
-  gathered.Blocks = ListBlockCells(gathered.Cells.data(), std::int64_t(gathered.Cells.size()), BlockSize);
-  return gathered;
-}
-
-/// copy = in[Order[g]] (3 values each) for the listed points g in [begin, end): what DeformGathered() reads.
-template <typename Real>
-inline void CopyGatheredPoints(
-  const Real* in, const GatheredPoints& gathered, std::int64_t begin, std::int64_t end, Real* copy)
-{
-  for (std::int64_t g = begin; g < end; ++g)
-  {
-    const std::int64_t i = gathered.Order[std::size_t(g)];
-    copy[3 * g] = in[3 * i];
-    copy[3 * g + 1] = in[3 * i + 1];
-    copy[3 * g + 2] = in[3 * i + 2];
-  }
-}
-
 namespace detail
 {
 /// Point i deformed alone, written to out + 3 (i - outFirst): cell -1 keeps its position.
@@ -465,20 +105,14 @@ template <typename Deformation, typename Real>
 inline void DeformOnePoint(
   const Deformation& deformation, const Real* in, const int* cells, Real* out, std::int64_t i, std::int64_t outFirst)
 {
-  const Vec3<Real> x = Vec3<Real>::From(in + 3 * i);
-  const Vec3<Real> y = cells[i] >= 0 ? deformation.Deform(x, cells[i]) : x;
-  Real* to = out + 3 * (i - outFirst);
-  to[0] = y.x;
-  to[1] = y.y;
-  to[2] = y.z;
+  DeformBoundPoint<false>(deformation, Vec3<Real>::From(in + 3 * i), cells[i], out + 3 * (i - outFirst));
 }
 
 /**
  * Tile t's results, staged in its run's order (DeformGathered()), written out in point order. In a whole block each
  * point but the last is copied as 4 Reals, the fourth landing on the next point's x, which the next copy then
- * writes; `staged` holds one Real past the tile (GatherStaging) for the read of the last staged point's. That and
- * the copies unrolled over the block: one move a point instead of two and no loop per point, the float32 gathered
- * pass 1.13-1.20x faster on the 0.4 M-point armadillo, float64 the same (BENCHMARKS.md, 2026-11-23, last).
+ * writes; `staged` holds one Real past the tile (GatherStaging) for the read of the last staged point's. With
+ * the copies unrolled over the block, that is one move a point instead of two and no loop per point.
  */
 template <typename Real>
 inline void WriteTile(const GatheredPoints& gathered, std::int64_t t, const Real* staged, Real* out)
@@ -506,30 +140,15 @@ inline void WriteTile(const GatheredPoints& gathered, std::int64_t t, const Real
   }
 }
 
-/// Point i deformed alone with its Jacobian (the identity where it keeps its position): its position and, where
-/// `outNormals` (or `determinants`) is not null, its transformed normal (its Jacobian's determinant), as the
-/// filter's one-point code computes them.
+/// Point i deformed alone with its Jacobian: its position and, where `outNormals` (or `determinants`) is not
+/// null, its transformed normal (its Jacobian's determinant).
 template <typename Deformation, typename Real>
 inline void DeformOnePointWithJacobian(const Deformation& deformation, const Real* in, const int* cells,
   const Real* inNormals, Real* out, Real* outNormals, Real* determinants, std::int64_t i)
 {
-  const Vec3<Real> x = Vec3<Real>::From(in + 3 * i);
-  Mat3<Real> jacobian = Mat3<Real>::Identity();
-  const Vec3<Real> y = cells[i] >= 0 ? deformation.Deform(x, cells[i], jacobian) : x;
-  out[3 * i] = y.x;
-  out[3 * i + 1] = y.y;
-  out[3 * i + 2] = y.z;
-  if (outNormals)
-  {
-    const Vec3<Real> m = TransformNormal(jacobian, Vec3<Real>::From(inNormals + 3 * i));
-    outNormals[3 * i] = m.x;
-    outNormals[3 * i + 1] = m.y;
-    outNormals[3 * i + 2] = m.z;
-  }
-  if (determinants)
-  {
-    determinants[i] = Determinant(jacobian);
-  }
+  DeformBoundPoint<true>(deformation, Vec3<Real>::From(in + 3 * i), cells[i], out + 3 * i,
+    outNormals ? inNormals + 3 * i : nullptr, outNormals ? outNormals + 3 * i : nullptr,
+    determinants ? determinants + i : nullptr);
 }
 
 #if FFD_HAVE_LANES
@@ -537,42 +156,6 @@ inline void DeformOnePointWithJacobian(const Deformation& deformation, const Rea
 
 namespace detail
 {
-/**
- * BindToGrid()'s flat cell index taken apart as GridDeformation::CellIndices() does, by multiplications: the
- * two integer divisions by run-time divisors cost as much as the rest of the set-up of a lane group. For a
- * divisor d in [1, 2^31), q = floor(n M / 2^63) with M = floor(2^63 / d) + 1 is floor(n / d) for every n in
- * [0, 2^31): n M / 2^63 exceeds n / d by less than 2^-32, less than the 1/d by which n / d stays below the next
- * integer.
- */
-class CellSplit
-{
-public:
-  template <typename Deformation>
-  explicit CellSplit(const Deformation& deformation)
-  {
-    for (int a = 0; a < 2; ++a)
-    {
-      this->Cells[a] = BindingCells(deformation.BasisOf(), deformation.Voxels[a]);
-      this->Inverse[a] = (std::uint64_t(1) << 63) / std::uint64_t(this->Cells[a]) + 1;
-    }
-  }
-
-  void Split(int cell, int c[3]) const
-  {
-    for (int a = 0; a < 2; ++a)
-    {
-      const int q = int((unsigned __int128)std::uint64_t(cell) * this->Inverse[a] >> 63);
-      c[a] = cell - q * this->Cells[a];
-      cell = q;
-    }
-    c[2] = cell;
-  }
-
-private:
-  int Cells[2];
-  std::uint64_t Inverse[2];
-};
-
 /// The flat index of the first control point of a cell (not -1) of a local basis, and the cell's index along
 /// each axis.
 template <typename Deformation>
@@ -673,9 +256,6 @@ inline void DeformInSeveralCells(const Deformation& deformation, const Wide& wid
   }
 }
 
-/// Blocks ahead whose points the in-place pass prefetches.
-constexpr int PrefetchBlocks = 8;
-
 /// The in-place pass over blocks [blockBegin, blockEnd); point i's result goes to out + 3 (i - outFirst), by
 /// non-temporal stores where Streaming (out + 3 (blockBegin BlockSize - outFirst) aligned to 64 bytes).
 template <int W, bool Streaming, typename Deformation, typename Real>
@@ -687,7 +267,7 @@ inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in,
   using Mask = typename Lane::IndexVector;
   const auto wide = deformation.template WithLanes<Lane>();
   const bool global = deformation.BasisOf() == GridBasis::Bernstein;
-  const CellSplit split(deformation);
+  const CellSplit split = CellSplit::For(deformation.BasisOf(), deformation.Voxels);
   blockEnd = std::min(blockEnd, std::int64_t(blocks.Entry.size())); // the last, partial block is gathered
   // Blocks in several cells are deformed after the others of a window of blocks, still in cache: kept out of the
   // loop over the window, their code leaves that loop's registers to the common case.
@@ -704,8 +284,7 @@ inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in,
       }
       if (b + PrefetchBlocks < blockEnd)
       {
-        // The points a few blocks ahead: the hardware did not fetch them in time (float64 over 6.7 M points:
-        // 213-296 -> 284-343 Mpoints/s; float32 the same or a few % faster).
+        // The points a few blocks ahead: the hardware prefetcher does not fetch them in time on large meshes.
         const char* ahead = reinterpret_cast<const char*>(in + 3 * (b + PrefetchBlocks) * BlockSize);
         for (std::size_t line = 0; line < 3 * BlockSize * sizeof(Real); line += 64)
         {
@@ -775,7 +354,7 @@ inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, 
   using Mask = typename Lane::IndexVector;
   const auto wide = deformation.template WithLanes<Lane>();
   const bool global = deformation.BasisOf() == GridBasis::Bernstein;
-  const CellSplit split(deformation);
+  const CellSplit split = CellSplit::For(deformation.BasisOf(), deformation.Voxels);
   const Mat3<Lane> identity = Mat3<Lane>::Identity();
   // Whole blocks in lanes (begin is a block's first point), the last points one at a time.
   const std::int64_t whole = std::min(end, std::int64_t(blocks.Entry.size()) * BlockSize);

@@ -1,0 +1,441 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkFFDGridDeformer.h"
+
+#include "vtkFFDBuildLattice.h"
+#include "vtkFFDDataContract.h"
+#include "vtkFFDDeform.h"
+#include "vtkFFDDeformPoints.h"
+#include "vtkFFDForInChunks.h"
+#include "vtkFFDLatticeDisplacements.h"
+
+#include "vtkAOSDataArrayTemplate.h"
+#include "vtkArrayDispatch.h"
+#include "vtkDataArray.h"
+#include "vtkDataArrayRange.h"
+#include "vtkPointData.h"
+#include "vtkPointSet.h"
+#include "vtkPoints.h"
+#include "vtkSMPThreadLocal.h"
+#include "vtkSMPTools.h"
+
+#include "FFDCellTable.h"
+#include "FFDGridLanes.h"
+
+#include <algorithm>
+#include <sstream>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace
+{
+using PointArrays = vtkArrayDispatch::Reals;
+
+//------------------------------------------------------------------------------------------------------------
+static_assert(int(ffd::GridBasis::Bernstein) == vtkFFDBuildLattice::BERNSTEIN &&
+    int(ffd::GridBasis::Trilinear) == vtkFFDBuildLattice::TRILINEAR &&
+    int(ffd::GridBasis::TriquadraticBezier) == vtkFFDBuildLattice::TRIQUADRATIC_BEZIER &&
+    int(ffd::GridBasis::TricubicBezier) == vtkFFDBuildLattice::TRICUBIC_BEZIER &&
+    int(ffd::GridBasis::CubicBSpline) == vtkFFDBuildLattice::CUBIC_BSPLINE,
+  "the kernels' basis values are the FFDBasis values");
+
+// Reads a lattice per the data contract; returns an empty string or what is wrong with it.
+std::string ReadLattice(vtkPointSet* lattice, vtkFFDGridLattice& view)
+{
+  const std::string fix = " Build the lattice with vtkFFDBuildLattice, or keep its data contract "
+                          "(see vtkFFDDataContract).";
+  if (!lattice)
+  {
+    return "The lattice on input port 1 is not a vtkPointSet." + fix;
+  }
+  if (!vtkFFDDataContract::GetFrame(lattice, view.Frame))
+  {
+    return "The lattice has no valid FFDFrame field array (12 finite doubles)." + fix;
+  }
+  if (ffd::CheckFrame(view.Frame) != ffd::FrameStatus::Valid)
+  {
+    return "The lattice's FFDFrame has no volume: its edge vectors S, T, U are (nearly) linearly dependent.";
+  }
+  if (!vtkFFDDataContract::GetDivisions(lattice, view.Divisions))
+  {
+    return "The lattice has no valid FFDDivisions field array (3 ints >= 1)." + fix;
+  }
+  int basis;
+  if (!vtkFFDDataContract::GetBasis(lattice, basis))
+  {
+    return "The lattice has no FFDBasis field array (1 int)." + fix;
+  }
+  if (!ffd::IsGridBasis(basis))
+  {
+    return "The lattice's FFDBasis " + std::to_string(basis) + " is not a known basis." + fix;
+  }
+  view.Basis = static_cast<ffd::GridBasis>(basis);
+  std::string why;
+  if (!vtkFFDBuildLattice::GetControlPointsPerAxis(basis, view.Divisions, view.ControlPointsPerAxis, why))
+  {
+    return "The lattice's FFDDivisions do not fit its FFDBasis: " + why;
+  }
+  const vtkIdType expected = vtkIdType(view.ControlPointsPerAxis[0]) * view.ControlPointsPerAxis[1] * view.ControlPointsPerAxis[2];
+  const vtkIdType count = lattice->GetNumberOfPoints();
+  if (count != expected)
+  {
+    std::ostringstream msg;
+    msg << "The lattice has " << count << " points but its divisions " << view.Divisions[0] << "x"
+        << view.Divisions[1] << "x" << view.Divisions[2] << " and basis "
+        << vtkFFDBuildLattice::GetBasisAsString(basis) << " need " << expected << ".";
+    return msg.str();
+  }
+  vtkDataArray* rest = lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
+  if (!rest || rest->GetNumberOfComponents() != 3 || rest->GetNumberOfTuples() != count)
+  {
+    return "The lattice has no RestPosition point array of 3 components per point." + fix;
+  }
+  const vtkIdType notFinite = vtkFFDReadLatticeDisplacements(lattice, rest, view.Displacements, nullptr);
+  if (notFinite >= 0)
+  {
+    return "Lattice point " + std::to_string(notFinite) + " or its RestPosition is not finite.";
+  }
+  return std::string();
+}
+
+//------------------------------------------------------------------------------------------------------------
+// Binding: the cell of every point (ffd::BindToGrid), -1 for points that keep their position.
+struct BindSettings
+{
+  ffd::Frame<double> Frame;
+  ffd::GridBasis Basis;
+  int Voxels[3];
+  bool ClampOutside;
+};
+
+template <typename PointArrayT>
+struct BindFunctor
+{
+  PointArrayT* Points;
+  const BindSettings& Settings;
+  int* CellOfPoint;
+
+  void operator()(vtkIdType begin, vtkIdType end)
+  {
+    const auto points = vtk::DataArrayTupleRange<3>(this->Points, begin, end);
+    int* cell = this->CellOfPoint + begin;
+    for (const auto x : points)
+    {
+      *cell++ = ffd::BindToGrid(this->Settings.Frame, this->Settings.Basis, this->Settings.Voxels,
+        { double(x[0]), double(x[1]), double(x[2]) }, this->Settings.ClampOutside);
+    }
+  }
+};
+
+struct BindWorker
+{
+  template <typename PointArrayT>
+  void operator()(
+    PointArrayT* points, const BindSettings& settings, int* cells, vtkAlgorithm* self, double progressBegin,
+    double progressEnd, bool& completed)
+  {
+    BindFunctor<PointArrayT> functor{ points, settings, cells };
+    const vtkIdType n = points->GetNumberOfTuples();
+    completed = vtkFFDForInChunks(self, n, vtkFFDGrain(n, 2.0), functor, progressBegin, progressEnd);
+  }
+};
+} // namespace
+
+//------------------------------------------------------------------------------------------------------------
+// The CPU binding of the input's points to a grid lattice: kept while the points and the lattice's rest state
+// stay the same (vtkFFDBindingKey).
+struct vtkFFDGridBinding
+{
+  std::vector<int> CellOfPoint; // per input point: its cell (ffd::BindToGrid), -1 where it keeps its position
+  ffd::BlockCells Blocks;      // the cells of each block of points (ffd::ListBlockCells)
+  ffd::GatheredPoints Gathered; // the points of blocks not deformed in place (ffd::ListGatheredPoints)
+  bool CellTable = false;      // evaluation from ffd::FillCellTable (ffd::WorthCellTable)
+  // The gathered points' coordinates in their listed order (ffd::CopyGatheredPoints), in the precision of the
+  // evaluations that needed them: copied from the input at the first, then read in order by every update.
+  std::vector<float> ListedFloat;
+  std::vector<double> ListedDouble;
+  // Each thread's tile of results (ffd::DeformGathered), kept from update to update: making a vtkSMPThreadLocal
+  // and zeroing its buffers at every update is a noticeable part of an update's fixed cost.
+  vtkSMPThreadLocal<std::vector<float>> StagingFloat;
+  vtkSMPThreadLocal<std::vector<double>> StagingDouble;
+
+  template <typename Real>
+  const Real* Listed(const Real* inPoints)
+  {
+    std::vector<Real>& listed = this->ListedOf(Real());
+    const vtkIdType count = vtkIdType(this->Gathered.Order.size());
+    if (listed.size() != std::size_t(3 * count))
+    {
+      listed.resize(std::size_t(3 * count));
+      vtkSMPTools::For(0, count, vtkFFDGrain(count, 1.0), [&](vtkIdType begin, vtkIdType end) {
+        ffd::CopyGatheredPoints(inPoints, this->Gathered, begin, end, listed.data());
+      });
+    }
+    return listed.data();
+  }
+
+  /// The calling thread's staging buffer of ffd::GatherStaging Real values (ffd::DeformGathered).
+  template <typename Real>
+  Real* Staging()
+  {
+    std::vector<Real>& staging = this->StagingOf(Real()).Local();
+    staging.resize(ffd::GatherStaging);
+    return staging.data();
+  }
+
+private:
+  std::vector<float>& ListedOf(float) { return this->ListedFloat; }
+  std::vector<double>& ListedOf(double) { return this->ListedDouble; }
+  vtkSMPThreadLocal<std::vector<float>>& StagingOf(float) { return this->StagingFloat; }
+  vtkSMPThreadLocal<std::vector<double>>& StagingOf(double) { return this->StagingDouble; }
+};
+
+namespace
+{
+// Evaluation of the points alone (no normals, no determinants) from points of the output's precision, W at a
+// time in SIMD lanes (FFDGridLanes.h): first the blocks deformed in place, then the points of the other blocks,
+// gathered by cell at binding, tile by tile.
+template <typename Deformer, typename Real>
+struct LanesFunctor
+{
+  const Real* InPoints;
+  Real* OutPoints;
+  vtkFFDGridBinding& Binding;
+  const Real* Listed; // vtkFFDGridBinding::Listed()
+  Deformer Deformation;
+  bool Stream;       // non-temporal stores in the in-place pass (ffd::StreamOutput())
+  bool GatheredPass; // false: over the blocks of points, true: over the tiles of Binding.Gathered
+
+  void operator()(vtkIdType begin, vtkIdType end)
+  {
+    static const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
+    if (this->GatheredPass)
+    {
+      ffd::DeformGathered(level, this->Deformation, this->Listed, this->Binding.Gathered, this->OutPoints, begin,
+        end, this->Binding.template Staging<Real>());
+    }
+    else
+    {
+      ffd::DeformBlocksInPlace(level, this->Deformation, this->InPoints, this->Binding.CellOfPoint.data(),
+        this->OutPoints, this->Binding.Blocks, begin, end, this->Stream);
+    }
+  }
+};
+
+// Evaluation with the Jacobian (normals to transform, determinants), W points at a time in SIMD lanes
+// (ffd::DeformWithJacobian), over blocks of ffd::BlockSize points: the last points, fewer than a lane group, are
+// deformed one at a time, whatever the split among threads.
+template <typename Deformer, typename Real>
+struct JacobianFunctor
+{
+  const Real* InPoints;
+  Real* OutPoints;
+  const vtkFFDGridBinding& Binding;
+  vtkIdType NumberOfPoints;
+  const Real* InNormals; // nullptr: no normals to transform
+  Real* OutNormals;
+  Real* Determinants; // nullptr: not asked for
+  Deformer Deformation;
+
+  void operator()(vtkIdType begin, vtkIdType end)
+  {
+    static const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
+    ffd::DeformWithJacobian(level, this->Deformation, this->InPoints, this->Binding.CellOfPoint.data(),
+      this->Binding.Blocks, this->InNormals, this->OutPoints, this->OutNormals, this->Determinants,
+      begin * ffd::BlockSize, std::min(this->NumberOfPoints, end * ffd::BlockSize));
+  }
+};
+
+template <typename Real>
+struct EvaluateWorker
+{
+  template <typename PointArrayT>
+  void operator()(PointArrayT* inPoints, const vtkFFDGridLattice& lattice, vtkFFDGridBinding& binding,
+    vtkDataArray* inNormals, vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outPoints,
+    vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self, double progressBegin, double progressEnd, bool& completed)
+  {
+    const std::vector<Real> displacements(lattice.Displacements.begin(), lattice.Displacements.end());
+    std::vector<Real> cellTable;
+    if (binding.CellTable)
+    {
+      const int cells = lattice.Divisions[0] * lattice.Divisions[1] * lattice.Divisions[2];
+      cellTable.resize(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(lattice.Basis)));
+      vtkSMPTools::For(0, cells, 256, [&](int begin, int end) {
+        ffd::FillCellTable(
+          lattice.Basis, displacements.data(), lattice.Divisions, lattice.ControlPointsPerAxis, cellTable.data(), begin, end);
+      });
+    }
+    // One instantiation per basis (ffd::WithStaticBasis); a local basis but the tricubic Bezier one also with
+    // its cell table, where the binding chose one (ffd::WorthCellTable).
+    ffd::WithStaticBasis(lattice.Basis, [&](auto maxCount, auto basis) {
+      auto run = [&](auto withCellTable) {
+        this->Run<decltype(maxCount)::value, decltype(basis)::value, decltype(withCellTable)::value>(inPoints,
+          lattice, displacements.data(), cellTable.data(), binding, inNormals, outNormals, outPoints,
+          determinants, self, progressBegin, progressEnd, completed);
+      };
+      constexpr int Basis = decltype(basis)::value;
+      if constexpr (Basis != int(ffd::GridBasis::Bernstein) && Basis != int(ffd::GridBasis::TricubicBezier))
+      {
+        if (binding.CellTable)
+        {
+          run(std::true_type());
+          return;
+        }
+      }
+      run(std::false_type());
+    });
+  }
+
+  template <int MaxCount, int StaticBasis, bool WithCellTable, typename PointArrayT>
+  void Run(PointArrayT* inPoints, const vtkFFDGridLattice& lattice, const Real* displacements, const Real* cellTable,
+    vtkFFDGridBinding& binding, vtkDataArray* inNormals, vtkDataArray* outNormals,
+    vtkAOSDataArrayTemplate<Real>* outPoints, vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self,
+    double progressBegin, double progressEnd, bool& completed)
+  {
+    using Deformation = ffd::GridDeformation<MaxCount, Real, StaticBasis, Real, WithCellTable>;
+    const Deformation deformation{ lattice.Basis,
+      { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] },
+      { lattice.ControlPointsPerAxis[0], lattice.ControlPointsPerAxis[1], lattice.ControlPointsPerAxis[2] }, displacements,
+      ffd::Frame<Real>::FromArray(lattice.Frame), cellTable };
+    const vtkIdType n = inPoints->GetNumberOfTuples();
+    // The work of a point: the control points it reads, and 16 for its parameters and output.
+    double reads = 1.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      reads *= ffd::SupportSize(lattice.Basis, lattice.Divisions[a]);
+    }
+    const double cost = reads + 16.0;
+    const vtkIdType pointGrain = vtkFFDGrain(n, cost);
+    const vtkIdType blockGrain = std::max<vtkIdType>(1, pointGrain / ffd::BlockSize);
+    if constexpr (std::is_same<PointArrayT, vtkAOSDataArrayTemplate<Real>>::value)
+    {
+      if (!outNormals && !determinants)
+      {
+        const Real* in = inPoints->GetPointer(0);
+        LanesFunctor<Deformation, Real> lanes{ in, outPoints->GetPointer(0), binding,
+          binding.Gathered.Order.empty() ? nullptr : binding.Listed(in), deformation,
+          ffd::StreamOutput(std::int64_t(3 * sizeof(Real)) * n), false };
+        const vtkIdType blocks = (n + ffd::BlockSize - 1) / ffd::BlockSize;
+        const vtkIdType gathered = vtkIdType(binding.Gathered.Order.size());
+        const double middle = progressBegin + (progressEnd - progressBegin) * double(n - gathered) / double(n);
+        completed = binding.Blocks.MaxCells <= 0 || // every block gathered
+          vtkFFDForInChunks(self, blocks, blockGrain, lanes, progressBegin, middle);
+        lanes.GatheredPass = true;
+        completed = completed && vtkFFDForInChunks(self, binding.Gathered.TileCount(), 1, lanes, middle, progressEnd);
+        return;
+      }
+      using NormalArray = vtkAOSDataArrayTemplate<Real>;
+      NormalArray* normalsIn = NormalArray::FastDownCast(inNormals);
+      NormalArray* normalsOut = NormalArray::FastDownCast(outNormals);
+      if (!inNormals || (normalsIn && normalsOut))
+      {
+        JacobianFunctor<Deformation, Real> jacobian{ inPoints->GetPointer(0), outPoints->GetPointer(0), binding,
+          n, normalsIn ? normalsIn->GetPointer(0) : nullptr, normalsOut ? normalsOut->GetPointer(0) : nullptr,
+          determinants ? determinants->GetPointer(0) : nullptr, deformation };
+        completed = vtkFFDForInChunks(
+          self, (n + ffd::BlockSize - 1) / ffd::BlockSize, blockGrain, jacobian, progressBegin, progressEnd);
+        return;
+      }
+    }
+    completed = vtkFFDDeformPoints(inPoints, binding.CellOfPoint.data(), deformation, inNormals, outNormals,
+      outPoints->GetPointer(0), determinants ? determinants->GetPointer(0) : nullptr, self, pointGrain,
+      progressBegin, progressEnd);
+  }
+};
+} // namespace
+
+//------------------------------------------------------------------------------------------------------------
+vtkFFDGridDeformer::vtkFFDGridDeformer()
+  : Binding(new vtkFFDGridBinding)
+{
+}
+
+vtkFFDGridDeformer::~vtkFFDGridDeformer() = default;
+
+//------------------------------------------------------------------------------------------------------------
+std::string vtkFFDGridDeformer::SetLattice(vtkPointSet* lattice)
+{
+  return ReadLattice(lattice, this->Lattice);
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkFFDBindingKey vtkFFDGridDeformer::KeyOf(vtkPoints* points, int outsidePolicy) const
+{
+  return vtkFFDBindingKey::OfGrid(
+    points, outsidePolicy, this->Lattice.Frame, this->Lattice.Divisions, static_cast<int>(this->Lattice.Basis));
+}
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDGridDeformer::Bind(
+  vtkPoints* points, int outsidePolicy, vtkAlgorithm* self, double progressBegin, double progressEnd, bool& rebound)
+{
+  rebound = false;
+  const vtkFFDBindingKey key = this->KeyOf(points, outsidePolicy);
+  if (key == this->Bound)
+  {
+    return true;
+  }
+  this->Bound = vtkFFDBindingKey();
+  const vtkFFDGridLattice& lattice = this->Lattice;
+  vtkFFDGridBinding& binding = *this->Binding;
+  const vtkIdType n = points->GetNumberOfPoints();
+  binding.CellOfPoint.resize(n);
+  const BindSettings settings{ ffd::Frame<double>::FromArray(lattice.Frame), lattice.Basis,
+    { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] }, key.ClampsOutside() };
+  bool completed = false;
+  BindWorker bind;
+  if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(points->GetData(), bind, settings,
+        binding.CellOfPoint.data(), self, progressBegin, progressEnd, completed))
+  {
+    bind(points->GetData(), settings, binding.CellOfPoint.data(), self, progressBegin, progressEnd, completed);
+  }
+  if (!completed)
+  {
+    return false;
+  }
+  int cellCount = 1;
+  for (int a = 0; a < 3; ++a)
+  {
+    cellCount *= ffd::BindingCells(lattice.Basis, lattice.Divisions[a]);
+  }
+  const int* cells = binding.CellOfPoint.data();
+  binding.CellTable = ffd::WorthCellTable(lattice.Basis, cellCount, n);
+  const int maxCellsInPlace =
+    ffd::MaxCellsInPlace(lattice.Basis, ffd::MeanCellsPerBlock(cells, n), binding.CellTable);
+  binding.Blocks = ffd::ListBlockCells(cells, n, maxCellsInPlace);
+  binding.Gathered = ffd::ListGatheredPoints(cells, n, cellCount, maxCellsInPlace);
+  binding.ListedFloat.clear();
+  binding.ListedDouble.clear();
+  this->Bound = key;
+  rebound = true;
+  return true;
+}
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDGridDeformer::Evaluate(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints,
+  vtkDataArray* outNormals, vtkDataArray* outDeterminants, vtkAlgorithm* self, double progressBegin,
+  double progressEnd)
+{
+  bool completed = false;
+  auto evaluate = [&](auto* out) {
+    using RealArray = std::remove_pointer_t<decltype(out)>;
+    using Real = typename RealArray::ValueType;
+    EvaluateWorker<Real> worker;
+    auto* determinants = static_cast<RealArray*>(outDeterminants);
+    if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(points->GetData(), worker, this->Lattice,
+          *this->Binding, normals, outNormals, out, determinants, self, progressBegin, progressEnd, completed))
+    {
+      worker(points->GetData(), this->Lattice, *this->Binding, normals, outNormals, out, determinants, self,
+        progressBegin, progressEnd, completed);
+    }
+  };
+  if (auto* doubles = vtkAOSDataArrayTemplate<double>::FastDownCast(outPoints))
+  {
+    evaluate(doubles);
+  }
+  else
+  {
+    evaluate(vtkAOSDataArrayTemplate<float>::FastDownCast(outPoints));
+  }
+  return completed;
+}

@@ -1,0 +1,82 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkFFDGridDeformer
+ * @brief   vtkFFDDeform's path for grid lattices: reading, binding and CPU evaluation
+ *
+ * Private to the Filters module (not wrapped); the counterpart of vtkFFDTetrahedralDeformer for the lattices of
+ * vtkFFDBuildLattice (see vtkFFDDataContract). SetLattice() reads and checks a lattice and keeps its control
+ * points' displacements; Bind() finds every point's cell (ffd::BindToGrid) and lists the blocks of points
+ * for the SIMD passes, unless the binding is already for these points, the same rest frame, divisions, basis and
+ * policy; Evaluate() deforms the bound points on vtkSMPTools threads. Filters/README.md says how the passes work.
+ */
+#ifndef vtkFFDGridDeformer_h
+#define vtkFFDGridDeformer_h
+
+#include "vtkFFDBindingKey.h"
+#include "vtkType.h"
+
+#include "FFDGridBasis.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+class vtkAlgorithm;
+class vtkDataArray;
+class vtkPoints;
+class vtkPointSet;
+struct vtkFFDGridBinding;
+
+/// What vtkFFDDeform needs from a grid lattice, read and checked once per update.
+struct vtkFFDGridLattice
+{
+  double Frame[12];
+  int Divisions[3];
+  ffd::GridBasis Basis;
+  int ControlPointsPerAxis[3];
+  std::vector<double> Displacements; // 3 per control point: point minus RestPosition
+};
+
+class vtkFFDGridDeformer
+{
+public:
+  vtkFFDGridDeformer();
+  ~vtkFFDGridDeformer();
+  vtkFFDGridDeformer(const vtkFFDGridDeformer&) = delete;
+  vtkFFDGridDeformer& operator=(const vtkFFDGridDeformer&) = delete;
+
+  /**
+   * Reads and checks a grid lattice per the data contract and keeps it for Bind() and Evaluate(). Returns an
+   * empty string, or what is wrong with it.
+   */
+  std::string SetLattice(vtkPointSet* lattice);
+
+  /// The lattice of the last SetLattice().
+  const vtkFFDGridLattice& GetLattice() const { return this->Lattice; }
+
+  /// What a binding of `points` to the lattice of SetLattice() under `outsidePolicy` is for.
+  vtkFFDBindingKey KeyOf(vtkPoints* points, int outsidePolicy) const;
+
+  /**
+   * Binds the points to the lattice of SetLattice() unless the binding is already for them (KeyOf()). Progress
+   * goes to `self` from `progressBegin` to `progressEnd`. Returns false when aborted (the binding is then
+   * dropped); `rebound` tells whether it bound.
+   */
+  bool Bind(vtkPoints* points, int outsidePolicy, vtkAlgorithm* self, double progressBegin, double progressEnd,
+    bool& rebound);
+
+  /**
+   * Deforms the bound points into outPoints (a float or double AOS array of their count), with the normals
+   * (3 components, may be null) transformed into outNormals and det J into outDeterminants (of outPoints' type)
+   * when those are not null. Returns false when aborted.
+   */
+  bool Evaluate(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals,
+    vtkDataArray* outDeterminants, vtkAlgorithm* self, double progressBegin, double progressEnd);
+
+private:
+  vtkFFDGridLattice Lattice;
+  std::unique_ptr<vtkFFDGridBinding> Binding;
+  vtkFFDBindingKey Bound; // what Binding is for
+};
+
+#endif
