@@ -2,8 +2,9 @@
 /**
  * @file FFDKernelTestUtilities.h
  * @brief Random inputs shared by the kernel tests: frames, points, grid lattices of every basis, conversions
- * between the reference's double arrays (ffdref::) and the kernels' types (ffd::), and the tolerances the tests
- * share. No VTK, plain C++17 (also built by nvcc).
+ * between the reference's double arrays (ffdref::) and the kernels' types (ffd::), the tolerances the tests
+ * share, the loop over random lattices of every basis, random affine maps and central differences; the
+ * comparisons themselves are FFDTestComparisons.h's. No VTK, plain C++17 (also built by nvcc).
  */
 #ifndef FFDKernelTestUtilities_h
 #define FFDKernelTestUtilities_h
@@ -12,6 +13,7 @@
 #include "FFDFrame.h"
 #include "FFDGridDeformation.h"
 #include "FFDReference.h"
+#include "FFDTestComparisons.h"
 #include "FFDVector.h"
 
 #include <gtest/gtest.h>
@@ -19,9 +21,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <random>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace ffdtest
@@ -197,23 +202,6 @@ constexpr double GradientTolerance()
   return sizeof(Real) >= sizeof(double) ? 1e-6 : 1e-4;
 }
 
-/// Tracks the worst error / tolerance ratio of a test and records it in the XML output (--gtest_output=xml),
-/// so the margins can be read without a debugger.
-class WorstRatio
-{
-public:
-  explicit WorstRatio(const char* key)
-    : Key(key)
-  {
-  }
-  ~WorstRatio() { ::testing::Test::RecordProperty(this->Key, std::to_string(this->Worst)); }
-  void Add(double error, double tol) { this->Worst = std::max(this->Worst, error / tol); }
-
-private:
-  const char* Key;
-  double Worst = 0.0;
-};
-
 /// The kernels' frame (dual basis from ffd::Frame::FromArray) of a reference frame.
 template <typename Real>
 ffd::Frame<Real> KernelFrame(const ffdref::Frame& f)
@@ -279,6 +267,45 @@ inline GridLattice RandomGridLattice(Rng& rng, ffdref::Basis basis, int maxDivis
     lat.Points.push_back({ p[0] + d[0], p[1] + d[1], p[2] + d[2] });
   }
   return lat;
+}
+
+/**
+ * The loop the grid tests share: for each basis of `bases` (every grid basis by default), `trials` lattices of
+ * RandomGridLattice(rng, basis, maxDivisions), each passed to f as a GridLattice& that f may change (and the trial,
+ * 0..trials - 1, where f takes it too). Stops at the first fatal failure, as an ASSERT_* in the loop's body would.
+ */
+template <typename F>
+void ForEachRandomLattice(
+  Rng& rng, std::initializer_list<ffdref::Basis> bases, int trials, int maxDivisions, F&& f)
+{
+  for (ffdref::Basis b : bases)
+  {
+    for (int trial = 0; trial < trials; ++trial)
+    {
+      GridLattice lat = RandomGridLattice(rng, b, maxDivisions);
+      if constexpr (std::is_invocable_v<F&, GridLattice&, int>)
+      {
+        f(lat, trial);
+      }
+      else
+      {
+        f(lat);
+      }
+      if (::testing::Test::HasFatalFailure())
+      {
+        return;
+      }
+    }
+  }
+}
+
+template <typename F>
+void ForEachRandomLattice(Rng& rng, int trials, int maxDivisions, F&& f)
+{
+  ForEachRandomLattice(rng,
+    { ffdref::Basis::Bernstein, ffdref::Basis::Trilinear, ffdref::Basis::TriquadraticBezier,
+      ffdref::Basis::TricubicBezier, ffdref::Basis::CubicBSpline },
+    trials, maxDivisions, std::forward<F>(f));
 }
 
 /**
@@ -397,6 +424,58 @@ inline Mat Cofactor(const Mat& a)
       c[i][k] = a[i1][k1] * a[i2][k2] - a[i1][k2] * a[i2][k1];
     }
   return c;
+}
+
+/// An affine map x -> A x + b.
+struct Affine
+{
+  Mat A;
+  ffdref::Vec B;
+
+  ffdref::Vec operator()(const ffdref::Vec& x) const
+  {
+    ffdref::Vec y;
+    for (int r = 0; r < 3; ++r)
+    {
+      y[r] = A[r][0] * x[0] + A[r][1] * x[1] + A[r][2] * x[2] + B[r];
+    }
+    return y;
+  }
+};
+
+/// A random affine map: A = I plus entries uniform in [-amplitude, amplitude] (drawn row by row), then b in
+/// [-1, 1]^3.
+inline Affine RandomAffine(Rng& rng, double amplitude)
+{
+  Affine m;
+  for (int r = 0; r < 3; ++r)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      m.A[r][c] = (r == c ? 1.0 : 0.0) + Uniform(rng, -amplitude, amplitude);
+    }
+  }
+  m.B = RandomVec(rng, -1.0, 1.0);
+  return m;
+}
+
+/// Central differences of a map f of 3-vectors at x with step h: d[r][c] = (f(x + h e_c) - f(x - h e_c))_r / 2h.
+template <typename F>
+Mat CentralDifferences(const ffdref::Vec& x, double h, F&& f)
+{
+  Mat d;
+  for (int c = 0; c < 3; ++c)
+  {
+    ffdref::Vec plus = x, minus = x;
+    plus[c] += h;
+    minus[c] -= h;
+    const ffdref::Vec diff = ffdref::Sub(f(plus), f(minus));
+    for (int r = 0; r < 3; ++r)
+    {
+      d[r][c] = diff[r] / (2.0 * h);
+    }
+  }
+  return d;
 }
 
 /// The float64 Jacobian of a point bound to a grid lattice, and where ffdref::JacobianLocal evaluated it.

@@ -14,12 +14,7 @@ namespace
 {
 using ffdtest::Eps;
 
-template <typename Real>
-class FFDBernsteinTest : public ::testing::Test
-{
-};
-using RealTypes = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(FFDBernsteinTest, RealTypes);
+FFD_REAL_TYPED_TEST_SUITE(FFDBernsteinTest);
 
 constexpr int MaxDegree = ffd::MaxBernsteinDegree;
 constexpr int SamplesPerDegree = 200;

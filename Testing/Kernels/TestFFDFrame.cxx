@@ -19,12 +19,7 @@ using ffdtest::MaxAbs;
 using ffdtest::Norm;
 using ffdtest::WorldScale;
 
-template <typename Real>
-class FFDFrameTest : public ::testing::Test
-{
-};
-using RealTypes = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(FFDFrameTest, RealTypes);
+FFD_REAL_TYPED_TEST_SUITE(FFDFrameTest);
 
 constexpr int NumberOfFrames = 200;
 constexpr int PointsPerFrame = 50;
@@ -57,10 +52,7 @@ TYPED_TEST(FFDFrameTest, ToParametricMatchesReference)
       // numbers are rounded to Real and X - X0 and the dot products round at that scale, and the dual vectors
       // turn world errors into parameter errors.
       const double tol = 16.0 * Eps<Real>() * DualNorm(f) * WorldScale(f, xd);
-      for (int c = 0; c < 3; ++c)
-      {
-        ASSERT_NEAR(got[c], ref[c], tol) << "frame " << trial << " point " << p << " axis " << c;
-      }
+      ASSERT_TRUE(ffdtest::VectorNear(got, ref, tol, "axis")) << "frame " << trial << " point " << p;
     }
   }
 }
@@ -82,10 +74,7 @@ TYPED_TEST(FFDFrameTest, ToWorldInvertsToParametric)
       // Tolerance (absolute, world units): the parameter error above times the edges, plus the rounding of
       // the sum X0 + sS + tT + uU: 16 eps (1 + |dual| (|S| + |T| + |U|)) (|x| + |X0| + |S| + |T| + |U|).
       const double tol = 16.0 * Eps<Real>() * (1.0 + DualNorm(f) * edges) * WorldScale(f, xd);
-      for (int c = 0; c < 3; ++c)
-      {
-        ASSERT_NEAR(back[c], xd[c], tol) << "frame " << trial << " point " << p << " axis " << c;
-      }
+      ASSERT_TRUE(ffdtest::VectorNear(back, xd, tol, "axis")) << "frame " << trial << " point " << p;
     }
   }
 }
@@ -110,8 +99,8 @@ TYPED_TEST(FFDFrameTest, BindKeepsCornersFacesAndInterior)
       {
         ASSERT_GE(g[c], 0.0) << what;
         ASSERT_LE(g[c], 1.0) << what;
-        ASSERT_NEAR(g[c], stu[c], tol) << what << ", frame " << trial << " axis " << c;
       }
+      ASSERT_TRUE(ffdtest::VectorNear(g, stu, tol, "axis")) << what << ", frame " << trial;
     };
     // The 8 corners, built exactly as X0, X0 + S, X0 + S + T, ... in Real from the frame's own vectors.
     for (int corner = 0; corner < 8; ++corner)

@@ -59,12 +59,7 @@ ffd::Vec3<Real> EvaluateBernsteinWithGradient(
   return ffd::SumTensorProductWithGradient(values, dims, axes, gradient);
 }
 
-template <typename Real>
-class FFDGlobalBernsteinTest : public ::testing::Test
-{
-};
-using RealTypes = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(FFDGlobalBernsteinTest, RealTypes);
+FFD_REAL_TYPED_TEST_SUITE(FFDGlobalBernsteinTest);
 
 /// A lattice of degree (l, m, n) over a frame: its rest positions and its (moved) control points.
 struct Lattice
@@ -154,23 +149,7 @@ TYPED_TEST(FFDGlobalBernsteinTest, AffineMapIsReproduced)
   WorstRatio worst("worst_error_over_tolerance");
   for (const Lattice& lat : RandomLattices(rng, 30))
   {
-    double a[3][3];
-    for (int r = 0; r < 3; ++r)
-    {
-      for (int c = 0; c < 3; ++c)
-      {
-        a[r][c] = (r == c ? 1.0 : 0.0) + ffdtest::Uniform(rng, -0.5, 0.5);
-      }
-    }
-    const Vec b = ffdtest::RandomVec(rng, -1.0, 1.0);
-    const auto map = [&](const Vec& x) {
-      Vec y;
-      for (int r = 0; r < 3; ++r)
-      {
-        y[r] = a[r][0] * x[0] + a[r][1] * x[1] + a[r][2] * x[2] + b[r];
-      }
-      return y;
-    };
+    const ffdtest::Affine map = ffdtest::RandomAffine(rng, 0.5);
     std::vector<Vec> mapped, displacement;
     for (const Vec& p : lat.Rest)
     {
@@ -354,7 +333,6 @@ TYPED_TEST(FFDGlobalBernsteinTest, GradientMatchesCentralDifferences)
   using Real = TypeParam;
   ffdtest::Rng rng(306);
   WorstRatio worst("worst_error_over_tolerance");
-  const double h = 1e-6;
   for (const Lattice& lat : RandomLattices(rng, 30))
   {
     const std::vector<Real> values = ffdtest::Flatten<Real>(lat.Points);
@@ -368,21 +346,10 @@ TYPED_TEST(FFDGlobalBernsteinTest, GradientMatchesCentralDifferences)
       const Vec got = ffdtest::ToRef(EvaluateBernsteinWithGradient(values.data(), lat.Dims().data(), stu, g));
       const Vec want = ffdref::Evaluate(seen, lat.L, lat.M, lat.N, s);
       ASSERT_LE(MaxDiff(got, want), EvaluationTolerance<Real>() * scale) << lat.Name();
-      for (int c = 0; c < 3; ++c)
-      {
-        Vec plus = s, minus = s;
-        plus[c] += h;
-        minus[c] -= h;
-        const Vec fd = ffdref::Sub(ffdref::Evaluate(seen, lat.L, lat.M, lat.N, plus),
-          ffdref::Evaluate(seen, lat.L, lat.M, lat.N, minus));
-        for (int r = 0; r < 3; ++r)
-        {
-          const double derivative = fd[r] / (2.0 * h);
-          const double tol = GradientTolerance<Real>() * std::max(scale, std::fabs(derivative));
-          worst.Add(std::fabs(double(g.M[r][c]) - derivative), tol);
-          ASSERT_NEAR(double(g.M[r][c]), derivative, tol) << lat.Name() << " d/d" << "stu"[c] << " of x" << r;
-        }
-      }
+      const ffdtest::Mat fd = ffdtest::CentralDifferences(
+        s, 1e-6, [&](const Vec& y) { return ffdref::Evaluate(seen, lat.L, lat.M, lat.N, y); });
+      const auto tol = [&](int r, int c) { return GradientTolerance<Real>() * std::max(scale, std::fabs(fd[r][c])); };
+      ASSERT_TRUE(ffdtest::MatrixNear(g, fd, tol, "dx/dstu", &worst)) << lat.Name() << " point " << p;
     }
   }
 }
@@ -395,7 +362,6 @@ TYPED_TEST(FFDGlobalBernsteinTest, DeformationJacobianMatchesCentralDifferences)
   using Real = TypeParam;
   ffdtest::Rng rng(307);
   WorstRatio worst("worst_error_over_tolerance");
-  const double h = 1e-6;
   for (const Lattice& lat : RandomLattices(rng, 30))
   {
     const std::vector<Real> dvalues = ffdtest::Flatten<Real>(Displacements(lat));
@@ -412,30 +378,10 @@ TYPED_TEST(FFDGlobalBernsteinTest, DeformationJacobianMatchesCentralDifferences)
       ffd::Mat3<Real> g;
       EvaluateBernsteinWithGradient(dvalues.data(), lat.Dims().data(), stu, g);
       const ffd::Mat3<Real> j = ffd::DeformationJacobian(g, frame);
-      double fd[3][3];
-      double jmax = 1.0;
-      for (int c = 0; c < 3; ++c)
-      {
-        Vec plus = xd, minus = xd;
-        plus[c] += h;
-        minus[c] -= h;
-        const Vec diff = ffdref::Sub(ffdref::Deform(lat.F, lat.Points, lat.L, lat.M, lat.N, plus),
-          ffdref::Deform(lat.F, lat.Points, lat.L, lat.M, lat.N, minus));
-        for (int r = 0; r < 3; ++r)
-        {
-          fd[r][c] = diff[r] / (2.0 * h);
-          jmax = std::max(jmax, std::fabs(fd[r][c]));
-        }
-      }
-      const double tol = GradientTolerance<Real>() * jmax;
-      for (int r = 0; r < 3; ++r)
-      {
-        for (int c = 0; c < 3; ++c)
-        {
-          worst.Add(std::fabs(double(j.M[r][c]) - fd[r][c]), tol);
-          ASSERT_NEAR(double(j.M[r][c]), fd[r][c], tol) << lat.Name() << " J[" << r << "][" << c << "]";
-        }
-      }
+      const ffdtest::Mat fd = ffdtest::CentralDifferences(
+        xd, 1e-6, [&](const Vec& y) { return ffdref::Deform(lat.F, lat.Points, lat.L, lat.M, lat.N, y); });
+      const double tol = GradientTolerance<Real>() * ffdtest::MaxAbsEntry(fd, 1.0);
+      ASSERT_TRUE(ffdtest::MatrixNear(j, fd, tol, "J", &worst)) << lat.Name() << " point " << p;
     }
   }
 }
@@ -519,15 +465,16 @@ TYPED_TEST(FFDGlobalBernsteinTest, CofactorIsDeterminantTimesInverseTranspose)
     double inv[3][3];
     const double det = InvertReference(a, inv);
     EXPECT_NEAR(double(ffd::Determinant(ak)), det, 64.0 * Eps<Real>() * amax * amax * amax);
-    const ffd::Mat3<Real> cof = ffd::Cofactor(ak);
+    ffdtest::Mat want; // det(A) A^-T
     for (int r = 0; r < 3; ++r)
     {
       for (int c = 0; c < 3; ++c)
       {
-        ASSERT_NEAR(double(cof.M[r][c]), det * inv[c][r], 64.0 * Eps<Real>() * amax * amax)
-          << "trial " << trial << " entry " << r << "," << c;
+        want[r][c] = det * inv[c][r];
       }
     }
+    ASSERT_TRUE(ffdtest::MatrixNear(ffd::Cofactor(ak), want, 64.0 * Eps<Real>() * amax * amax, "cofactor"))
+      << "trial " << trial;
 
     // Singular: row 2 = alpha row 0 + beta row 1.
     const double alpha = ffdtest::Uniform(rng, -1, 1), beta = ffdtest::Uniform(rng, -1, 1);
@@ -537,18 +484,15 @@ TYPED_TEST(FFDGlobalBernsteinTest, CofactorIsDeterminantTimesInverseTranspose)
       a[2][c] = double(ak.M[2][c]);
       amax = std::max(amax, std::fabs(a[2][c]));
     }
-    const ffd::Mat3<Real> cs = ffd::Cofactor(ak);
     const Vec rows[3] = { { a[0][0], a[0][1], a[0][2] }, { a[1][0], a[1][1], a[1][2] },
       { a[2][0], a[2][1], a[2][2] } };
+    ffdtest::Mat crosses; // row r: the cross product of the other two rows
     for (int r = 0; r < 3; ++r)
     {
-      const Vec cross = ffdref::Cross(rows[(r + 1) % 3], rows[(r + 2) % 3]);
-      for (int c = 0; c < 3; ++c)
-      {
-        ASSERT_NEAR(double(cs.M[r][c]), cross[c], 64.0 * Eps<Real>() * amax * amax)
-          << "singular, trial " << trial << " entry " << r << "," << c;
-      }
+      crosses[r] = ffdref::Cross(rows[(r + 1) % 3], rows[(r + 2) % 3]);
     }
+    ASSERT_TRUE(ffdtest::MatrixNear(ffd::Cofactor(ak), crosses, 64.0 * Eps<Real>() * amax * amax, "cofactor"))
+      << "singular, trial " << trial;
   }
 }
 

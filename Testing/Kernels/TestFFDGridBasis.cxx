@@ -108,12 +108,7 @@ Vec InteriorParameters(ffdtest::Rng& rng, const GridLattice& lat, double margin)
   return stu;
 }
 
-template <typename Real>
-class FFDGridBasisTest : public ::testing::Test
-{
-};
-using RealTypes = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(FFDGridBasisTest, RealTypes);
+FFD_REAL_TYPED_TEST_SUITE(FFDGridBasisTest);
 
 TEST(FFDGridBasisLayout, MatchesDataContractAndReference)
 {
@@ -216,38 +211,33 @@ TYPED_TEST(FFDGridBasisTest, RestLatticeIsIdentity)
   using Real = TypeParam;
   ffdtest::Rng rng(402);
   WorstRatio worst("worst_error_over_tolerance");
-  for (Basis b : ffdtest::AllBases)
-  {
-    for (int trial = 0; trial < 20; ++trial)
+  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](const GridLattice& lat) {
+    const std::vector<Real> values = ffdtest::Flatten<Real>(lat.Rest);
+    const double tol = EvaluationTolerance<Real>() * ffdtest::LatticeScale(lat.Rest);
+    std::vector<Vec> params;
+    for (int p = 0; p < 50; ++p)
     {
-      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 6);
-      const std::vector<Real> values = ffdtest::Flatten<Real>(lat.Rest);
-      const double tol = EvaluationTolerance<Real>() * ffdtest::LatticeScale(lat.Rest);
-      std::vector<Vec> params;
-      for (int p = 0; p < 50; ++p)
-      {
-        params.push_back(RandomParameters<Real>(rng));
-      }
-      for (int p = 0; p < 50; ++p)
-      {
-        Vec stu;
-        for (int a = 0; a < 3; ++a)
-        {
-          const int n = lat.Divisions[a];
-          const int i = std::uniform_int_distribution<int>(0, lat.Dims()[a] - 1)(rng);
-          stu[a] = double(Real(std::min(std::max(ffdref::RestParameter(b, n, i), 0.0), 1.0)));
-        }
-        params.push_back(stu);
-      }
-      for (const Vec& stu : params)
-      {
-        const Vec got = Evaluate(lat, values, stu);
-        const Vec want = ffdtest::ToWorld(lat.F, stu);
-        worst.Add(MaxDiff(got, want), tol);
-        ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " at (" << stu[0] << "," << stu[1] << "," << stu[2] << ")";
-      }
+      params.push_back(RandomParameters<Real>(rng));
     }
-  }
+    for (int p = 0; p < 50; ++p)
+    {
+      Vec stu;
+      for (int a = 0; a < 3; ++a)
+      {
+        const int n = lat.Divisions[a];
+        const int i = std::uniform_int_distribution<int>(0, lat.Dims()[a] - 1)(rng);
+        stu[a] = double(Real(std::min(std::max(ffdref::RestParameter(lat.Basis, n, i), 0.0), 1.0)));
+      }
+      params.push_back(stu);
+    }
+    for (const Vec& stu : params)
+    {
+      const Vec got = Evaluate(lat, values, stu);
+      const Vec want = ffdtest::ToWorld(lat.F, stu);
+      worst.Add(MaxDiff(got, want), tol);
+      ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " at (" << stu[0] << "," << stu[1] << "," << stu[2] << ")";
+    }
+  });
 }
 
 TYPED_TEST(FFDGridBasisTest, AffineMotionIsReproduced)
@@ -257,42 +247,24 @@ TYPED_TEST(FFDGridBasisTest, AffineMotionIsReproduced)
   using Real = TypeParam;
   ffdtest::Rng rng(403);
   WorstRatio worst("worst_error_over_tolerance");
-  for (Basis b : ffdtest::AllBases)
-  {
-    for (int trial = 0; trial < 20; ++trial)
+  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](const GridLattice& lat) {
+    const ffdtest::Affine map = ffdtest::RandomAffine(rng, 0.5);
+    std::vector<Vec> mapped;
+    for (const Vec& p : lat.Rest)
     {
-      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 6);
-      double m[3][3];
-      for (int r = 0; r < 3; ++r)
-      {
-        for (int c = 0; c < 3; ++c)
-        {
-          m[r][c] = (r == c ? 1.0 : 0.0) + ffdtest::Uniform(rng, -0.5, 0.5);
-        }
-      }
-      const Vec t = ffdtest::RandomVec(rng, -1.0, 1.0);
-      const auto map = [&](const Vec& x) {
-        return Vec{ m[0][0] * x[0] + m[0][1] * x[1] + m[0][2] * x[2] + t[0],
-          m[1][0] * x[0] + m[1][1] * x[1] + m[1][2] * x[2] + t[1],
-          m[2][0] * x[0] + m[2][1] * x[1] + m[2][2] * x[2] + t[2] };
-      };
-      std::vector<Vec> mapped;
-      for (const Vec& p : lat.Rest)
-      {
-        mapped.push_back(map(p));
-      }
-      const std::vector<Real> values = ffdtest::Flatten<Real>(mapped);
-      const double tol = EvaluationTolerance<Real>() * ffdtest::LatticeScale(mapped);
-      for (int p = 0; p < 50; ++p)
-      {
-        const Vec stu = RandomParameters<Real>(rng);
-        const Vec got = Evaluate(lat, values, stu);
-        const Vec want = map(ffdtest::ToWorld(lat.F, stu));
-        worst.Add(MaxDiff(got, want), tol);
-        ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " point " << p;
-      }
+      mapped.push_back(map(p));
     }
-  }
+    const std::vector<Real> values = ffdtest::Flatten<Real>(mapped);
+    const double tol = EvaluationTolerance<Real>() * ffdtest::LatticeScale(mapped);
+    for (int p = 0; p < 50; ++p)
+    {
+      const Vec stu = RandomParameters<Real>(rng);
+      const Vec got = Evaluate(lat, values, stu);
+      const Vec want = map(ffdtest::ToWorld(lat.F, stu));
+      worst.Add(MaxDiff(got, want), tol);
+      ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " point " << p;
+    }
+  });
 }
 
 TYPED_TEST(FFDGridBasisTest, RandomLatticesMatchReference)
@@ -303,24 +275,19 @@ TYPED_TEST(FFDGridBasisTest, RandomLatticesMatchReference)
   using Real = TypeParam;
   ffdtest::Rng rng(404);
   WorstRatio worst("worst_error_over_tolerance");
-  for (Basis b : ffdtest::AllBases)
-  {
-    for (int trial = 0; trial < 40; ++trial)
+  ffdtest::ForEachRandomLattice(rng, 40, 6, [&](const GridLattice& lat) {
+    const std::vector<Real> values = ffdtest::Flatten<Real>(lat.Points);
+    const std::vector<Vec> seen = ffdtest::RoundLattice<Real>(lat.Points);
+    const double tol = EvaluationTolerance<Real>() * ffdtest::LatticeScale(seen);
+    for (int p = 0; p < 30; ++p)
     {
-      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 6);
-      const std::vector<Real> values = ffdtest::Flatten<Real>(lat.Points);
-      const std::vector<Vec> seen = ffdtest::RoundLattice<Real>(lat.Points);
-      const double tol = EvaluationTolerance<Real>() * ffdtest::LatticeScale(seen);
-      for (int p = 0; p < 30; ++p)
-      {
-        const Vec stu = RandomParameters<Real>(rng);
-        const Vec got = Evaluate(lat, values, stu);
-        const Vec want = ffdref::EvaluateLocal(b, lat.Divisions.data(), seen, stu);
-        worst.Add(MaxDiff(got, want), tol);
-        ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " point " << p;
-      }
+      const Vec stu = RandomParameters<Real>(rng);
+      const Vec got = Evaluate(lat, values, stu);
+      const Vec want = ffdref::EvaluateLocal(lat.Basis, lat.Divisions.data(), seen, stu);
+      worst.Add(MaxDiff(got, want), tol);
+      ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " point " << p;
     }
-  }
+  });
 }
 
 TYPED_TEST(FFDGridBasisTest, OneBezierVoxelEqualsGlobalBernstein)
@@ -334,46 +301,38 @@ TYPED_TEST(FFDGridBasisTest, OneBezierVoxelEqualsGlobalBernstein)
   using Real = TypeParam;
   ffdtest::Rng rng(405);
   WorstRatio worst("worst_error_over_tolerance");
-  for (Basis b : { Basis::Trilinear, Basis::TriquadraticBezier, Basis::TricubicBezier })
-  {
-    const int d = int(b);
-    for (int trial = 0; trial < 20; ++trial)
+  const auto bases = { Basis::Trilinear, Basis::TriquadraticBezier, Basis::TricubicBezier };
+  ffdtest::ForEachRandomLattice(rng, bases, 20, 1, [&](const GridLattice& bezier) {
+    const int d = int(bezier.Basis);
+    GridLattice global = bezier;
+    global.Basis = Basis::Bernstein;
+    global.Divisions = { d, d, d };
+    ASSERT_EQ(bezier.Dims(), global.Dims());
+    ASSERT_EQ(ffdref::RestLattice(Basis::Bernstein, global.F, global.Divisions.data()), bezier.Rest);
+    for (int i = 0; i <= d; ++i)
     {
-      GridLattice bezier = ffdtest::RandomGridLattice(rng, b, 1);
-      GridLattice global = bezier;
-      global.Basis = Basis::Bernstein;
-      global.Divisions = { d, d, d };
-      ASSERT_EQ(bezier.Dims(), global.Dims());
-      ASSERT_EQ(ffdref::RestLattice(Basis::Bernstein, global.F, global.Divisions.data()), bezier.Rest);
-      for (int i = 0; i <= d; ++i)
-      {
-        ASSERT_EQ(ffd::RestParameter(KernelBasis(b), 1, i), ffd::RestParameter(ffd::GridBasis::Bernstein, d, i));
-      }
-      const std::vector<Real> values = ffdtest::Flatten<Real>(bezier.Points);
-      const std::vector<Vec> seen = ffdtest::RoundLattice<Real>(bezier.Points);
-      const double scale = ffdtest::LatticeScale(seen);
-      const double tol = EvaluationTolerance<Real>() * scale;
-      for (int p = 0; p < 50; ++p)
-      {
-        const Vec stu = RandomParameters<Real>(rng);
-        double gb[3][3], gg[3][3];
-        const Vec xb = EvaluateWithGradient(bezier, values, stu, gb);
-        const Vec xg = EvaluateWithGradient(global, values, stu, gg);
-        const Vec want = ffdref::Evaluate(seen, d, d, d, stu);
-        worst.Add(MaxDiff(xb, xg), tol);
-        worst.Add(MaxDiff(xb, want), tol);
-        ASSERT_LE(MaxDiff(xb, xg), tol) << bezier.Name() << " point " << p;
-        ASSERT_LE(MaxDiff(xb, want), tol) << bezier.Name() << " point " << p;
-        for (int r = 0; r < 3; ++r)
-        {
-          for (int c = 0; c < 3; ++c)
-          {
-            ASSERT_NEAR(gb[r][c], gg[r][c], GradientTolerance<Real>() * scale) << bezier.Name() << " point " << p;
-          }
-        }
-      }
+      ASSERT_EQ(
+        ffd::RestParameter(KernelBasis(bezier.Basis), 1, i), ffd::RestParameter(ffd::GridBasis::Bernstein, d, i));
     }
-  }
+    const std::vector<Real> values = ffdtest::Flatten<Real>(bezier.Points);
+    const std::vector<Vec> seen = ffdtest::RoundLattice<Real>(bezier.Points);
+    const double scale = ffdtest::LatticeScale(seen);
+    const double tol = EvaluationTolerance<Real>() * scale;
+    for (int p = 0; p < 50; ++p)
+    {
+      const Vec stu = RandomParameters<Real>(rng);
+      double gb[3][3], gg[3][3];
+      const Vec xb = EvaluateWithGradient(bezier, values, stu, gb);
+      const Vec xg = EvaluateWithGradient(global, values, stu, gg);
+      const Vec want = ffdref::Evaluate(seen, d, d, d, stu);
+      worst.Add(MaxDiff(xb, xg), tol);
+      worst.Add(MaxDiff(xb, want), tol);
+      ASSERT_LE(MaxDiff(xb, xg), tol) << bezier.Name() << " point " << p;
+      ASSERT_LE(MaxDiff(xb, want), tol) << bezier.Name() << " point " << p;
+      ASSERT_TRUE(ffdtest::MatrixNear(gb, gg, GradientTolerance<Real>() * scale, "dx/dstu"))
+        << bezier.Name() << " point " << p;
+    }
+  });
 }
 
 /// One side of a voxel face or knot along axis `a`: the value, the analytic gradient, and the derivative of the
@@ -642,40 +601,23 @@ TYPED_TEST(FFDGridBasisTest, GradientMatchesCentralDifferences)
   using Real = TypeParam;
   ffdtest::Rng rng(409);
   WorstRatio worst("worst_error_over_tolerance");
-  const double h = 1e-6;
-  for (Basis b : ffdtest::AllBases)
-  {
-    for (int trial = 0; trial < 20; ++trial)
+  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](const GridLattice& lat) {
+    const std::vector<Real> values = ffdtest::Flatten<Real>(lat.Points);
+    const std::vector<Vec> seen = ffdtest::RoundLattice<Real>(lat.Points);
+    const double scale = ffdtest::LatticeScale(seen);
+    for (int p = 0; p < 10; ++p)
     {
-      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 6);
-      const std::vector<Real> values = ffdtest::Flatten<Real>(lat.Points);
-      const std::vector<Vec> seen = ffdtest::RoundLattice<Real>(lat.Points);
-      const double scale = ffdtest::LatticeScale(seen);
-      for (int p = 0; p < 10; ++p)
-      {
-        const Vec stu = InteriorParameters<Real>(rng, lat, 0.01);
-        double g[3][3];
-        const Vec got = EvaluateWithGradient(lat, values, stu, g);
-        const Vec want = ffdref::EvaluateLocal(b, lat.Divisions.data(), seen, stu);
-        ASSERT_LE(MaxDiff(got, want), EvaluationTolerance<Real>() * scale) << lat.Name();
-        for (int c = 0; c < 3; ++c)
-        {
-          Vec plus = stu, minus = stu;
-          plus[c] += h;
-          minus[c] -= h;
-          const Vec fd = ffdref::Sub(ffdref::EvaluateLocal(b, lat.Divisions.data(), seen, plus),
-            ffdref::EvaluateLocal(b, lat.Divisions.data(), seen, minus));
-          for (int r = 0; r < 3; ++r)
-          {
-            const double derivative = fd[r] / (2.0 * h);
-            const double tol = GradientTolerance<Real>() * std::max(scale, std::fabs(derivative));
-            worst.Add(std::fabs(g[r][c] - derivative), tol);
-            ASSERT_NEAR(g[r][c], derivative, tol) << lat.Name() << " d/d" << "stu"[c] << " of x" << r;
-          }
-        }
-      }
+      const Vec stu = InteriorParameters<Real>(rng, lat, 0.01);
+      double g[3][3];
+      const Vec got = EvaluateWithGradient(lat, values, stu, g);
+      const Vec want = ffdref::EvaluateLocal(lat.Basis, lat.Divisions.data(), seen, stu);
+      ASSERT_LE(MaxDiff(got, want), EvaluationTolerance<Real>() * scale) << lat.Name();
+      const ffdtest::Mat fd = ffdtest::CentralDifferences(
+        stu, 1e-6, [&](const Vec& y) { return ffdref::EvaluateLocal(lat.Basis, lat.Divisions.data(), seen, y); });
+      const auto tol = [&](int r, int c) { return GradientTolerance<Real>() * std::max(scale, std::fabs(fd[r][c])); };
+      ASSERT_TRUE(ffdtest::MatrixNear(g, fd, tol, "dx/dstu", &worst)) << lat.Name() << " point " << p;
     }
-  }
+  });
 }
 
 } // namespace

@@ -81,12 +81,7 @@ Vec ClampedReference(const GridLattice& lat, const Vec& x)
   return { x[0] + d[0], x[1] + d[1], x[2] + d[2] };
 }
 
-template <typename Real>
-class FFDGridDeformationTest : public ::testing::Test
-{
-};
-using RealTypes = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(FFDGridDeformationTest, RealTypes);
+FFD_REAL_TYPED_TEST_SUITE(FFDGridDeformationTest);
 
 TYPED_TEST(FFDGridDeformationTest, DeformMatchesReference)
 {
@@ -96,31 +91,26 @@ TYPED_TEST(FFDGridDeformationTest, DeformMatchesReference)
   using Real = TypeParam;
   ffdtest::Rng rng(501);
   WorstRatio worst("worst_error_over_tolerance");
-  for (Basis b : ffdtest::AllBases)
-  {
-    for (int trial = 0; trial < 30; ++trial)
-    {
-      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 6);
-      const double scale = ffdtest::LatticeScale(lat.Points);
-      WithKernel<Real>(lat, [&](const auto& k) {
-        for (int p = 0; p < 30; ++p)
-        {
-          const ffd::Vec3<Real> x = PointAt<Real>(lat, ffdtest::RandomVec(rng, 0.0, 1.0)).first;
-          const Vec xd = ffdtest::ToRef(x);
-          const int cell = k.Bind(x, false);
-          ASSERT_GE(cell, 0) << lat.Name() << " point " << p;
-          ffd::Mat3<Real> j;
-          const Vec got = ffdtest::ToRef(k.D.Deform(x, cell));
-          const Vec gotJ = ffdtest::ToRef(k.D.Deform(x, cell, j));
-          const Vec want = ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, xd);
-          const double tol = PositionTolerance(scale, xd, lat.F, j);
-          worst.Add(MaxDiff(got, want), tol);
-          ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " point " << p;
-          ASSERT_LE(MaxDiff(gotJ, want), tol) << lat.Name() << " point " << p << " (with Jacobian)";
-        }
-      });
-    }
-  }
+  ffdtest::ForEachRandomLattice(rng, 30, 6, [&](const GridLattice& lat) {
+    const double scale = ffdtest::LatticeScale(lat.Points);
+    WithKernel<Real>(lat, [&](const auto& k) {
+      for (int p = 0; p < 30; ++p)
+      {
+        const ffd::Vec3<Real> x = PointAt<Real>(lat, ffdtest::RandomVec(rng, 0.0, 1.0)).first;
+        const Vec xd = ffdtest::ToRef(x);
+        const int cell = k.Bind(x, false);
+        ASSERT_GE(cell, 0) << lat.Name() << " point " << p;
+        ffd::Mat3<Real> j;
+        const Vec got = ffdtest::ToRef(k.D.Deform(x, cell));
+        const Vec gotJ = ffdtest::ToRef(k.D.Deform(x, cell, j));
+        const Vec want = ffdref::DeformLocal(lat.Basis, lat.F, lat.Divisions.data(), lat.Points, xd);
+        const double tol = PositionTolerance(scale, xd, lat.F, j);
+        worst.Add(MaxDiff(got, want), tol);
+        ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " point " << p;
+        ASSERT_LE(MaxDiff(gotJ, want), tol) << lat.Name() << " point " << p << " (with Jacobian)";
+      }
+    });
+  });
 }
 
 TYPED_TEST(FFDGridDeformationTest, AffineMotionIsReproduced)
@@ -132,74 +122,38 @@ TYPED_TEST(FFDGridDeformationTest, AffineMotionIsReproduced)
   using Real = TypeParam;
   ffdtest::Rng rng(502);
   WorstRatio worst("worst_error_over_tolerance");
-  for (Basis b : ffdtest::AllBases)
-  {
-    for (int trial = 0; trial < 20; ++trial)
+  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](GridLattice& lat) {
+    const ffdtest::Affine map = ffdtest::RandomAffine(rng, 0.5);
+    const double mmax = ffdtest::MaxAbsEntry(map.A, 1.0);
+    for (size_t i = 0; i < lat.Rest.size(); ++i)
     {
-      GridLattice lat = ffdtest::RandomGridLattice(rng, b, 6);
-      double m[3][3], mmax = 1.0;
-      for (int r = 0; r < 3; ++r)
-      {
-        for (int c = 0; c < 3; ++c)
-        {
-          m[r][c] = (r == c ? 1.0 : 0.0) + ffdtest::Uniform(rng, -0.5, 0.5);
-          mmax = std::max(mmax, std::fabs(m[r][c]));
-        }
-      }
-      const Vec t = ffdtest::RandomVec(rng, -1.0, 1.0);
-      const auto map = [&](const Vec& x) {
-        return Vec{ m[0][0] * x[0] + m[0][1] * x[1] + m[0][2] * x[2] + t[0],
-          m[1][0] * x[0] + m[1][1] * x[1] + m[1][2] * x[2] + t[1],
-          m[2][0] * x[0] + m[2][1] * x[1] + m[2][2] * x[2] + t[2] };
-      };
-      for (size_t i = 0; i < lat.Rest.size(); ++i)
-      {
-        lat.Points[i] = map(lat.Rest[i]);
-      }
-      const double scale = ffdtest::LatticeScale(lat.Points);
-      WithKernel<Real>(lat, [&](const auto& k) {
-        for (int p = 0; p < 30; ++p)
-        {
-          const ffd::Vec3<Real> x = PointAt<Real>(lat, ffdtest::RandomVec(rng, 0.0, 1.0)).first;
-          const Vec xd = ffdtest::ToRef(x);
-          const int cell = k.Bind(x, false);
-          ASSERT_GE(cell, 0);
-          ffd::Mat3<Real> j;
-          const Vec got = ffdtest::ToRef(k.D.Deform(x, cell, j));
-          const double tol = EvaluationTolerance<Real>() * (scale + MaxAbs(xd));
-          worst.Add(MaxDiff(got, map(xd)), tol);
-          ASSERT_LE(MaxDiff(got, map(xd)), tol) << lat.Name() << " point " << p;
-          const double tolJ = 100.0 * EvaluationTolerance<Real>() * mmax;
-          for (int r = 0; r < 3; ++r)
-          {
-            for (int c = 0; c < 3; ++c)
-            {
-              worst.Add(std::fabs(double(j.M[r][c]) - m[r][c]), tolJ);
-              ASSERT_NEAR(double(j.M[r][c]), m[r][c], tolJ) << lat.Name() << " J[" << r << "][" << c << "]";
-            }
-          }
-        }
-      });
+      lat.Points[i] = map(lat.Rest[i]);
     }
-  }
+    const double scale = ffdtest::LatticeScale(lat.Points);
+    WithKernel<Real>(lat, [&](const auto& k) {
+      for (int p = 0; p < 30; ++p)
+      {
+        const ffd::Vec3<Real> x = PointAt<Real>(lat, ffdtest::RandomVec(rng, 0.0, 1.0)).first;
+        const Vec xd = ffdtest::ToRef(x);
+        const int cell = k.Bind(x, false);
+        ASSERT_GE(cell, 0);
+        ffd::Mat3<Real> j;
+        const Vec got = ffdtest::ToRef(k.D.Deform(x, cell, j));
+        const double tol = EvaluationTolerance<Real>() * (scale + MaxAbs(xd));
+        worst.Add(MaxDiff(got, map(xd)), tol);
+        ASSERT_LE(MaxDiff(got, map(xd)), tol) << lat.Name() << " point " << p;
+        const double tolJ = 100.0 * EvaluationTolerance<Real>() * mmax;
+        ASSERT_TRUE(ffdtest::MatrixNear(j, map.A, tolJ, "J", &worst)) << lat.Name() << " point " << p;
+      }
+    });
+  });
 }
 
 /// Central differences, h = 1e-6, of a map of world points: fd[r][c] = d f_r / d x_c.
 template <typename F>
-void CentralDifferences(const Vec& x, F&& f, double fd[3][3])
+ffdtest::Mat CentralDifferences(const Vec& x, F&& f)
 {
-  const double h = 1e-6;
-  for (int c = 0; c < 3; ++c)
-  {
-    Vec plus = x, minus = x;
-    plus[c] += h;
-    minus[c] -= h;
-    const Vec diff = ffdref::Sub(f(plus), f(minus));
-    for (int r = 0; r < 3; ++r)
-    {
-      fd[r][c] = diff[r] / (2.0 * h);
-    }
-  }
+  return ffdtest::CentralDifferences(x, 1e-6, std::forward<F>(f));
 }
 
 TYPED_TEST(FFDGridDeformationTest, JacobianMatchesCentralDifferences)
@@ -211,43 +165,22 @@ TYPED_TEST(FFDGridDeformationTest, JacobianMatchesCentralDifferences)
   using Real = TypeParam;
   ffdtest::Rng rng(503);
   WorstRatio worst("worst_error_over_tolerance");
-  for (Basis b : ffdtest::AllBases)
-  {
-    for (int trial = 0; trial < 20; ++trial)
-    {
-      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 6);
-      WithKernel<Real>(lat, [&](const auto& k) {
-        for (int p = 0; p < 10; ++p)
-        {
-          const ffd::Vec3<Real> x = PointAt<Real>(lat, InteriorParameters(rng, lat, 0.01)).first;
-          const int cell = k.Bind(x, false);
-          ASSERT_GE(cell, 0);
-          ffd::Mat3<Real> j;
-          k.D.Deform(x, cell, j);
-          double fd[3][3];
-          CentralDifferences(ffdtest::ToRef(x),
-            [&](const Vec& y) { return ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, y); }, fd);
-          double jmax = 1.0;
-          for (int r = 0; r < 3; ++r)
-          {
-            for (int c = 0; c < 3; ++c)
-            {
-              jmax = std::max(jmax, std::fabs(fd[r][c]));
-            }
-          }
-          const double tol = GradientTolerance<Real>() * jmax;
-          for (int r = 0; r < 3; ++r)
-          {
-            for (int c = 0; c < 3; ++c)
-            {
-              worst.Add(std::fabs(double(j.M[r][c]) - fd[r][c]), tol);
-              ASSERT_NEAR(double(j.M[r][c]), fd[r][c], tol) << lat.Name() << " J[" << r << "][" << c << "]";
-            }
-          }
-        }
-      });
-    }
-  }
+  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](const GridLattice& lat) {
+    WithKernel<Real>(lat, [&](const auto& k) {
+      for (int p = 0; p < 10; ++p)
+      {
+        const ffd::Vec3<Real> x = PointAt<Real>(lat, InteriorParameters(rng, lat, 0.01)).first;
+        const int cell = k.Bind(x, false);
+        ASSERT_GE(cell, 0);
+        ffd::Mat3<Real> j;
+        k.D.Deform(x, cell, j);
+        const ffdtest::Mat fd = CentralDifferences(ffdtest::ToRef(x),
+          [&](const Vec& y) { return ffdref::DeformLocal(lat.Basis, lat.F, lat.Divisions.data(), lat.Points, y); });
+        const double tol = GradientTolerance<Real>() * ffdtest::MaxAbsEntry(fd, 1.0);
+        ASSERT_TRUE(ffdtest::MatrixNear(j, fd, tol, "J", &worst)) << lat.Name() << " point " << p;
+      }
+    });
+  });
 }
 
 TYPED_TEST(FFDGridDeformationTest, TransformNormalMatchesDeformedTangents)
@@ -262,61 +195,41 @@ TYPED_TEST(FFDGridDeformationTest, TransformNormalMatchesDeformedTangents)
   ffdtest::Rng rng(508);
   WorstRatio worst("worst_error_over_tolerance");
   int folded = 0;
-  for (Basis b : ffdtest::AllBases)
-  {
-    for (int trial = 0; trial < 20; ++trial)
-    {
-      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 4);
-      WithKernel<Real>(lat, [&](const auto& k) {
-        for (int p = 0; p < 10; ++p)
+  ffdtest::ForEachRandomLattice(rng, 20, 4, [&](const GridLattice& lat) {
+    WithKernel<Real>(lat, [&](const auto& k) {
+      for (int p = 0; p < 10; ++p)
+      {
+        const ffd::Vec3<Real> x = PointAt<Real>(lat, InteriorParameters(rng, lat, 0.01)).first;
+        const int cell = k.Bind(x, false);
+        ASSERT_GE(cell, 0);
+        ffd::Mat3<Real> j;
+        k.D.Deform(x, cell, j);
+        const ffdtest::Mat fd = CentralDifferences(ffdtest::ToRef(x),
+          [&](const Vec& y) { return ffdref::DeformLocal(lat.Basis, lat.F, lat.Divisions.data(), lat.Points, y); });
+        const double jmax = ffdtest::MaxAbsEntry(fd, 1.0);
+        const Vec t1 = ffdtest::RandomVec(rng, -1.0, 1.0), t2 = ffdtest::RandomVec(rng, -1.0, 1.0);
+        const Vec n = ffdref::Cross(t1, t2);
+        const double nn = ffdtest::Norm(n);
+        if (nn < 0.1)
         {
-          const ffd::Vec3<Real> x = PointAt<Real>(lat, InteriorParameters(rng, lat, 0.01)).first;
-          const int cell = k.Bind(x, false);
-          ASSERT_GE(cell, 0);
-          ffd::Mat3<Real> j;
-          k.D.Deform(x, cell, j);
-          double fd[3][3], jmax = 1.0;
-          CentralDifferences(ffdtest::ToRef(x),
-            [&](const Vec& y) { return ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, y); }, fd);
-          for (int r = 0; r < 3; ++r)
-          {
-            for (int c = 0; c < 3; ++c)
-            {
-              jmax = std::max(jmax, std::fabs(fd[r][c]));
-            }
-          }
-          const Vec t1 = ffdtest::RandomVec(rng, -1.0, 1.0), t2 = ffdtest::RandomVec(rng, -1.0, 1.0);
-          const Vec n = ffdref::Cross(t1, t2);
-          const double nn = ffdtest::Norm(n);
-          if (nn < 0.1)
-          {
-            continue;
-          }
-          const auto apply = [&](const Vec& t) {
-            Vec y;
-            for (int r = 0; r < 3; ++r)
-            {
-              y[r] = fd[r][0] * t[0] + fd[r][1] * t[1] + fd[r][2] * t[2];
-            }
-            return y;
-          };
-          const Vec m = ffdref::Cross(apply(t1), apply(t2));
-          const double mm = ffdtest::Norm(m);
-          if (mm < 0.1 * nn)
-          {
-            continue;
-          }
-          folded += ffd::Determinant(j) < Real(0) ? 1 : 0;
-          const ffd::Vec3<Real> unit = ffdtest::ToKernel<Real>({ n[0] / nn, n[1] / nn, n[2] / nn });
-          const Vec got = ffdtest::ToRef(ffd::TransformNormal(j, unit));
-          const Vec want = { m[0] / mm, m[1] / mm, m[2] / mm };
-          const double tol = 10.0 * GradientTolerance<Real>() * jmax * jmax * nn / mm;
-          worst.Add(MaxDiff(got, want), tol);
-          ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " point " << p;
+          continue;
         }
-      });
-    }
-  }
+        const Vec m = ffdref::Cross(ffdtest::Product(fd, t1), ffdtest::Product(fd, t2));
+        const double mm = ffdtest::Norm(m);
+        if (mm < 0.1 * nn)
+        {
+          continue;
+        }
+        folded += ffd::Determinant(j) < Real(0) ? 1 : 0;
+        const ffd::Vec3<Real> unit = ffdtest::ToKernel<Real>({ n[0] / nn, n[1] / nn, n[2] / nn });
+        const Vec got = ffdtest::ToRef(ffd::TransformNormal(j, unit));
+        const Vec want = { m[0] / mm, m[1] / mm, m[2] / mm };
+        const double tol = 10.0 * GradientTolerance<Real>() * jmax * jmax * nn / mm;
+        worst.Add(MaxDiff(got, want), tol);
+        ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " point " << p;
+      }
+    });
+  });
   ::testing::Test::RecordProperty("folded_points", folded);
 }
 
@@ -331,74 +244,69 @@ TYPED_TEST(FFDGridDeformationTest, BindToGridFindsCells)
   //  - interior voxel faces s = c/n: cell c - 1 or c.
   using Real = TypeParam;
   ffdtest::Rng rng(504);
-  for (Basis b : ffdtest::AllBases)
-  {
-    for (int trial = 0; trial < 20; ++trial)
-    {
-      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 6);
-      const double scale = ffdtest::LatticeScale(lat.Points);
-      WithKernel<Real>(lat, [&](const auto& k) {
-        for (int p = 0; p < 100; ++p)
-        {
-          const auto [x, stu] = PointAt<Real>(lat, ffdtest::RandomVec(rng, 0.0, 1.0));
-          int c[3];
-          bool nearFace = false;
-          for (int a = 0; a < 3; ++a)
-          {
-            const double v = stu[a] * Cells(lat, a);
-            c[a] = std::min(int(std::floor(v)), Cells(lat, a) - 1);
-            nearFace = nearFace || std::fabs(v - std::round(v)) < 1e-3;
-          }
-          if (!nearFace)
-          {
-            ASSERT_EQ(k.Bind(x, false), FlatCell(lat, c)) << lat.Name() << " point " << p;
-            ASSERT_EQ(k.Bind(x, true), FlatCell(lat, c)) << lat.Name() << " point " << p;
-          }
-        }
-        for (int combo = 0; combo < 27; ++combo)
-        {
-          const int kind[3] = { combo % 3, (combo / 3) % 3, combo / 9 }; // 0: s = 0, 1: interior, 2: s = 1
-          Vec stu;
-          int c[3];
-          for (int a = 0; a < 3; ++a)
-          {
-            const int cells = Cells(lat, a);
-            const int random = std::uniform_int_distribution<int>(0, cells - 1)(rng);
-            c[a] = kind[a] == 0 ? 0 : (kind[a] == 2 ? cells - 1 : random);
-            stu[a] = kind[a] == 0 ? 0.0 : (kind[a] == 2 ? 1.0 : (c[a] + ffdtest::Uniform(rng, 0.01, 0.99)) / cells);
-          }
-          const ffd::Vec3<Real> x = PointAt<Real>(lat, stu).first;
-          const Vec xd = ffdtest::ToRef(x);
-          const int cell = k.Bind(x, false);
-          ASSERT_EQ(cell, FlatCell(lat, c)) << lat.Name() << " kinds " << kind[0] << kind[1] << kind[2];
-          ASSERT_EQ(k.Bind(x, true), cell) << lat.Name() << " kinds " << kind[0] << kind[1] << kind[2];
-          const Vec want = ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, xd);
-          ffd::Mat3<Real> j;
-          const Vec got = ffdtest::ToRef(k.D.Deform(x, cell, j));
-          ASSERT_LE(MaxDiff(got, want), PositionTolerance(scale, xd, lat.F, j))
-            << lat.Name() << " kinds " << kind[0] << kind[1] << kind[2];
-        }
+  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](const GridLattice& lat) {
+    const double scale = ffdtest::LatticeScale(lat.Points);
+    WithKernel<Real>(lat, [&](const auto& k) {
+      for (int p = 0; p < 100; ++p)
+      {
+        const auto [x, stu] = PointAt<Real>(lat, ffdtest::RandomVec(rng, 0.0, 1.0));
+        int c[3];
+        bool nearFace = false;
         for (int a = 0; a < 3; ++a)
         {
-          for (int face = 1; face < Cells(lat, a); ++face)
-          {
-            Vec stu = InteriorParameters(rng, lat, 0.01); // the other axes away from their cells' faces
-            int lo[3], hi[3];
-            for (int q = 0; q < 3; ++q)
-            {
-              lo[q] = hi[q] = int(std::floor(stu[q] * Cells(lat, q)));
-            }
-            stu[a] = double(face) / Cells(lat, a);
-            lo[a] = face - 1;
-            hi[a] = face;
-            const int cell = k.Bind(PointAt<Real>(lat, stu).first, false);
-            ASSERT_TRUE(cell == FlatCell(lat, lo) || cell == FlatCell(lat, hi))
-              << lat.Name() << " face " << face << " of axis " << a << ": cell " << cell;
-          }
+          const double v = stu[a] * Cells(lat, a);
+          c[a] = std::min(int(std::floor(v)), Cells(lat, a) - 1);
+          nearFace = nearFace || std::fabs(v - std::round(v)) < 1e-3;
         }
-      });
-    }
-  }
+        if (!nearFace)
+        {
+          ASSERT_EQ(k.Bind(x, false), FlatCell(lat, c)) << lat.Name() << " point " << p;
+          ASSERT_EQ(k.Bind(x, true), FlatCell(lat, c)) << lat.Name() << " point " << p;
+        }
+      }
+      for (int combo = 0; combo < 27; ++combo)
+      {
+        const int kind[3] = { combo % 3, (combo / 3) % 3, combo / 9 }; // 0: s = 0, 1: interior, 2: s = 1
+        Vec stu;
+        int c[3];
+        for (int a = 0; a < 3; ++a)
+        {
+          const int cells = Cells(lat, a);
+          const int random = std::uniform_int_distribution<int>(0, cells - 1)(rng);
+          c[a] = kind[a] == 0 ? 0 : (kind[a] == 2 ? cells - 1 : random);
+          stu[a] = kind[a] == 0 ? 0.0 : (kind[a] == 2 ? 1.0 : (c[a] + ffdtest::Uniform(rng, 0.01, 0.99)) / cells);
+        }
+        const ffd::Vec3<Real> x = PointAt<Real>(lat, stu).first;
+        const Vec xd = ffdtest::ToRef(x);
+        const int cell = k.Bind(x, false);
+        ASSERT_EQ(cell, FlatCell(lat, c)) << lat.Name() << " kinds " << kind[0] << kind[1] << kind[2];
+        ASSERT_EQ(k.Bind(x, true), cell) << lat.Name() << " kinds " << kind[0] << kind[1] << kind[2];
+        const Vec want = ffdref::DeformLocal(lat.Basis, lat.F, lat.Divisions.data(), lat.Points, xd);
+        ffd::Mat3<Real> j;
+        const Vec got = ffdtest::ToRef(k.D.Deform(x, cell, j));
+        ASSERT_LE(MaxDiff(got, want), PositionTolerance(scale, xd, lat.F, j))
+          << lat.Name() << " kinds " << kind[0] << kind[1] << kind[2];
+      }
+      for (int a = 0; a < 3; ++a)
+      {
+        for (int face = 1; face < Cells(lat, a); ++face)
+        {
+          Vec stu = InteriorParameters(rng, lat, 0.01); // the other axes away from their cells' faces
+          int lo[3], hi[3];
+          for (int q = 0; q < 3; ++q)
+          {
+            lo[q] = hi[q] = int(std::floor(stu[q] * Cells(lat, q)));
+          }
+          stu[a] = double(face) / Cells(lat, a);
+          lo[a] = face - 1;
+          hi[a] = face;
+          const int cell = k.Bind(PointAt<Real>(lat, stu).first, false);
+          ASSERT_TRUE(cell == FlatCell(lat, lo) || cell == FlatCell(lat, hi))
+            << lat.Name() << " face " << face << " of axis " << a << ": cell " << cell;
+        }
+      }
+    });
+  });
 }
 
 TYPED_TEST(FFDGridDeformationTest, BindToGridOutsideAndNonFinite)
@@ -410,53 +318,48 @@ TYPED_TEST(FFDGridDeformationTest, BindToGridOutsideAndNonFinite)
   using Real = TypeParam;
   ffdtest::Rng rng(505);
   const double band = double(ffd::ParametricTolerance<Real>());
-  for (Basis b : ffdtest::AllBases)
-  {
-    for (int trial = 0; trial < 10; ++trial)
-    {
-      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 6);
-      WithKernel<Real>(lat, [&](const auto& k) {
-        for (int p = 0; p < 200; ++p)
-        {
-          const int axis = std::uniform_int_distribution<int>(0, 2)(rng);
-          const bool high = rng() % 2 == 1;
-          const bool far = p % 2 == 0;
-          Vec stu = InteriorParameters(rng, lat, 0.01);
-          const double out = far ? ffdtest::Uniform(rng, 0.01, 2.0) : ffdtest::Uniform(rng, -3.0 * band, 3.0 * band);
-          stu[axis] = high ? 1.0 + out : -out;
-          const auto [x, seen] = PointAt<Real>(lat, stu);
-          const double beyond = high ? seen[axis] - 1.0 : -seen[axis];
-          int c[3];
-          for (int a = 0; a < 3; ++a)
-          {
-            c[a] = std::min(std::max(int(std::floor(seen[a] * Cells(lat, a))), 0), Cells(lat, a) - 1);
-          }
-          if (beyond <= 0.5 * band)
-          {
-            ASSERT_EQ(k.Bind(x, false), FlatCell(lat, c)) << lat.Name() << " " << beyond << " outside";
-            ASSERT_EQ(k.Bind(x, true), FlatCell(lat, c)) << lat.Name() << " " << beyond << " outside";
-          }
-          else if (beyond >= 2.0 * band)
-          {
-            ASSERT_EQ(k.Bind(x, false), -1) << lat.Name() << " " << beyond << " outside";
-            ASSERT_EQ(k.Bind(x, true), FlatCell(lat, c)) << lat.Name() << " " << beyond << " outside";
-          }
-        }
-        const Real bad[3] = { std::numeric_limits<Real>::quiet_NaN(), std::numeric_limits<Real>::infinity(),
-          -std::numeric_limits<Real>::infinity() };
+  ffdtest::ForEachRandomLattice(rng, 10, 6, [&](const GridLattice& lat) {
+    WithKernel<Real>(lat, [&](const auto& k) {
+      for (int p = 0; p < 200; ++p)
+      {
+        const int axis = std::uniform_int_distribution<int>(0, 2)(rng);
+        const bool high = rng() % 2 == 1;
+        const bool far = p % 2 == 0;
+        Vec stu = InteriorParameters(rng, lat, 0.01);
+        const double out = far ? ffdtest::Uniform(rng, 0.01, 2.0) : ffdtest::Uniform(rng, -3.0 * band, 3.0 * band);
+        stu[axis] = high ? 1.0 + out : -out;
+        const auto [x, seen] = PointAt<Real>(lat, stu);
+        const double beyond = high ? seen[axis] - 1.0 : -seen[axis];
+        int c[3];
         for (int a = 0; a < 3; ++a)
         {
-          for (Real v : bad)
-          {
-            ffd::Vec3<Real> x = PointAt<Real>(lat, { 0.5, 0.5, 0.5 }).first;
-            (a == 0 ? x.x : (a == 1 ? x.y : x.z)) = v;
-            ASSERT_EQ(k.Bind(x, false), -1) << lat.Name() << " coordinate " << a << " = " << v;
-            ASSERT_EQ(k.Bind(x, true), -1) << lat.Name() << " coordinate " << a << " = " << v;
-          }
+          c[a] = std::min(std::max(int(std::floor(seen[a] * Cells(lat, a))), 0), Cells(lat, a) - 1);
         }
-      });
-    }
-  }
+        if (beyond <= 0.5 * band)
+        {
+          ASSERT_EQ(k.Bind(x, false), FlatCell(lat, c)) << lat.Name() << " " << beyond << " outside";
+          ASSERT_EQ(k.Bind(x, true), FlatCell(lat, c)) << lat.Name() << " " << beyond << " outside";
+        }
+        else if (beyond >= 2.0 * band)
+        {
+          ASSERT_EQ(k.Bind(x, false), -1) << lat.Name() << " " << beyond << " outside";
+          ASSERT_EQ(k.Bind(x, true), FlatCell(lat, c)) << lat.Name() << " " << beyond << " outside";
+        }
+      }
+      const Real bad[3] = { std::numeric_limits<Real>::quiet_NaN(), std::numeric_limits<Real>::infinity(),
+        -std::numeric_limits<Real>::infinity() };
+      for (int a = 0; a < 3; ++a)
+      {
+        for (Real v : bad)
+        {
+          ffd::Vec3<Real> x = PointAt<Real>(lat, { 0.5, 0.5, 0.5 }).first;
+          (a == 0 ? x.x : (a == 1 ? x.y : x.z)) = v;
+          ASSERT_EQ(k.Bind(x, false), -1) << lat.Name() << " coordinate " << a << " = " << v;
+          ASSERT_EQ(k.Bind(x, true), -1) << lat.Name() << " coordinate " << a << " = " << v;
+        }
+      }
+    });
+  });
 }
 
 TYPED_TEST(FFDGridDeformationTest, ClampingGivesEdgeDisplacement)
@@ -471,78 +374,59 @@ TYPED_TEST(FFDGridDeformationTest, ClampingGivesEdgeDisplacement)
   using Real = TypeParam;
   ffdtest::Rng rng(506);
   WorstRatio worst("worst_error_over_tolerance");
-  for (Basis b : ffdtest::AllBases)
-  {
-    for (int trial = 0; trial < 20; ++trial)
-    {
-      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 6);
-      const double scale = ffdtest::LatticeScale(lat.Points);
-      const Vec edges[3] = { lat.F.S, lat.F.T, lat.F.U };
-      WithKernel<Real>(lat, [&](const auto& k) {
-        for (int p = 0; p < 20; ++p)
+  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](const GridLattice& lat) {
+    const double scale = ffdtest::LatticeScale(lat.Points);
+    const Vec edges[3] = { lat.F.S, lat.F.T, lat.F.U };
+    WithKernel<Real>(lat, [&](const auto& k) {
+      for (int p = 0; p < 20; ++p)
+      {
+        Vec stu = InteriorParameters(rng, lat, 0.01);
+        bool clamped[3] = { false, false, false };
+        for (int a = 0; a < 3; ++a)
         {
-          Vec stu = InteriorParameters(rng, lat, 0.01);
-          bool clamped[3] = { false, false, false };
-          for (int a = 0; a < 3; ++a)
+          if (rng() % 2 == 0 || (a == 2 && !clamped[0] && !clamped[1]))
           {
-            if (rng() % 2 == 0 || (a == 2 && !clamped[0] && !clamped[1]))
-            {
-              clamped[a] = true;
-              const double out = ffdtest::Uniform(rng, 0.01, 0.5);
-              stu[a] = rng() % 2 == 0 ? -out : 1.0 + out;
-            }
-          }
-          const ffd::Vec3<Real> x = PointAt<Real>(lat, stu).first;
-          const Vec xd = ffdtest::ToRef(x);
-          ASSERT_EQ(k.Bind(x, false), -1) << lat.Name();
-          const int cell = k.Bind(x, true);
-          ASSERT_GE(cell, 0) << lat.Name();
-          ffd::Mat3<Real> j;
-          const Vec got = ffdtest::ToRef(k.D.Deform(x, cell, j));
-          const Vec gotPlain = ffdtest::ToRef(k.D.Deform(x, cell));
-          const Vec want = ClampedReference(lat, xd);
-          const double tol = PositionTolerance(scale, xd, lat.F, j);
-          worst.Add(MaxDiff(got, want), tol);
-          ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " point " << p;
-          ASSERT_LE(MaxDiff(gotPlain, want), tol) << lat.Name() << " point " << p;
-
-          double fd[3][3];
-          CentralDifferences(xd, [&](const Vec& y) { return ClampedReference(lat, y); }, fd);
-          double jmax = 1.0;
-          for (int r = 0; r < 3; ++r)
-          {
-            for (int c = 0; c < 3; ++c)
-            {
-              jmax = std::max({ jmax, std::fabs(fd[r][c]), std::fabs(double(j.M[r][c])) });
-            }
-          }
-          for (int r = 0; r < 3; ++r)
-          {
-            for (int c = 0; c < 3; ++c)
-            {
-              const double tolJ = GradientTolerance<Real>() * jmax;
-              worst.Add(std::fabs(double(j.M[r][c]) - fd[r][c]), tolJ);
-              ASSERT_NEAR(double(j.M[r][c]), fd[r][c], tolJ) << lat.Name() << " J[" << r << "][" << c << "]";
-            }
-          }
-          for (int a = 0; a < 3; ++a)
-          {
-            if (!clamped[a])
-            {
-              continue;
-            }
-            const Vec& e = edges[a];
-            for (int r = 0; r < 3; ++r)
-            {
-              const double je = double(j.M[r][0]) * e[0] + double(j.M[r][1]) * e[1] + double(j.M[r][2]) * e[2];
-              ASSERT_NEAR(je, e[r], 100.0 * Eps<Real>() * jmax * ffdtest::Norm(e))
-                << lat.Name() << " (J - I) E along clamped axis " << a;
-            }
+            clamped[a] = true;
+            const double out = ffdtest::Uniform(rng, 0.01, 0.5);
+            stu[a] = rng() % 2 == 0 ? -out : 1.0 + out;
           }
         }
-      });
-    }
-  }
+        const ffd::Vec3<Real> x = PointAt<Real>(lat, stu).first;
+        const Vec xd = ffdtest::ToRef(x);
+        ASSERT_EQ(k.Bind(x, false), -1) << lat.Name();
+        const int cell = k.Bind(x, true);
+        ASSERT_GE(cell, 0) << lat.Name();
+        ffd::Mat3<Real> j;
+        const Vec got = ffdtest::ToRef(k.D.Deform(x, cell, j));
+        const Vec gotPlain = ffdtest::ToRef(k.D.Deform(x, cell));
+        const Vec want = ClampedReference(lat, xd);
+        const double tol = PositionTolerance(scale, xd, lat.F, j);
+        worst.Add(MaxDiff(got, want), tol);
+        ASSERT_LE(MaxDiff(got, want), tol) << lat.Name() << " point " << p;
+        ASSERT_LE(MaxDiff(gotPlain, want), tol) << lat.Name() << " point " << p;
+
+        const ffdtest::Mat fd = CentralDifferences(xd, [&](const Vec& y) { return ClampedReference(lat, y); });
+        const double jmax = std::max(ffdtest::MaxAbsEntry(fd, 1.0), ffdtest::MaxAbsEntry(j, 1.0));
+        const double tolJ = GradientTolerance<Real>() * jmax;
+        ASSERT_TRUE(ffdtest::MatrixNear(j, fd, tolJ, "J", &worst)) << lat.Name() << " point " << p;
+        for (int a = 0; a < 3; ++a)
+        {
+          if (!clamped[a])
+          {
+            continue;
+          }
+          const Vec& e = edges[a];
+          Vec je;
+          for (int r = 0; r < 3; ++r)
+          {
+            je[r] = double(j.M[r][0]) * e[0] + double(j.M[r][1]) * e[1] + double(j.M[r][2]) * e[2];
+          }
+          ASSERT_TRUE(ffdtest::VectorNear(je, e, 100.0 * Eps<Real>() * jmax * ffdtest::Norm(e)))
+            << lat.Name() << " (J - I) E along clamped axis " << a;
+        }
+      }
+    });
+  });
 }
 
 /**

@@ -183,12 +183,7 @@ int CellCount(const GridLattice& lat)
   return lat.Basis == Basis::Bernstein ? 1 : lat.Divisions[0] * lat.Divisions[1] * lat.Divisions[2];
 }
 
-template <typename Real>
-class FFDGridLanesTest : public ::testing::Test
-{
-};
-using RealTypes = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(FFDGridLanesTest, RealTypes);
+FFD_REAL_TYPED_TEST_SUITE(FFDGridLanesTest);
 
 TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
 {
@@ -205,45 +200,40 @@ TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
     levels += (levels.empty() ? "" : " ") + LevelName(level);
   }
   ::testing::Test::RecordProperty("simd_levels", levels);
-  for (Basis b : ffdtest::AllBases)
-  {
-    for (int trial = 0; trial < 6; ++trial)
-    {
-      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 5);
-      const double scale = ffdtest::LatticeScale(lat.Points);
-      ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
-        const PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 1001);
-        for (int maxCells : MaxCellsToTry())
+  ffdtest::ForEachRandomLattice(rng, 6, 5, [&](const GridLattice& lat) {
+    const double scale = ffdtest::LatticeScale(lat.Points);
+    ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
+      const PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 1001);
+      for (int maxCells : MaxCellsToTry())
+      {
+        const ffd::GatheredPoints gathered =
+          ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells, TestTile);
+        for (ffd::SimdLevel level : Levels())
         {
-          const ffd::GatheredPoints gathered =
-            ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells, TestTile);
-          for (ffd::SimdLevel level : Levels())
+          const std::vector<Real> out = DeformAll(level, k.D, set, gathered, maxCells);
+          for (std::int64_t i = 0; i < set.Size(); ++i)
           {
-            const std::vector<Real> out = DeformAll(level, k.D, set, gathered, maxCells);
-            for (std::int64_t i = 0; i < set.Size(); ++i)
+            const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&set.Values[3 * i]);
+            const ffd::Vec3<Real> y = ffd::Vec3<Real>::From(&out[3 * i]);
+            const std::string where = lat.Name() + " level " + LevelName(level) + " in place up to " +
+              std::to_string(maxCells) + " cells, point " + std::to_string(i);
+            if (set.Cells[i] < 0)
             {
-              const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&set.Values[3 * i]);
-              const ffd::Vec3<Real> y = ffd::Vec3<Real>::From(&out[3 * i]);
-              const std::string where = lat.Name() + " level " + LevelName(level) + " in place up to " +
-                std::to_string(maxCells) + " cells, point " + std::to_string(i);
-              if (set.Cells[i] < 0)
-              {
-                ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
-                continue;
-              }
-              ffd::Mat3<Real> j;
-              k.D.Deform(x, set.Cells[i], j);
-              const Vec xd = ffdtest::ToRef(x);
-              const Vec want = ClampedReference(b, lat, xd);
-              const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
-              worst.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
-              ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
+              ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
+              continue;
             }
+            ffd::Mat3<Real> j;
+            k.D.Deform(x, set.Cells[i], j);
+            const Vec xd = ffdtest::ToRef(x);
+            const Vec want = ClampedReference(lat.Basis, lat, xd);
+            const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
+            worst.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
+            ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
           }
         }
-      });
-    }
-  }
+      }
+    });
+  });
 }
 
 TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
@@ -352,97 +342,92 @@ TYPED_TEST(FFDGridLanesTest, JacobianAtEveryLevelMatchesReference)
   ffdtest::WorstRatio worstPosition("worst_position_error_over_tolerance");
   ffdtest::WorstRatio worstDeterminant("worst_determinant_error_over_bound");
   ffdtest::WorstRatio worstNormal("worst_normal_error_over_bound");
-  for (Basis b : ffdtest::AllBases)
-  {
-    for (int trial = 0; trial < 4; ++trial)
-    {
-      const GridLattice lat = ffdtest::RandomGridLattice(rng, b, 5);
-      const double scale = ffdtest::LatticeScale(lat.Points);
-      const std::vector<Vec> displacements = ffdtest::RoundLattice<Real>(lat.Displacements()); // as the kernel
-      ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
-        PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 1001);
-        const bool clamp = trial >= 2; // the points outside lose the Jacobian's columns they are clamped along
-        if (clamp)
-        {
-          for (std::int64_t i = 0; i < set.Size(); ++i)
-          {
-            set.Cells[i] = k.Bind(ffd::Vec3<Real>::From(&set.Values[3 * i]), true);
-          }
-        }
-        if (trial % 2 == 1)
-        {
-          std::vector<std::int64_t> order;
-          set = Shuffled(set, rng, order);
-        }
-        std::vector<Real> normals;
+  ffdtest::ForEachRandomLattice(rng, 4, 5, [&](const GridLattice& lat, int trial) {
+    const double scale = ffdtest::LatticeScale(lat.Points);
+    const std::vector<Vec> displacements = ffdtest::RoundLattice<Real>(lat.Displacements()); // as the kernel
+    ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
+      PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 1001);
+      const bool clamp = trial >= 2; // the points outside lose the Jacobian's columns they are clamped along
+      if (clamp)
+      {
         for (std::int64_t i = 0; i < set.Size(); ++i)
         {
-          const Vec n = ffdtest::RandomVec(rng, -1.0, 1.0);
-          const double length = std::max(ffdtest::Norm(n), 1e-3);
-          normals.insert(normals.end(), { Real(n[0] / length), Real(n[1] / length), Real(n[2] / length) });
+          set.Cells[i] = k.Bind(ffd::Vec3<Real>::From(&set.Values[3 * i]), true);
         }
-        std::vector<std::int64_t> cuts = { 0, set.Size() };
-        for (int c = 0; c < 4; ++c)
+      }
+      if (trial % 2 == 1)
+      {
+        std::vector<std::int64_t> order;
+        set = Shuffled(set, rng, order);
+      }
+      std::vector<Real> normals;
+      for (std::int64_t i = 0; i < set.Size(); ++i)
+      {
+        const Vec n = ffdtest::RandomVec(rng, -1.0, 1.0);
+        const double length = std::max(ffdtest::Norm(n), 1e-3);
+        normals.insert(normals.end(), { Real(n[0] / length), Real(n[1] / length), Real(n[2] / length) });
+      }
+      std::vector<std::int64_t> cuts = { 0, set.Size() };
+      for (int c = 0; c < 4; ++c)
+      {
+        cuts.push_back(
+          ffd::BlockSize * std::uniform_int_distribution<std::int64_t>(0, set.Size() / ffd::BlockSize)(rng));
+      }
+      std::sort(cuts.begin(), cuts.end());
+      const ffd::BlockCells listed = ffd::ListBlockCells(set.Cells.data(), set.Size(), ffd::BlockSize);
+      for (ffd::SimdLevel level : Levels())
+      {
+        const Real nan = std::numeric_limits<Real>::quiet_NaN(); // poisoned outputs
+        std::vector<Real> out(set.Values.size(), nan), outNormals(normals.size(), nan),
+          determinants(std::size_t(set.Size()), nan);
+        for (std::size_t c = 0; c + 1 < cuts.size(); ++c)
         {
-          cuts.push_back(
-            ffd::BlockSize * std::uniform_int_distribution<std::int64_t>(0, set.Size() / ffd::BlockSize)(rng));
+          ffd::DeformWithJacobian(level, k.D, set.Values.data(), set.Cells.data(), listed, normals.data(),
+            out.data(), outNormals.data(), determinants.data(), cuts[c], cuts[c + 1]);
         }
-        std::sort(cuts.begin(), cuts.end());
-        const ffd::BlockCells listed = ffd::ListBlockCells(set.Cells.data(), set.Size(), ffd::BlockSize);
-        for (ffd::SimdLevel level : Levels())
+        for (std::int64_t i = 0; i < set.Size(); ++i)
         {
-          const Real nan = std::numeric_limits<Real>::quiet_NaN(); // poisoned outputs
-          std::vector<Real> out(set.Values.size(), nan), outNormals(normals.size(), nan),
-            determinants(std::size_t(set.Size()), nan);
-          for (std::size_t c = 0; c + 1 < cuts.size(); ++c)
+          const std::string where = lat.Name() + (clamp ? " clamped" : "") + " level " + LevelName(level) +
+            " point " + std::to_string(i);
+          const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&set.Values[3 * i]);
+          const ffd::Vec3<Real> y = ffd::Vec3<Real>::From(&out[3 * i]);
+          const Vec xd = ffdtest::ToRef(x);
+          const Vec n = ffdtest::ToRef(ffd::Vec3<Real>::From(&normals[3 * i]));
+          const Vec gotNormal = ffdtest::ToRef(ffd::Vec3<Real>::From(&outNormals[3 * i]));
+          if (set.Cells[i] < 0)
           {
-            ffd::DeformWithJacobian(level, k.D, set.Values.data(), set.Cells.data(), listed, normals.data(),
-              out.data(), outNormals.data(), determinants.data(), cuts[c], cuts[c + 1]);
+            ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
+            ASSERT_EQ(determinants[i], Real(1)) << where;
+            ASSERT_LE(ffdtest::MaxDiff(gotNormal, n), 4.0 * ffdtest::Eps<Real>()) << where; // n renormalised
+            continue;
           }
-          for (std::int64_t i = 0; i < set.Size(); ++i)
-          {
-            const std::string where = lat.Name() + (clamp ? " clamped" : "") + " level " + LevelName(level) +
-              " point " + std::to_string(i);
-            const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&set.Values[3 * i]);
-            const ffd::Vec3<Real> y = ffd::Vec3<Real>::From(&out[3 * i]);
-            const Vec xd = ffdtest::ToRef(x);
-            const Vec n = ffdtest::ToRef(ffd::Vec3<Real>::From(&normals[3 * i]));
-            const Vec gotNormal = ffdtest::ToRef(ffd::Vec3<Real>::From(&outNormals[3 * i]));
-            if (set.Cells[i] < 0)
-            {
-              ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
-              ASSERT_EQ(determinants[i], Real(1)) << where;
-              ASSERT_LE(ffdtest::MaxDiff(gotNormal, n), 4.0 * ffdtest::Eps<Real>()) << where; // n renormalised
-              continue;
-            }
-            const ffdtest::ReferenceJacobian ref =
-              ffdtest::JacobianOfPoint<Real>(lat, displacements, xd, set.Cells[i]);
-            const ffdtest::Mat bound =
-              ffdtest::JacobianErrorBound<Real>(lat, displacements, xd, ref, k.D.CellTable != nullptr);
-            ffd::Mat3<Real> j; // only for PositionTolerance()'s |J - I|
-            k.D.Deform(x, set.Cells[i], j);
-            const Vec want = ClampedReference(b, lat, xd);
-            const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
-            worstPosition.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
-            ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
+          const ffdtest::ReferenceJacobian ref =
+            ffdtest::JacobianOfPoint<Real>(lat, displacements, xd, set.Cells[i]);
+          const ffdtest::Mat bound =
+            ffdtest::JacobianErrorBound<Real>(lat, displacements, xd, ref, k.D.CellTable != nullptr);
+          ffd::Mat3<Real> j; // only for PositionTolerance()'s |J - I|
+          k.D.Deform(x, set.Cells[i], j);
+          const Vec want = ClampedReference(lat.Basis, lat, xd);
+          const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
+          worstPosition.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
+          ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
 
-            const double detBound = ffdtest::DeterminantErrorBound<Real>(ref.J, bound);
-            const double detError = std::fabs(double(determinants[i]) - ffdtest::Determinant(ref.J));
-            worstDeterminant.Add(detError, detBound);
-            ASSERT_LE(detError, detBound) << where;
-            const Vec m = ffdtest::Product(ffdtest::Cofactor(ref.J), n);
-            if (ffdtest::Norm(m) >= 0.1)
-            {
-              const Vec wantNormal = ffdtest::Scaled(m, 1.0 / ffdtest::Norm(m));
-              const double normalBound = ffdtest::NormalErrorBound<Real>(ref.J, bound, n);
-              worstNormal.Add(ffdtest::MaxDiff(gotNormal, wantNormal), normalBound);
-              ASSERT_LE(ffdtest::MaxDiff(gotNormal, wantNormal), normalBound) << where;
-            }
+          const double detBound = ffdtest::DeterminantErrorBound<Real>(ref.J, bound);
+          const double detError = std::fabs(double(determinants[i]) - ffdtest::Determinant(ref.J));
+          worstDeterminant.Add(detError, detBound);
+          ASSERT_LE(detError, detBound) << where;
+          const Vec m = ffdtest::Product(ffdtest::Cofactor(ref.J), n);
+          if (ffdtest::Norm(m) >= 0.1)
+          {
+            const Vec wantNormal = ffdtest::Scaled(m, 1.0 / ffdtest::Norm(m));
+            const double normalBound = ffdtest::NormalErrorBound<Real>(ref.J, bound, n);
+            worstNormal.Add(ffdtest::MaxDiff(gotNormal, wantNormal), normalBound);
+            ASSERT_LE(ffdtest::MaxDiff(gotNormal, wantNormal), normalBound) << where;
           }
         }
-      });
-    }
-  }
+      }
+    });
+  });
 }
 
 TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)

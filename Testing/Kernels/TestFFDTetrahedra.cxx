@@ -21,12 +21,7 @@ using ffdtest::MaxAbs;
 using ffdtest::Norm;
 using ffdtest::WorldScale;
 
-template <typename Real>
-class FFDTetrahedraTest : public ::testing::Test
-{
-};
-using RealTypes = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(FFDTetrahedraTest, RealTypes);
+FFD_REAL_TYPED_TEST_SUITE(FFDTetrahedraTest);
 
 constexpr int NumberOfTetrahedra = 200;
 constexpr int PointsPerTetrahedron = 50;
@@ -121,10 +116,7 @@ TYPED_TEST(FFDTetrahedraTest, MapIsTheWeightedSumOfNodes)
       // Weights as above times displacements of at most `largest`, and the rounding of x + D.
       const double tol = 64.0 * Eps<Real>() * WorldScale(t.Frame, xd) * (1.0 + DualNorm(t.Frame) * largest);
       const Vec y = ffdtest::ToRef(map.Deform(x));
-      for (int c = 0; c < 3; ++c)
-      {
-        EXPECT_NEAR(y[c], expected[c], tol) << "tetrahedron " << trial << " point " << i;
-      }
+      EXPECT_TRUE(ffdtest::VectorNear(y, expected, tol)) << "tetrahedron " << trial << " point " << i;
     }
   }
 }
@@ -142,19 +134,9 @@ TYPED_TEST(FFDTetrahedraTest, RestLatticeIsTheExactIdentity)
     for (int i = 0; i < PointsPerTetrahedron; ++i)
     {
       const ffd::Vec3<Real> x = ffdtest::ToKernel<Real>(RandomPoint(rng, t));
-      const ffd::Vec3<Real> y = map.Deform(x);
-      EXPECT_EQ(y.x, x.x);
-      EXPECT_EQ(y.y, x.y);
-      EXPECT_EQ(y.z, x.z);
+      EXPECT_TRUE(ffdtest::VectorEqual(map.Deform(x), x)) << "tetrahedron " << trial << " point " << i;
     }
-    const ffd::Mat3<Real> j = map.Jacobian();
-    for (int r = 0; r < 3; ++r)
-    {
-      for (int c = 0; c < 3; ++c)
-      {
-        EXPECT_EQ(j.M[r][c], r == c ? Real(1) : Real(0));
-      }
-    }
+    EXPECT_TRUE(ffdtest::MatrixEqual(map.Jacobian(), ffd::Mat3<Real>::Identity())) << "tetrahedron " << trial;
   }
 }
 
@@ -166,23 +148,7 @@ TYPED_TEST(FFDTetrahedraTest, AffineMotionOfTheNodesIsReproduced)
   {
     const Tetrahedron t = RandomTetrahedron(rng);
     // y = M x + b with M = I + a random matrix of entries in [-0.3, 0.3].
-    double m[3][3];
-    for (int r = 0; r < 3; ++r)
-    {
-      for (int c = 0; c < 3; ++c)
-      {
-        m[r][c] = (r == c ? 1.0 : 0.0) + ffdtest::Uniform(rng, -0.3, 0.3);
-      }
-    }
-    const Vec b = ffdtest::RandomVec(rng, -1.0, 1.0);
-    const auto affine = [&](const Vec& x) {
-      Vec y;
-      for (int r = 0; r < 3; ++r)
-      {
-        y[r] = m[r][0] * x[0] + m[r][1] * x[1] + m[r][2] * x[2] + b[r];
-      }
-      return y;
-    };
+    const ffdtest::Affine affine = ffdtest::RandomAffine(rng, 0.3);
     ffd::Vec3<double> d[4];
     for (int n = 0; n < 4; ++n)
     {
@@ -190,25 +156,17 @@ TYPED_TEST(FFDTetrahedraTest, AffineMotionOfTheNodesIsReproduced)
     }
     const ffd::TetrahedronMap<Real> map =
       ffd::MakeTetrahedronMap(KernelFrame(t), d[0], d[1], d[2], d[3]).template As<Real>();
-    const ffd::Mat3<Real> j = map.Jacobian();
-    for (int r = 0; r < 3; ++r)
-    {
-      for (int c = 0; c < 3; ++c)
-      {
-        EXPECT_NEAR(j.M[r][c], m[r][c], 64.0 * Eps<Real>() * DualNorm(t.Frame) * WorldScale(t.Frame, b));
-      }
-    }
+    EXPECT_TRUE(ffdtest::MatrixNear(
+      map.Jacobian(), affine.A, 64.0 * Eps<Real>() * DualNorm(t.Frame) * WorldScale(t.Frame, affine.B)))
+      << "tetrahedron " << trial;
     for (int i = 0; i < PointsPerTetrahedron; ++i)
     {
       const ffd::Vec3<Real> x = ffdtest::ToKernel<Real>(RandomPoint(rng, t));
       const Vec xd = ffdtest::ToRef(x);
       const Vec expected = affine(xd);
       const double tol = 64.0 * Eps<Real>() * WorldScale(t.Frame, xd) * (1.0 + 2.0 * DualNorm(t.Frame));
-      const Vec y = ffdtest::ToRef(map.Deform(x));
-      for (int c = 0; c < 3; ++c)
-      {
-        EXPECT_NEAR(y[c], expected[c], tol);
-      }
+      EXPECT_TRUE(ffdtest::VectorNear(ffdtest::ToRef(map.Deform(x)), expected, tol))
+        << "tetrahedron " << trial << " point " << i;
     }
   }
 }
@@ -244,32 +202,24 @@ TEST(FFDTetrahedra, ClosestPointGradientProjectsOntoTheFeature)
     const ffd::Mat3<double> face = ffd::ClosestPointGradient(frame, { s, 1.0 - s - u, u }, 1e-9);
     const Vec bc = ffdref::Sub(t.Nodes[2], t.Nodes[1]), bd = ffdref::Sub(t.Nodes[3], t.Nodes[1]);
     const Vec normal = ffdref::Cross(bc, bd);
-    for (int c = 0; c < 3; ++c)
-    {
-      EXPECT_NEAR(apply(face, bc)[c], bc[c], tol);
-      EXPECT_NEAR(apply(face, bd)[c], bd[c], tol);
-      EXPECT_NEAR(apply(face, normal)[c], 0.0, tol * Norm(normal));
-    }
+    const Vec zero = { 0.0, 0.0, 0.0 };
+    EXPECT_TRUE(ffdtest::VectorNear(apply(face, bc), bc, tol)) << "face, BC; tetrahedron " << trial;
+    EXPECT_TRUE(ffdtest::VectorNear(apply(face, bd), bd, tol)) << "face, BD; tetrahedron " << trial;
+    EXPECT_TRUE(ffdtest::VectorNear(apply(face, normal), zero, tol * Norm(normal)))
+      << "face, normal; tetrahedron " << trial;
     // A point on edge AB: AB is kept, directions across it are removed.
     const ffd::Mat3<double> edge = ffd::ClosestPointGradient(frame, { 0.4, 0.0, 0.0 }, 1e-9);
     const Vec ab = ffdref::Sub(t.Nodes[1], t.Nodes[0]);
     const Vec across = ffdref::Cross(ab, bc);
     const Vec across2 = ffdref::Cross(ab, across);
-    for (int c = 0; c < 3; ++c)
-    {
-      EXPECT_NEAR(apply(edge, ab)[c], ab[c], tol);
-      EXPECT_NEAR(apply(edge, across)[c], 0.0, tol * Norm(across));
-      EXPECT_NEAR(apply(edge, across2)[c], 0.0, tol * Norm(across2));
-    }
+    EXPECT_TRUE(ffdtest::VectorNear(apply(edge, ab), ab, tol)) << "edge, AB; tetrahedron " << trial;
+    EXPECT_TRUE(ffdtest::VectorNear(apply(edge, across), zero, tol * Norm(across)))
+      << "edge, across; tetrahedron " << trial;
+    EXPECT_TRUE(ffdtest::VectorNear(apply(edge, across2), zero, tol * Norm(across2)))
+      << "edge, across twice; tetrahedron " << trial;
     // At node C nothing moves the nearest point.
     const ffd::Mat3<double> node = ffd::ClosestPointGradient(frame, { 0.0, 1.0, 0.0 }, 1e-9);
-    for (int r = 0; r < 3; ++r)
-    {
-      for (int c = 0; c < 3; ++c)
-      {
-        EXPECT_EQ(node.M[r][c], 0.0);
-      }
-    }
+    EXPECT_TRUE(ffdtest::MatrixEqual(node, ffd::Mat3<double>{})) << "node; tetrahedron " << trial;
   }
 }
 } // namespace
