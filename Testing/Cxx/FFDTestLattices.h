@@ -8,6 +8,7 @@
 #define FFDTestLattices_h
 
 #include "FFDReference.h"
+#include "FFDTestComparisons.h"
 
 #include "vtkDoubleArray.h"
 #include "vtkFFDBuildLattice.h"
@@ -189,33 +190,51 @@ inline void Perturb(vtkPointSet* lattice, std::mt19937& rng, double amplitude)
   points->Modified();
 }
 
-// Largest distance between the output points and the reference, over the frame's diagonal.
-inline double MaxRelativeError(vtkPointSet* input, vtkPointSet* output, const Reference& ref, bool clamp = false)
+// Every point of `got` equal to the same point of `want`, coordinate for coordinate (==, as ASSERT_EQ compares),
+// over want's points; fails at the first point that is not, naming it and its coordinates.
+inline ::testing::AssertionResult SamePoints(vtkPointSet* got, vtkPointSet* want)
 {
-  EXPECT_EQ(input->GetNumberOfPoints(), output->GetNumberOfPoints());
+  for (vtkIdType i = 0; i < want->GetNumberOfPoints(); ++i)
+  {
+    double x[3], y[3];
+    got->GetPoint(i, x);
+    want->GetPoint(i, y);
+    const ::testing::AssertionResult same = VectorEqual(x, y, "coordinate");
+    if (!same)
+    {
+      return ::testing::AssertionFailure() << "point " << i << ": " << same.message();
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// Largest distance between each output point and expected(x) of its input point x, over `scale`.
+template <typename Expected>
+double MaxScaledDistance(vtkPointSet* input, vtkPointSet* output, const Expected& expected, double scale)
+{
   double worst = 0.0;
   for (vtkIdType i = 0; i < input->GetNumberOfPoints(); ++i)
   {
     Vec x, y;
     input->GetPoint(i, x.data());
     output->GetPoint(i, y.data());
-    worst = std::max(worst, Length(ffdref::Sub(y, ref.Deform(x, clamp))));
+    worst = std::max(worst, Length(ffdref::Sub(y, expected(x))));
   }
-  return worst / Diagonal(ref.F);
+  return worst / scale;
+}
+
+// Largest distance between the output points and the reference, over the frame's diagonal.
+inline double MaxRelativeError(vtkPointSet* input, vtkPointSet* output, const Reference& ref, bool clamp = false)
+{
+  EXPECT_EQ(input->GetNumberOfPoints(), output->GetNumberOfPoints());
+  return MaxScaledDistance(
+    input, output, [&](const Vec& x) { return ref.Deform(x, clamp); }, Diagonal(ref.F));
 }
 
 // Largest distance any point moved, over the frame's diagonal: shows that a comparison could fail.
 inline double MaxRelativeMotion(vtkPointSet* input, vtkPointSet* output, const ffdref::Frame& f)
 {
-  double worst = 0.0;
-  for (vtkIdType i = 0; i < input->GetNumberOfPoints(); ++i)
-  {
-    Vec x, y;
-    input->GetPoint(i, x.data());
-    output->GetPoint(i, y.data());
-    worst = std::max(worst, Length(ffdref::Sub(y, x)));
-  }
-  return worst / Diagonal(f);
+  return MaxScaledDistance(input, output, [](const Vec& x) { return x; }, Diagonal(f));
 }
 
 inline double Det(const Matrix& a)

@@ -7,6 +7,8 @@
 #ifndef FFDTestMeshes_h
 #define FFDTestMeshes_h
 
+#include "vtkNew.h"
+#include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 #include "vtkXMLPolyDataReader.h"
@@ -48,6 +50,18 @@ inline vtkSmartPointer<vtkPolyData> ReadTestMeshOrReport(const std::string& name
     std::cerr << e.what() << "\n";
     return nullptr;
   }
+}
+
+/// A copy of `mesh` (cells and arrays shared) whose points are stored as float: the float path of the filters.
+inline vtkSmartPointer<vtkPolyData> WithFloatPoints(vtkPolyData* mesh)
+{
+  vtkNew<vtkPoints> floatPoints;
+  floatPoints->SetDataTypeToFloat();
+  floatPoints->DeepCopy(mesh->GetPoints()); // keeps the float type: DeepCopy converts the values
+  auto floatMesh = vtkSmartPointer<vtkPolyData>::New();
+  floatMesh->ShallowCopy(mesh);
+  floatMesh->SetPoints(floatPoints);
+  return floatMesh;
 }
 
 #endif

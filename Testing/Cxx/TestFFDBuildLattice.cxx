@@ -24,6 +24,7 @@
 
 #include "FFDBernstein.h"
 #include "FFDReference.h"
+#include "FFDTestComparisons.h"
 #include "FFDTestErrorObserver.h"
 #include "FFDTestMeshes.h"
 
@@ -269,13 +270,11 @@ TEST(vtkFFDBuildLattice, BernsteinRestPositionsFollowEquation1)
     const double scale = 6.0;
     for (vtkIdType id = 0; id < lattice->GetNumberOfPoints(); ++id)
     {
-      double x[3];
+      double x[3], r[3];
       lattice->GetPoint(id, x);
-      for (int c = 0; c < 3; ++c)
-      {
-        ASSERT_NEAR(x[c], expected[id][c], 1e-15 * scale) << id;
-        ASSERT_EQ(rest->GetComponent(id, c), x[c]) << id;
-      }
+      rest->GetTuple(id, r);
+      ASSERT_TRUE(ffdtest::VectorNear(x, expected[id], 1e-15 * scale)) << id;
+      ASSERT_TRUE(ffdtest::VectorEqual(r, x, "rest position component")) << id;
     }
   }
 }
@@ -404,15 +403,15 @@ TEST(vtkFFDBuildLattice, EveryBasisHasItsDimensionsAndRestPositions)
             const vtkIdType id = i + expected[0] * (j + static_cast<vtkIdType>(expected[1]) * k);
             const double a = ExpectedRestParameter(basis, n[0], i), b = ExpectedRestParameter(basis, n[1], j),
                          c = ExpectedRestParameter(basis, n[2], k);
-            double x[3];
+            double x[3], r[3], want[3];
             lattice->GetPoint(id, x);
+            rest->GetTuple(id, r);
             for (int d = 0; d < 3; ++d)
             {
-              const double want = SkewedFrame[d] + a * SkewedFrame[3 + d] + b * SkewedFrame[6 + d] +
-                c * SkewedFrame[9 + d];
-              ASSERT_NEAR(x[d], want, 1e-14) << i << " " << j << " " << k;
-              ASSERT_EQ(rest->GetComponent(id, d), x[d]) << id;
+              want[d] = SkewedFrame[d] + a * SkewedFrame[3 + d] + b * SkewedFrame[6 + d] + c * SkewedFrame[9 + d];
             }
+            ASSERT_TRUE(ffdtest::VectorNear(x, want, 1e-14)) << i << " " << j << " " << k;
+            ASSERT_TRUE(ffdtest::VectorEqual(r, x, "rest position component")) << id;
           }
     }
   }

@@ -79,15 +79,8 @@ double MaxRelativeError(vtkPointSet* input, vtkPointSet* output, vtkPointSet* la
   EXPECT_TRUE(vtkFFDDataContract::GetDivisions(lattice, deg));
   const std::vector<Vec> p = ControlPoints(lattice);
   EXPECT_EQ(input->GetNumberOfPoints(), output->GetNumberOfPoints());
-  double worst = 0.0;
-  for (vtkIdType i = 0; i < input->GetNumberOfPoints(); ++i)
-  {
-    Vec x, y;
-    input->GetPoint(i, x.data());
-    output->GetPoint(i, y.data());
-    worst = std::max(worst, Length(ffdref::Sub(y, ReferenceDeform(f, p, deg, x))));
-  }
-  return worst / Diagonal(f);
+  return MaxScaledDistance(
+    input, output, [&](const Vec& x) { return ReferenceDeform(f, p, deg, x); }, Diagonal(f));
 }
 
 } // namespace
@@ -118,13 +111,7 @@ TEST(vtkFFDDeform, MatchesReferenceOnRealMeshes)
 TEST(vtkFFDDeform, FloatPointsStayFloatWithinSinglePrecision)
 {
   std::mt19937 rng(7);
-  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("bear");
-  vtkNew<vtkPoints> floatPoints;
-  floatPoints->SetDataTypeToFloat();
-  floatPoints->DeepCopy(mesh->GetPoints());
-  vtkNew<vtkPolyData> floatMesh;
-  floatMesh->ShallowCopy(mesh);
-  floatMesh->SetPoints(floatPoints);
+  vtkSmartPointer<vtkPolyData> floatMesh = WithFloatPoints(ReadTestMesh("bear"));
   ASSERT_EQ(floatMesh->GetPoints()->GetDataType(), VTK_FLOAT);
 
   Pipeline pipeline(floatMesh, vtkFFDBuildLattice::BERNSTEIN, 4, 4, 4);
@@ -173,15 +160,7 @@ TEST(vtkFFDDeform, RestLatticeIsTheIdentity)
   vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
   Pipeline pipeline(mesh, vtkFFDBuildLattice::BERNSTEIN, 4, 3, 2);
   pipeline.Deform->Update();
-  for (vtkIdType i = 0; i < mesh->GetNumberOfPoints(); ++i)
-  {
-    double x[3], y[3];
-    mesh->GetPoint(i, x);
-    pipeline.Output()->GetPoint(i, y);
-    ASSERT_EQ(x[0], y[0]);
-    ASSERT_EQ(x[1], y[1]);
-    ASSERT_EQ(x[2], y[2]);
-  }
+  ASSERT_TRUE(SamePoints(pipeline.Output(), mesh));
 }
 
 // The binding is computed once and reused while only lattice points move; it is recomputed when the input's
@@ -516,9 +495,7 @@ TEST(vtkFFDDeform, NonFiniteInputPointsPassThroughAndOthersAreUnaffected)
     else
     {
       clean->GetPoint(i, expected);
-      ASSERT_EQ(y[0], expected[0]);
-      ASSERT_EQ(y[1], expected[1]);
-      ASSERT_EQ(y[2], expected[2]);
+      ASSERT_TRUE(VectorEqual(y, expected)) << "point " << i;
     }
   }
 }

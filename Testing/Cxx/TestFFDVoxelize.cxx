@@ -20,6 +20,7 @@
 #include "vtkUnsignedCharArray.h"
 
 #include "FFDReference.h"
+#include "FFDTestComparisons.h"
 #include "FFDTestErrorObserver.h"
 #include "FFDTestMeshes.h"
 
@@ -221,15 +222,10 @@ TEST(vtkFFDVoxelize, AxisAlignedFrameIsThePaddedBounds)
     const double pad = padding * largest;
     // The frame is a few additions away from the bounds: 1e-12 of the mesh size is far above rounding.
     const double tol = 1e-12 * largest;
-    const Vec* edges[3] = { &f.S, &f.T, &f.U };
-    for (int c = 0; c < 3; ++c)
-    {
-      EXPECT_NEAR(f.X0[c], lo[c] - pad, tol);
-      for (int a = 0; a < 3; ++a)
-      {
-        EXPECT_NEAR((*edges[a])[c], a == c ? hi[c] - lo[c] + 2 * pad : 0.0, tol);
-      }
-    }
+    const Vec size = { hi[0] - lo[0] + 2 * pad, hi[1] - lo[1] + 2 * pad, hi[2] - lo[2] + 2 * pad };
+    const ffdref::Frame box = { { lo[0] - pad, lo[1] - pad, lo[2] - pad }, { size[0], 0.0, 0.0 },
+      { 0.0, size[1], 0.0 }, { 0.0, 0.0, size[2] } };
+    EXPECT_TRUE(ffdtest::FramesNear(f, box, tol));
     for (const Vec& x : xs)
     {
       const Vec p = ffdref::Parameters(f, x);
@@ -339,14 +335,7 @@ TEST(vtkFFDVoxelize, ExplicitFrameIgnoresPointsOutside)
   voxelize->SetFrame(origin, s, t, u);
   voxelize->SetDivisions(5, 3, 4);
   ExpectActiveVoxelsMatchBruteForce(cloud, voxelize);
-  const ffdref::Frame out = FrameOf(voxelize->GetOutput());
-  for (int c = 0; c < 3; ++c)
-  {
-    EXPECT_EQ(out.X0[c], f.X0[c]);
-    EXPECT_EQ(out.S[c], f.S[c]);
-    EXPECT_EQ(out.T[c], f.T[c]);
-    EXPECT_EQ(out.U[c], f.U[c]);
-  }
+  EXPECT_TRUE(ffdtest::FramesEqual(FrameOf(voxelize->GetOutput()), f));
 }
 
 TEST(vtkFFDVoxelize, SetFrameSelectsTheExplicitMode)
@@ -361,14 +350,9 @@ TEST(vtkFFDVoxelize, SetFrameSelectsTheExplicitMode)
   voxelize->SetFrame(origin, s, t, u);
   EXPECT_EQ(voxelize->GetFrameMode(), vtkFFDVoxelize::EXPLICIT);
   voxelize->Update();
-  const ffdref::Frame out = FrameOf(voxelize->GetOutput());
-  for (int c = 0; c < 3; ++c)
-  {
-    EXPECT_EQ(out.X0[c], origin[c]);
-    EXPECT_EQ(out.S[c], s[c]);
-    EXPECT_EQ(out.T[c], t[c]);
-    EXPECT_EQ(out.U[c], u[c]);
-  }
+  const ffdref::Frame f = { { origin[0], origin[1], origin[2] }, { s[0], s[1], s[2] }, { t[0], t[1], t[2] },
+    { u[0], u[1], u[2] } };
+  EXPECT_TRUE(ffdtest::FramesEqual(FrameOf(voxelize->GetOutput()), f));
   voxelize->SetFrameModeToAxisAligned();
   voxelize->SetFrameOrigin(5.0, 5.0, 5.0);
   EXPECT_EQ(voxelize->GetFrameMode(), vtkFFDVoxelize::AXIS_ALIGNED);
@@ -433,10 +417,7 @@ TEST(vtkFFDVoxelize, OutputFollowsTheDataContract)
   {
     double x[3];
     out->GetPoint(id, x);
-    for (int c = 0; c < 3; ++c)
-    {
-      ASSERT_NEAR(x[c], expected[id][c], 1e-15 * scale) << id;
-    }
+    ASSERT_TRUE(ffdtest::VectorNear(x, expected[id], 1e-15 * scale)) << id;
   }
   EXPECT_EQ(vtkUnsignedCharArray::SafeDownCast(out->GetCellData()->GetArray(vtkDataSetAttributes::GhostArrayName()))
               ->GetNumberOfValues(),
