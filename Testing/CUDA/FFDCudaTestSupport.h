@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
  * @file FFDCudaTestSupport.h
- * @brief What the GPU tests and BenchmarkFFDCuda share: the device check of the tests, and random tetrahedral
- * control meshes with points bound to them (no VTK: the GPU machine has none).
+ * @brief What the GPU tests and BenchmarkFFDCuda share: the device check of the tests, the count of GPU values
+ * that differ from the CPU's or the reference's, and random tetrahedral control meshes with points bound to them
+ * (no VTK: the GPU machine has none).
  */
 #ifndef FFDCudaTestSupport_h
 #define FFDCudaTestSupport_h
@@ -10,6 +11,7 @@
 #include "FFDCudaResidentPoints.h"
 #include "FFDTetrahedra.h"
 
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -28,6 +30,37 @@
 
 namespace ffdtest
 {
+/// Whether a GPU value matches the expected one: both NaN, the same infinity, or within `tolerance`.
+inline bool Same(double a, double b, double tolerance)
+{
+  return (std::isnan(a) && std::isnan(b)) || (std::isinf(a) && a == b) || std::fabs(a - b) <= tolerance;
+}
+
+/// The values of a comparison over many points that did not match, and a description of the first five.
+struct Mismatches
+{
+  std::int64_t Count = 0;
+  std::string First; ///< "<where>: got vs expected; " for each of the first five
+
+  /// Records a value that did not match.
+  void Add(const std::string& where, double got, double expected)
+  {
+    if (this->Count++ < 5)
+    {
+      this->First += where + ": " + std::to_string(got) + " vs " + std::to_string(expected) + "; ";
+    }
+  }
+
+  /// Records `what` of point i unless Same(got, expected, tolerance).
+  void Check(const char* what, std::int64_t i, double got, double expected, double tolerance)
+  {
+    if (!Same(got, expected, tolerance))
+    {
+      this->Add(std::string(what) + " of point " + std::to_string(i), got, expected);
+    }
+  }
+};
+
 /// A tetrahedral control mesh: rest nodes (3 doubles each) and tetrahedra (4 node indices each).
 struct TetrahedralMesh
 {

@@ -5,6 +5,7 @@
 #include "FFDCudaGridDeformer.h"
 #include "FFDCudaTestSupport.h"
 #include "FFDGridDeformation.h"
+#include "FFDTestComparisons.h"
 
 #include <gtest/gtest.h>
 
@@ -131,17 +132,7 @@ void CpuDeform(const Problem& p, bool clampOutside, std::vector<double>& points,
   }
 }
 
-bool Same(double a, double b, double tolerance)
-{
-  return (std::isnan(a) && std::isnan(b)) || (std::isinf(a) && a == b) || std::fabs(a - b) <= tolerance;
-}
-
-template <typename Real>
-class CudaGridDeformerTest : public ::testing::Test
-{
-};
-using RealTypes = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(CudaGridDeformerTest, RealTypes);
+FFD_REAL_TYPED_TEST_SUITE(CudaGridDeformerTest);
 
 // GPU and CPU agree for every basis and outside policy, each in the precision of the points. Tolerance: 1e-5
 // relative to the frame's scale (about 3) in float32, the bound, and 1e-12 in double (the same
@@ -178,17 +169,9 @@ TYPED_TEST(CudaGridDeformerTest, MatchesCpuForEveryBasis)
       // within 1e-5 times the ratio of that size to |det J| (a bound on J's condition number) in float32, and
       // 1e-12 times it in double (normals are uploaded, transformed and downloaded in the points' precision).
       const bool single = sizeof(Real) == sizeof(float);
-      std::int64_t wrong = 0;
-      std::string firstWrong;
-      auto check = [&](const char* what, std::int64_t i, double got, double expected, double tol) {
-        if (!Same(got, expected, tol))
-        {
-          if (wrong++ < 5)
-          {
-            firstWrong += std::string(what) + " of point " + std::to_string(i) + ": " + std::to_string(got) +
-              " vs " + std::to_string(expected) + "; ";
-          }
-        }
+      ffdtest::Mismatches wrong;
+      const auto check = [&](const char* what, std::int64_t i, double got, double expected, double tol) {
+        wrong.Check(what, i, got, expected, tol);
       };
       for (std::int64_t i = 0; i < p.Count(); ++i)
       {
@@ -211,7 +194,7 @@ TYPED_TEST(CudaGridDeformerTest, MatchesCpuForEveryBasis)
       {
         check("position without Jacobian", std::int64_t(v / 3), double(outPoints[v]), cpuPoints[v], tolerance);
       }
-      EXPECT_EQ(wrong, 0) << "basis " << basis << (clamp ? " clamped" : " kept") << ": " << firstWrong;
+      EXPECT_EQ(wrong.Count, 0) << "basis " << basis << (clamp ? " clamped" : " kept") << ": " << wrong.First;
     }
   }
 }
@@ -247,24 +230,22 @@ void ExpectFloatMatchesCpu(int basis, const int divisions[3], std::int64_t count
   ASSERT_TRUE(gpu.Evaluate(p.Displacements.data(), p.ControlPoints(), false, false)) << gpu.GetLastError();
   ASSERT_TRUE(gpu.Download(out.data(), nullptr, nullptr)) << gpu.GetLastError();
   double largest = 0;
-  std::int64_t wrong = 0;
-  std::string firstWrong;
+  ffdtest::Mismatches wrong;
   for (std::size_t v = 0; v < out.size(); ++v)
   {
     // Against float64, the float32 rounding of the input point itself is no error of the evaluation: the
     // reference starts from the double point, so compare the displacements (y - x). Kept points exactly.
     const double x = againstDouble ? p.Points[v] : double(points[v]), expected = cpuPoints[v], got = double(out[v]);
     const double error = std::isfinite(expected) ? std::fabs((got - double(points[v])) - (expected - x)) : 0.0;
-    const bool ok = std::isfinite(expected) ? error <= 1e-5 * 3.0 : Same(got, double(points[v]), 0.0);
+    const bool ok = std::isfinite(expected) ? error <= 1e-5 * 3.0 : ffdtest::Same(got, double(points[v]), 0.0);
     largest = std::max(largest, std::isfinite(error) ? error : 1e30);
-    if (!ok && wrong++ < 5)
+    if (!ok)
     {
-      firstWrong +=
-        "value " + std::to_string(v) + ": " + std::to_string(got) + " vs " + std::to_string(expected) + "; ";
+      wrong.Add("value " + std::to_string(v), got, expected);
     }
   }
-  EXPECT_EQ(wrong, 0) << "basis " << basis << " divisions " << divisions[0] << "x" << divisions[1] << "x"
-                      << divisions[2] << ", " << count << " points" << (clamp ? " clamped" : "") << ": " << firstWrong;
+  EXPECT_EQ(wrong.Count, 0) << "basis " << basis << " divisions " << divisions[0] << "x" << divisions[1] << "x"
+                      << divisions[2] << ", " << count << " points" << (clamp ? " clamped" : "") << ": " << wrong.First;
   if (worst)
   {
     *worst = std::max(*worst, largest);

@@ -5,6 +5,7 @@
 // update uploads only the nodes' displacements); failures. Without a CUDA device every test skips but the last.
 #include "FFDCudaTestSupport.h"
 #include "FFDCudaTetrahedralDeformer.h"
+#include "FFDTestComparisons.h"
 
 #include <gtest/gtest.h>
 
@@ -205,17 +206,7 @@ struct Problem
   }
 };
 
-bool Same(double a, double b, double tolerance)
-{
-  return (std::isnan(a) && std::isnan(b)) || (std::isinf(a) && a == b) || std::fabs(a - b) <= tolerance;
-}
-
-template <typename Real>
-class CudaTetrahedralDeformerTest : public ::testing::Test
-{
-};
-using RealTypes = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(CudaTetrahedralDeformerTest, RealTypes);
+FFD_REAL_TYPED_TEST_SUITE(CudaTetrahedralDeformerTest);
 
 // The device against the float64 reference, each in the precision of the points (the reference starts from the
 // points as the device has them). Tolerances, relative to the mesh's size (3): positions 1e-5 in float32 (the
@@ -262,14 +253,9 @@ TYPED_TEST(CudaTetrahedralDeformerTest, MatchesFloat64Reference)
       ASSERT_TRUE(gpu.Download(outPoints.data(), withJacobian ? outNormals.data() : nullptr,
         withJacobian ? outDeterminants.data() : nullptr))
         << gpu.GetLastError();
-      std::int64_t wrong = 0;
-      std::string firstWrong;
-      auto check = [&](const char* what, std::int64_t i, double got, double want, double tolerance) {
-        if (!Same(got, want, tolerance) && wrong++ < 5)
-        {
-          firstWrong += std::string(what) + " of point " + std::to_string(i) + ": " + std::to_string(got) + " vs " +
-            std::to_string(want) + "; ";
-        }
+      ffdtest::Mismatches wrong;
+      const auto check = [&](const char* what, std::int64_t i, double got, double want, double tolerance) {
+        wrong.Check(what, i, got, want, tolerance);
       };
       for (std::int64_t i = 0; i < p.Count(); ++i)
       {
@@ -295,8 +281,8 @@ TYPED_TEST(CudaTetrahedralDeformerTest, MatchesFloat64Reference)
             relative * std::max(1.0, r.Scale));
         }
       }
-      EXPECT_EQ(wrong, 0) << (meshOrder ? "mesh order" : "random order")
-                          << (withJacobian ? ", with normals and det J: " : ": ") << firstWrong;
+      EXPECT_EQ(wrong.Count, 0) << (meshOrder ? "mesh order" : "random order")
+                                << (withJacobian ? ", with normals and det J: " : ": ") << wrong.First;
     }
   }
   std::printf("tetrahedra, %s against float64: largest position error %.2e of the mesh's size\n",
