@@ -3,12 +3,16 @@
  * @file FFDImageTestScene.h
  * @brief Set-up shared by the image regression tests of local and global lattices: a lattice of a basis over
  * a real mesh, control points moved in frame units, and a viewport that shows the deformed mesh coloured by
- * how far each point moved, with the lattice drawn by vtkFFDLatticeActor.
+ * how far each point moved, with the lattice drawn by vtkFFDLatticeActor; the off-screen window, the camera
+ * and the comparison with the baseline image that every image test uses.
  */
 #ifndef FFDImageTestScene_h
 #define FFDImageTestScene_h
 
+#include "FFDTestMeshes.h"
+
 #include "vtkActor.h"
+#include "vtkCamera.h"
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDDeform.h"
@@ -22,12 +26,16 @@
 #include "vtkPolyData.h"
 #include "vtkPolyDataMapper.h"
 #include "vtkProperty.h"
+#include "vtkRegressionTestImage.h"
+#include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkSmartPointer.h"
 #include "vtkStructuredGrid.h"
+#include "vtkTesting.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 
 /// A lattice whose points the test moves (a copy of vtkFFDBuildLattice's output), with what it was built from.
@@ -89,6 +97,15 @@ inline bool BuildTestLattice(
     return false;
   }
   return true;
+}
+
+/// ReadTestMeshOrReport(name) into `mesh`, then BuildTestLattice() over it: false (and why on stderr) when
+/// either fails.
+inline bool ReadMeshAndBuildTestLattice(const char* name, const int divisions[3], int basis,
+  const int expectedDims[3], vtkSmartPointer<vtkPolyData>& mesh, FFDTestLattice& lattice)
+{
+  mesh = ReadTestMeshOrReport(name);
+  return mesh && BuildTestLattice(mesh, divisions, basis, expectedDims, lattice);
 }
 
 /// `mesh` deformed by `lattice`, with a `Displacement` point array: the distance each point moved.
@@ -167,6 +184,48 @@ inline vtkFFDLatticeActor* AddDeformedScene(vtkRenderer* renderer, vtkPolyData* 
   renderer->AddActor(latticeActor);
   renderer->SetBackground(1.0, 1.0, 1.0);
   return latticeActor; // the renderer holds it
+}
+
+/// The image tests' window: off-screen, `width` x `height` pixels, without multisampling (it differs between GL
+/// drivers; the comparison is about geometry).
+inline vtkSmartPointer<vtkRenderWindow> NewTestRenderWindow(int width, int height)
+{
+  auto window = vtkSmartPointer<vtkRenderWindow>::New();
+  window->SetOffScreenRendering(1);
+  window->SetMultiSamples(0);
+  window->SetSize(width, height);
+  return window;
+}
+
+/**
+ * Points the renderer's camera at a model standing along +Y and facing +Z (CGAL's bear and cow): from the front
+ * (+Z, up +Y), turned by `azimuth` and `elevation` degrees, then fitted to `bounds` and zoomed by `zoom` (1: not
+ * zoomed; ResetCamera fits the bounding sphere, leaving wide margins).
+ */
+inline void ViewFromFront(vtkRenderer* renderer, double azimuth, double elevation, const double bounds[6], double zoom)
+{
+  vtkCamera* camera = renderer->GetActiveCamera();
+  camera->SetPosition(0.0, 0.0, 1.0);
+  camera->SetFocalPoint(0.0, 0.0, 0.0);
+  camera->SetViewUp(0.0, 1.0, 0.0);
+  camera->Azimuth(azimuth);
+  camera->Elevation(elevation);
+  renderer->ResetCamera(bounds);
+  if (zoom != 1.0)
+  {
+    camera->Zoom(zoom);
+  }
+}
+
+/**
+ * The test's result: EXIT_SUCCESS only when the window's image matches the baseline given by -V within
+ * `threshold` (vtkTesting's image-difference error). vtkTesting::Test answers NOT_RUN without a -V baseline
+ * argument: only a comparison that ran and matched passes.
+ */
+inline int CompareWithBaseline(int argc, char* argv[], vtkRenderWindow* window, double threshold)
+{
+  const int result = vtkRegressionTestImageThreshold(window, threshold);
+  return result == vtkTesting::PASSED ? EXIT_SUCCESS : EXIT_FAILURE;
 }
 
 #endif

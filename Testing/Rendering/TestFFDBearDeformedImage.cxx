@@ -3,6 +3,7 @@
 // lattice (3 x 4 x 5 control points, the paper's Figure 12 set-up) moved deterministically, the bear deformed
 // by vtkFFDDeform and drawn with its lattice (vtkFFDLatticeActor), compared with
 // Testing/Data/Baseline/TestFFDBearDeformedImage.png.
+#include "FFDImageTestScene.h"
 #include "FFDTestMeshes.h"
 
 #include "vtkActor.h"
@@ -118,10 +119,7 @@ int TestFFDBearDeformedImage(int argc, char* argv[])
   renderer->AddActor(bearActor);
   renderer->AddActor(latticeActor);
   renderer->SetBackground(1.0, 1.0, 1.0);
-  vtkNew<vtkRenderWindow> window;
-  window->SetOffScreenRendering(1);
-  window->SetMultiSamples(0); // multisampling differs between GL drivers; keep the comparison about geometry
-  window->SetSize(600, 600);
+  vtkSmartPointer<vtkRenderWindow> window = NewTestRenderWindow(600, 600);
   window->AddRenderer(renderer);
 
   // A first frame with the rest lattice, then the points are moved in place: the image compared below shows
@@ -139,8 +137,5 @@ int TestFFDBearDeformedImage(int argc, char* argv[])
   // Threshold 0.05 (vtkTesting's image-difference error): renders under Xvfb/llvmpipe were byte-identical
   // across runs (error 0), so this only absorbs small rasterization differences between Mesa versions. An image
   // of the undeformed bear with its rest lattice, same camera, scored 14390 against this render.
-  const int result = vtkRegressionTestImageThreshold(window, 0.05);
-  // vtkTesting::Test answers NOT_RUN without a -V baseline argument: only a comparison that ran and matched
-  // passes.
-  return result == vtkTesting::PASSED ? EXIT_SUCCESS : EXIT_FAILURE;
+  return CompareWithBaseline(argc, argv, window, 0.05);
 }

@@ -24,15 +24,11 @@
 
 int TestFFDBearLocalRegionsImage(int argc, char* argv[])
 {
-  vtkSmartPointer<vtkPolyData> bear = ReadTestMeshOrReport("bear");
-  if (!bear)
-  {
-    return EXIT_FAILURE;
-  }
   const int divisions[3] = { 5, 5, 5 };
   const int dims[3] = { 6, 6, 6 };
+  vtkSmartPointer<vtkPolyData> bear;
   FFDTestLattice lattice;
-  if (!BuildTestLattice(bear, divisions, vtkFFDBuildLattice::TRILINEAR, dims, lattice))
+  if (!ReadMeshAndBuildTestLattice("bear", divisions, vtkFFDBuildLattice::TRILINEAR, dims, bear, lattice))
   {
     return EXIT_FAILURE;
   }
@@ -156,24 +152,13 @@ int TestFFDBearLocalRegionsImage(int argc, char* argv[])
   magnetActor->GetProperty()->SetSpecular(0.5);
   renderer->AddActor(magnetActor);
 
-  vtkNew<vtkRenderWindow> window;
-  window->SetOffScreenRendering(1);
-  window->SetMultiSamples(0); // multisampling differs between GL drivers; keep the comparison about geometry
-  window->SetSize(500, 500);
+  vtkSmartPointer<vtkRenderWindow> window = NewTestRenderWindow(500, 500);
   window->AddRenderer(renderer);
-  vtkCamera* camera = renderer->GetActiveCamera();
   // CGAL's bear stands along +Y and faces +Z: its front, a little from its left and from above.
-  camera->SetPosition(0.0, 0.0, 1.0);
-  camera->SetFocalPoint(0.0, 0.0, 0.0);
-  camera->SetViewUp(0.0, 1.0, 0.0);
-  camera->Azimuth(25.0);
-  camera->Elevation(15.0);
-  renderer->ResetCamera(lattice.Grid->GetBounds());
-  camera->Zoom(1.05);
+  ViewFromFront(renderer, 25.0, 15.0, lattice.Grid->GetBounds(), 1.05);
   window->Render();
 
   // Threshold 0.05 (vtkTesting's image-difference error), as the other image tests: repeated renders under
   // Xvfb/llvmpipe are identical; this absorbs small rasterization differences between Mesa versions.
-  const int result = vtkRegressionTestImageThreshold(window, 0.05);
-  return result == vtkTesting::PASSED ? EXIT_SUCCESS : EXIT_FAILURE;
+  return CompareWithBaseline(argc, argv, window, 0.05);
 }

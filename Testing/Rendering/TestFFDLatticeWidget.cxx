@@ -141,15 +141,11 @@ void Translate(vtkStructuredGrid* grid, vtkIdType id, const double motion[3])
 
 int TestFFDLatticeWidget(int argc, char* argv[])
 {
-  vtkSmartPointer<vtkPolyData> bear = ReadTestMeshOrReport("bear");
-  if (!bear)
-  {
-    return EXIT_FAILURE;
-  }
   const int divisions[3] = { 4, 4, 4 };
   const int dims[3] = { 5, 5, 5 };
+  vtkSmartPointer<vtkPolyData> bear;
   FFDTestLattice lattice;
-  if (!BuildTestLattice(bear, divisions, vtkFFDBuildLattice::TRILINEAR, dims, lattice))
+  if (!ReadMeshAndBuildTestLattice("bear", divisions, vtkFFDBuildLattice::TRILINEAR, dims, bear, lattice))
   {
     return EXIT_FAILURE;
   }
@@ -170,10 +166,7 @@ int TestFFDLatticeWidget(int argc, char* argv[])
   vtkNew<vtkRenderer> renderer;
   renderer->AddActor(meshActor);
   renderer->SetBackground(1.0, 1.0, 1.0);
-  vtkNew<vtkRenderWindow> window;
-  window->SetOffScreenRendering(1);
-  window->SetMultiSamples(0);
-  window->SetSize(500, 500);
+  vtkSmartPointer<vtkRenderWindow> window = NewTestRenderWindow(500, 500);
   window->AddRenderer(renderer);
   vtkNew<vtkRenderWindowInteractor> interactor;
   interactor->SetRenderWindow(window);
@@ -187,12 +180,7 @@ int TestFFDLatticeWidget(int argc, char* argv[])
   rep->SetLattice(grid);
   widget->On();
 
-  vtkCamera* camera = renderer->GetActiveCamera();
-  camera->SetPosition(0.0, 0.0, 1.0);
-  camera->SetViewUp(0.0, 1.0, 0.0);
-  camera->Azimuth(20.0);
-  camera->Elevation(15.0);
-  renderer->ResetCamera(grid->GetBounds());
+  ViewFromFront(renderer, 20.0, 15.0, grid->GetBounds(), 1.0);
   window->Render();
   if (deform->GetNumberOfBindings() != 1)
   {
@@ -292,6 +280,5 @@ int TestFFDLatticeWidget(int argc, char* argv[])
   window->Render();
 
   // Threshold 0.05 (vtkTesting's image-difference error), as the other image tests.
-  const int result = vtkRegressionTestImageThreshold(window, 0.05);
-  return result == vtkTesting::PASSED ? EXIT_SUCCESS : EXIT_FAILURE;
+  return CompareWithBaseline(argc, argv, window, 0.05);
 }

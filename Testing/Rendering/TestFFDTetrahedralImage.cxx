@@ -121,23 +121,12 @@ int TestFFDTetrahedralImage(int argc, char* argv[])
   latticeActor->GetEdgeProperty()->SetColor(0.62, 0.7, 0.88);
   latticeActor->GetEdgeProperty()->SetOpacity(0.6);
 
-  vtkNew<vtkRenderWindow> window;
-  window->SetOffScreenRendering(1);
-  window->SetMultiSamples(0); // multisampling differs between GL drivers; keep the comparison about geometry
-  window->SetSize(560, 420);
+  vtkSmartPointer<vtkRenderWindow> window = NewTestRenderWindow(560, 420);
   window->AddRenderer(renderer);
-  vtkCamera* camera = renderer->GetActiveCamera();
   // CGAL's cow: length along X, up along +Y; seen from its side, a little from the front and above.
-  camera->SetPosition(0.0, 0.0, 1.0);
-  camera->SetFocalPoint(0.0, 0.0, 0.0);
-  camera->SetViewUp(0.0, 1.0, 0.0);
-  camera->Azimuth(-20.0);
-  camera->Elevation(12.0);
-  renderer->ResetCamera(lattice->GetBounds());
-  camera->Zoom(1.3);
+  ViewFromFront(renderer, -20.0, 12.0, lattice->GetBounds(), 1.3);
   window->Render();
 
   // Threshold 0.05 (vtkTesting's image-difference error), as the other image tests.
-  const int result = vtkRegressionTestImageThreshold(window, 0.05);
-  return result == vtkTesting::PASSED ? EXIT_SUCCESS : EXIT_FAILURE;
+  return CompareWithBaseline(argc, argv, window, 0.05);
 }

@@ -18,16 +18,11 @@
 
 int TestFFDTricubicBezierImage(int argc, char* argv[])
 {
-  vtkSmartPointer<vtkPolyData> bear = ReadTestMeshOrReport("bear");
-  if (!bear)
-  {
-    return EXIT_FAILURE;
-  }
-
   const int divisions[3] = { 3, 4, 3 };
   const int dims[3] = { 10, 13, 10 };
+  vtkSmartPointer<vtkPolyData> bear;
   FFDTestLattice lattice;
-  if (!BuildTestLattice(bear, divisions, vtkFFDBuildLattice::TRICUBIC_BEZIER, dims, lattice))
+  if (!ReadMeshAndBuildTestLattice("bear", divisions, vtkFFDBuildLattice::TRICUBIC_BEZIER, dims, bear, lattice))
   {
     return EXIT_FAILURE;
   }
@@ -67,27 +62,15 @@ int TestFFDTricubicBezierImage(int argc, char* argv[])
   // Spheres of 0.4 % of the lattice's diagonal: 1300 control points at the automatic 1.5 % hide the bear.
   AddDeformedScene(renderer, deformed, lattice.Grid, deformed->GetPointData()->GetScalars()->GetRange()[1],
     0.004 * lattice.Grid->GetLength());
-  vtkNew<vtkRenderWindow> window;
-  window->SetOffScreenRendering(1);
-  window->SetMultiSamples(0); // multisampling differs between GL drivers; keep the comparison about geometry
-  window->SetSize(600, 600);
+  vtkSmartPointer<vtkRenderWindow> window = NewTestRenderWindow(600, 600);
   window->AddRenderer(renderer);
   // CGAL's bear stands along +Y and faces +Z: look at its front, from its right and from above, so that the
   // belly's bulge shows in profile.
-  vtkCamera* camera = renderer->GetActiveCamera();
-  camera->SetPosition(0.0, 0.0, 1.0);
-  camera->SetViewUp(0.0, 1.0, 0.0);
-  camera->Azimuth(-55.0);
-  camera->Elevation(15.0);
-  renderer->ResetCamera(lattice.Grid->GetBounds());
-  camera->Zoom(1.2); // ResetCamera fits the bounding sphere, leaving wide margins
+  ViewFromFront(renderer, -55.0, 15.0, lattice.Grid->GetBounds(), 1.2);
   window->Render();
 
   // Threshold 0.05 (vtkTesting's image-difference error): renders under Xvfb/llvmpipe were byte-identical
   // across runs (error 0), so this only absorbs small rasterization differences between Mesa versions. The
   // same scene with the belly pushed by 0.5 U instead of 0.6 U scored 2503 against this baseline.
-  const int result = vtkRegressionTestImageThreshold(window, 0.05);
-  // vtkTesting::Test answers NOT_RUN without a -V baseline argument: only a comparison that ran and matched
-  // passes.
-  return result == vtkTesting::PASSED ? EXIT_SUCCESS : EXIT_FAILURE;
+  return CompareWithBaseline(argc, argv, window, 0.05);
 }
