@@ -11,20 +11,14 @@ moved. Compared with Testing/Data/Baseline/TestFFDCulledVoxelsImage.png through 
 Run: /usr/bin/python3 TestFFDCulledVoxelsImage.py -B <baseline folder> -T <temporary folder>, with
 PYTHONPATH=<build>/lib/python3/dist-packages and VOXELFFD_MESH_DIR (ctest sets all of them).
 """
-import os
-
 import numpy as np
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
-from vtkmodules.vtkCommonDataModel import vtkStructuredGrid
-from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
-from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper, vtkRenderer, vtkRenderWindow
+from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper, vtkRenderer
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window behind vtkRenderWindow)
 from vtkmodules.test import Testing
 
 import vtkffd
-
-MESH_DIR = os.environ.get(
-    "VOXELFFD_MESH_DIR", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Data", "Meshes"))
+from ffdtesting import build_lattice, offscreen_window, read_mesh  # the same folder
 
 # vtkTesting's image-difference error, as the C++ image tests: repeated renders under Xvfb/llvmpipe are
 # identical; 0.05 absorbs small rasterization differences between Mesa versions.
@@ -33,22 +27,8 @@ THRESHOLD = 0.05
 
 class TestFFDCulledVoxelsImage(Testing.vtkTest):
     def test_culled_voxels(self):
-        path = os.path.join(MESH_DIR, "armadillo.vtp")
-        self.assertTrue(os.path.isfile(path), path + " is missing: run Utilities/setup.sh")
-        reader = vtkXMLPolyDataReader()
-        reader.SetFileName(path)
-        reader.Update()
-        mesh = reader.GetOutput()
-
-        voxelize = vtkffd.vtkFFDVoxelize()
-        voxelize.SetInputData(mesh)
-        voxelize.SetDivisions(10, 10, 10)
-        build = vtkffd.vtkFFDBuildLattice()
-        build.SetInputConnection(voxelize.GetOutputPort())
-        build.SetBasisToTrilinear()
-        build.Update()
-        lattice = vtkStructuredGrid()
-        lattice.DeepCopy(build.GetOutput())
+        mesh = read_mesh("armadillo")
+        voxelize, build, lattice = build_lattice(mesh, (10, 10, 10), vtkffd.vtkFFDBuildLattice.TRILINEAR)
         self.assertEqual(lattice.GetNumberOfPoints(), 1331)
         active_voxels = voxelize.GetNumberOfActiveVoxels()
         active_points = build.GetNumberOfActiveControlPoints()
@@ -126,11 +106,7 @@ class TestFFDCulledVoxelsImage(Testing.vtkTest):
         renderer.AddActor(actor)
         renderer.AddActor(lattice_actor)
         renderer.SetBackground(1.0, 1.0, 1.0)
-        window = vtkRenderWindow()
-        window.SetOffScreenRendering(1)
-        window.SetMultiSamples(0)
-        window.SetSize(500, 500)
-        window.AddRenderer(renderer)
+        window = offscreen_window(renderer, (500, 500), multisamples=0)
         camera = renderer.GetActiveCamera()
         # CGAL's armadillo stands along +Y and faces +Z: its front, a little from the side and from above.
         camera.SetPosition(0.0, 0.0, 1.0)

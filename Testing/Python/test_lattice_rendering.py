@@ -14,28 +14,11 @@ from vtkmodules.vtkCommonCore import vtkCommand, vtkIdList, vtkPoints
 from vtkmodules.vtkCommonDataModel import VTK_TETRA, vtkStructuredGrid, vtkUnstructuredGrid
 from vtkmodules.vtkFiltersSources import vtkSphereSource
 from vtkmodules.vtkInteractionStyle import vtkInteractorStyleTrackballCamera
-from vtkmodules.vtkRenderingCore import (vtkInteractorObserver, vtkRenderer, vtkRenderWindow,
-                                         vtkRenderWindowInteractor)
+from vtkmodules.vtkRenderingCore import vtkInteractorObserver, vtkRenderer, vtkRenderWindowInteractor
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
 
 import vtkffd
-
-
-class ErrorCatcher:
-    """Collects the messages of ErrorEvents (and keeps expected errors out of the log)."""
-
-    def __init__(self):
-        self.CallDataType = "string0"  # VTK passes the message as call data to observers that declare it
-        self.messages = []
-
-    def __call__(self, caller, event, message):
-        self.messages.append(message)
-
-
-def catch_errors(obj):
-    catcher = ErrorCatcher()
-    obj.AddObserver("ErrorEvent", catcher)
-    return catcher
+from ffdtesting import build_lattice, catch_errors, offscreen_window  # the same folder
 
 
 def cube_tetrahedra():
@@ -66,16 +49,7 @@ def sphere_lattice(divisions=(5, 5, 5)):
     sphere = vtkSphereSource()
     sphere.SetThetaResolution(24)
     sphere.SetPhiResolution(16)
-    voxelize = vtkffd.vtkFFDVoxelize()
-    voxelize.SetInputConnection(sphere.GetOutputPort())
-    voxelize.SetDivisions(*divisions)
-    build = vtkffd.vtkFFDBuildLattice()
-    build.SetInputConnection(voxelize.GetOutputPort())
-    build.SetBasisToTrilinear()
-    build.Update()
-    lattice = vtkStructuredGrid()
-    lattice.DeepCopy(build.GetOutput())
-    return voxelize, build, lattice
+    return build_lattice(sphere.GetOutputPort(), divisions, vtkffd.vtkFFDBuildLattice.TRILINEAR)
 
 
 def parts(actor):
@@ -216,9 +190,7 @@ class LatticeActorTest(unittest.TestCase):
         self.assertIn("Lattice: (none)", str(actor))
         renderer = vtkRenderer()
         renderer.AddActor(actor)
-        window = vtkRenderWindow()
-        window.SetOffScreenRendering(1)
-        window.AddRenderer(renderer)
+        window = offscreen_window(renderer)
         window.Render()
         actor.SetInputData(None)
         window.Render()
@@ -228,10 +200,7 @@ class LatticeWidgetTest(unittest.TestCase):
     def setUp(self):
         _, self.build, self.lattice = sphere_lattice()
         self.renderer = vtkRenderer()
-        self.window = vtkRenderWindow()
-        self.window.SetOffScreenRendering(1)
-        self.window.SetSize(400, 400)
-        self.window.AddRenderer(self.renderer)
+        self.window = offscreen_window(self.renderer, (400, 400))
         self.interactor = vtkRenderWindowInteractor()
         self.interactor.SetRenderWindow(self.window)
         self.interactor.SetInteractorStyle(vtkInteractorStyleTrackballCamera())

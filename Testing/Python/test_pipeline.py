@@ -15,34 +15,17 @@ import unittest
 import numpy as np
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkPoints
-from vtkmodules.vtkCommonDataModel import vtkPolyData, vtkStructuredGrid
+from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkCommonExecutionModel import vtkAlgorithm
-from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
 
 import vtkffd
-
-MESH_DIR = os.environ.get(
-    "VOXELFFD_MESH_DIR", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Data", "Meshes"))
+from ffdtesting import bbox_diagonal, build_lattice, catch_errors, points_of, read_mesh  # the same folder
 
 # Deformed points agree with the float64 reference within this fraction of the mesh's bounding-box diagonal:
 # both sides compute in double precision from the same input points, so the only differences
 # are rounding in evaluation orders that differ (de Casteljau and displacement form against binomials times
 # powers on absolute positions), a few 1e-16 relative per term.
 RELATIVE_TOLERANCE = 1e-9
-
-
-def read_mesh(name):
-    path = os.path.join(MESH_DIR, name + ".vtp")
-    if not os.path.isfile(path):
-        raise FileNotFoundError(path + " is missing: run Utilities/setup.sh, which fetches the meshes")
-    reader = vtkXMLPolyDataReader()
-    reader.SetFileName(path)
-    reader.Update()
-    return reader.GetOutput()
-
-
-def bbox_diagonal(points):
-    return float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
 
 
 def reference_deform(frame, divisions, control_points, x):
@@ -62,33 +45,15 @@ def reference_deform(frame, divisions, control_points, x):
     return np.einsum("pi,pj,pk,kjic->pc", bs, bt, bu, p)
 
 
-class ErrorCatcher:
-    """Collects the messages of ErrorEvents (and keeps expected errors out of the log)."""
-
-    def __init__(self):
-        self.CallDataType = "string0"
-        self.messages = []
-
-    def __call__(self, caller, event, message):
-        self.messages.append(message)
-
-
 class TestPipeline(unittest.TestCase):
     def setUp(self):
         self.mesh = read_mesh("elephant")
-        self.mesh_points = vtk_to_numpy(self.mesh.GetPoints().GetData()).astype(np.float64)
+        self.mesh_points = points_of(self.mesh)
         self.diagonal = bbox_diagonal(self.mesh_points)
 
-        self.voxelize = vtkffd.vtkFFDVoxelize()
-        self.voxelize.SetInputData(self.mesh)
-        self.voxelize.SetDivisions(2, 3, 4)
-        self.build = vtkffd.vtkFFDBuildLattice()
-        self.build.SetInputConnection(self.voxelize.GetOutputPort())
-        self.build.SetBasisToBernstein()
-        self.build.Update()
-        # The test owns a copy that it moves; the filters keep their own output.
-        self.lattice = vtkStructuredGrid()
-        self.lattice.DeepCopy(self.build.GetOutput())
+        # The test owns a copy of the lattice that it moves; the filters keep their own output.
+        self.voxelize, self.build, self.lattice = build_lattice(
+            self.mesh, (2, 3, 4), vtkffd.vtkFFDBuildLattice.BERNSTEIN)
 
         self.deform = vtkffd.vtkFFDDeform()
         self.deform.SetInputData(self.mesh)
@@ -169,14 +134,7 @@ class TestPipeline(unittest.TestCase):
         point_set = vtkPolyData()
         point_set.SetPoints(vtk_points)
 
-        voxelize = vtkffd.vtkFFDVoxelize()
-        voxelize.SetInputData(point_set)
-        voxelize.SetDivisions(3, 2, 2)
-        build = vtkffd.vtkFFDBuildLattice()
-        build.SetInputConnection(voxelize.GetOutputPort())
-        build.Update()
-        lattice = vtkStructuredGrid()
-        lattice.DeepCopy(build.GetOutput())
+        _, _, lattice = build_lattice(point_set, (3, 2, 2))
         matrix = np.eye(3) + rng.uniform(-0.3, 0.3, size=(3, 3))
         offset = rng.uniform(-1.0, 1.0, size=3)
         control = vtk_to_numpy(lattice.GetPoints().GetData())
@@ -194,19 +152,15 @@ class TestPipeline(unittest.TestCase):
 
     def test_lattice_without_rest_position_is_an_error(self):
         self.lattice.GetPointData().RemoveArray("RestPosition")
-        errors = ErrorCatcher()
-        self.deform.AddObserver("ErrorEvent", errors)
         # The executive reports the failed request too; catch it so the log shows only unexpected errors.
-        self.deform.GetExecutive().AddObserver("ErrorEvent", ErrorCatcher())
+        errors = catch_errors(self.deform, executive=True)
         self.deform.Update()
         self.assertTrue(any("RestPosition" in message for message in errors.messages), errors.messages)
         self.assertEqual(self.deform.GetOutput().GetNumberOfPoints(), 0)
 
     def expect_error(self, algorithm, needle):
         """Updates algorithm and asserts that it failed with an error containing needle and an empty output."""
-        errors = ErrorCatcher()
-        algorithm.AddObserver("ErrorEvent", errors)
-        algorithm.GetExecutive().AddObserver("ErrorEvent", ErrorCatcher())
+        errors = catch_errors(algorithm, executive=True)
         self.assertEqual(algorithm.GetExecutive().Update(), 0)
         self.assertTrue(any(needle in message for message in errors.messages), errors.messages)
         self.assertEqual(algorithm.GetOutputDataObject(0).GetNumberOfPoints(), 0)
@@ -307,19 +261,11 @@ class TestLocalBases(unittest.TestCase):
 
     def setUp(self):
         self.mesh = read_mesh("elephant")
-        self.mesh_points = vtk_to_numpy(self.mesh.GetPoints().GetData()).astype(np.float64)
+        self.mesh_points = points_of(self.mesh)
 
     def pipeline(self, basis):
         """Voxelize -> build the lattice of `basis` -> a copy the test moves -> deform."""
-        voxelize = vtkffd.vtkFFDVoxelize()
-        voxelize.SetInputData(self.mesh)
-        voxelize.SetDivisions(*self.DIVISIONS)
-        build = vtkffd.vtkFFDBuildLattice()
-        build.SetInputConnection(voxelize.GetOutputPort())
-        build.SetBasis(basis)
-        build.Update()
-        lattice = vtkStructuredGrid()
-        lattice.DeepCopy(build.GetOutput())
+        _, _, lattice = build_lattice(self.mesh, self.DIVISIONS, basis)
         deform = vtkffd.vtkFFDDeform()
         deform.SetInputData(self.mesh)
         deform.SetLatticeData(lattice)

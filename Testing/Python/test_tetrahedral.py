@@ -15,7 +15,7 @@ from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 from vtkmodules.vtkCommonDataModel import vtkUnstructuredGrid
 
 import vtkffd
-from test_pipeline import ErrorCatcher, read_mesh  # the same folder
+from ffdtesting import bbox_diagonal, catch_errors, points_of, read_mesh  # the same folder
 
 # Deformed points agree with the reference within this fraction of the mesh's bounding-box diagonal: both
 # compute in double precision; the filter folds the weights into one affine map per tetrahedron, the reference
@@ -76,11 +76,11 @@ class TetrahedralPipelineTest(unittest.TestCase):
         deform.Update()
         self.assertEqual(deform.GetLastBackendUsed(), "CPU")
         self.assertEqual(deform.GetNumberOfBindings(), 1)
-        points = vtk_to_numpy(self.mesh.GetPoints().GetData()).astype(np.float64)
+        points = points_of(self.mesh)
         got = vtk_to_numpy(deform.GetOutput().GetPoints().GetData())
         tetrahedra = vtk_to_numpy(lattice.GetCells().GetConnectivityArray()).reshape(-1, 4)
         expected = reference_deform(rest, moved, tetrahedra, points)
-        diagonal = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+        diagonal = bbox_diagonal(points)
         self.assertLess(float(np.abs(got - expected).max()), RELATIVE_TOLERANCE * diagonal)
         self.assertGreater(float(np.abs(got - points).max()), 0.01 * diagonal)
 
@@ -110,9 +110,7 @@ class TetrahedralPipelineTest(unittest.TestCase):
         hexahedra.GetPointData().AddArray(numpy_to_vtk(vtk_to_numpy(hexahedra.GetPoints().GetData()), deep=True))
         hexahedra.GetPointData().GetArray(0).SetName("RestPosition")
         deform = vtkffd.vtkFFDDeform()
-        catcher = ErrorCatcher()
-        deform.AddObserver("ErrorEvent", catcher)
-        deform.GetExecutive().AddObserver("ErrorEvent", ErrorCatcher())
+        catcher = catch_errors(deform, executive=True)
         deform.SetInputData(self.mesh)
         deform.SetLatticeData(hexahedra)
         deform.Update()
