@@ -22,8 +22,10 @@
 #include <array>
 #include <cmath>
 #include <initializer_list>
+#include <iomanip>
 #include <limits>
 #include <random>
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -181,6 +183,28 @@ inline double LatticeScale(const std::vector<ffdref::Vec>& points)
 inline double MaxDiff(const ffdref::Vec& a, const ffdref::Vec& b)
 {
   return MaxAbs(ffdref::Sub(a, b));
+}
+
+/**
+ * MaxDiff(got, want) <= tol, as ASSERT_LE compares (a NaN fails); records MaxDiff / tol in `worst`, if given. The
+ * message gives the difference, the tolerance and both vectors.
+ */
+inline ::testing::AssertionResult MaxDiffWithin(
+  const ffdref::Vec& got, const ffdref::Vec& want, double tol, WorstRatio* worst = nullptr)
+{
+  const double diff = MaxDiff(got, want);
+  if (worst)
+  {
+    worst->Add(diff, tol);
+  }
+  if (diff <= tol)
+  {
+    return ::testing::AssertionSuccess();
+  }
+  std::ostringstream s;
+  s << std::setprecision(17) << "max |got - want| = " << diff << " > " << tol << ", got (" << got[0] << ", "
+    << got[1] << ", " << got[2] << "), expected (" << want[0] << ", " << want[1] << ", " << want[2] << ")";
+  return ::testing::AssertionFailure() << s.str();
 }
 
 /// Evaluation tolerance relative to the lattice scale: 1e-12 in double, 1e-6 in float (the issues' targets).

@@ -227,8 +227,7 @@ TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
             const Vec xd = ffdtest::ToRef(x);
             const Vec want = ClampedReference(lat.Basis, lat, xd);
             const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
-            worst.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
-            ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
+            ASSERT_TRUE(ffdtest::MaxDiffWithin(ffdtest::ToRef(y), want, tol, &worst)) << where;
           }
         }
       }
@@ -398,7 +397,7 @@ TYPED_TEST(FFDGridLanesTest, JacobianAtEveryLevelMatchesReference)
           {
             ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
             ASSERT_EQ(determinants[i], Real(1)) << where;
-            ASSERT_LE(ffdtest::MaxDiff(gotNormal, n), 4.0 * ffdtest::Eps<Real>()) << where; // n renormalised
+            ASSERT_TRUE(ffdtest::MaxDiffWithin(gotNormal, n, 4.0 * ffdtest::Eps<Real>())) << where; // n renormalised
             continue;
           }
           const ffdtest::ReferenceJacobian ref =
@@ -409,8 +408,7 @@ TYPED_TEST(FFDGridLanesTest, JacobianAtEveryLevelMatchesReference)
           k.D.Deform(x, set.Cells[i], j);
           const Vec want = ClampedReference(lat.Basis, lat, xd);
           const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
-          worstPosition.Add(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol);
-          ASSERT_LE(ffdtest::MaxDiff(ffdtest::ToRef(y), want), tol) << where;
+          ASSERT_TRUE(ffdtest::MaxDiffWithin(ffdtest::ToRef(y), want, tol, &worstPosition)) << where;
 
           const double detBound = ffdtest::DeterminantErrorBound<Real>(ref.J, bound);
           const double detError = std::fabs(double(determinants[i]) - ffdtest::Determinant(ref.J));
@@ -421,8 +419,7 @@ TYPED_TEST(FFDGridLanesTest, JacobianAtEveryLevelMatchesReference)
           {
             const Vec wantNormal = ffdtest::Scaled(m, 1.0 / ffdtest::Norm(m));
             const double normalBound = ffdtest::NormalErrorBound<Real>(ref.J, bound, n);
-            worstNormal.Add(ffdtest::MaxDiff(gotNormal, wantNormal), normalBound);
-            ASSERT_LE(ffdtest::MaxDiff(gotNormal, wantNormal), normalBound) << where;
+            ASSERT_TRUE(ffdtest::MaxDiffWithin(gotNormal, wantNormal, normalBound, &worstNormal)) << where;
           }
         }
       }
