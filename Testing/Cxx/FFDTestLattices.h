@@ -17,6 +17,8 @@
 #include "vtkFFDVoxelize.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkPolyDataNormals.h"
 #include "vtkSmartPointer.h"
 #include "vtkStructuredGrid.h"
 
@@ -188,6 +190,16 @@ inline void Perturb(vtkPointSet* lattice, std::mt19937& rng, double amplitude)
     points->SetPoint(p, x[0] + d(rng), x[1] + d(rng), x[2] + d(rng));
   }
   points->Modified();
+}
+
+/// The mesh with point normals (vtkPolyDataNormals without splitting: the same points).
+inline vtkSmartPointer<vtkPolyData> WithPointNormals(vtkPolyData* mesh)
+{
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputData(mesh);
+  normals->SplittingOff();
+  normals->Update();
+  return normals->GetOutput();
 }
 
 // Every point of `got` equal to the same point of `want`, coordinate for coordinate (==, as ASSERT_EQ compares),

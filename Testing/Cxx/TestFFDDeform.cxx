@@ -19,7 +19,6 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
-#include "vtkPolyDataNormals.h"
 #include "vtkStructuredGrid.h"
 #include "vtkTransform.h"
 #include "vtkTransformFilter.h"
@@ -207,16 +206,6 @@ TEST(vtkFFDDeform, BindingIsCachedUntilPointsOrRestFrameChange)
 
 namespace
 {
-/// The mesh with point normals (vtkPolyDataNormals without splitting: the same points).
-vtkSmartPointer<vtkPolyData> WithPointNormals(vtkPolyData* mesh)
-{
-  vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputData(mesh);
-  normals->SplittingOff();
-  normals->Update();
-  return normals->GetOutput();
-}
-
 /// A TRILINEAR lattice over 3x3x3 voxels in the frame that vtkFFDVoxelize gives the mesh.
 vtkSmartPointer<vtkStructuredGrid> TrilinearLatticeAround(vtkPolyData* mesh)
 {
@@ -359,11 +348,7 @@ TEST(vtkFFDDeform, NormalsAndJacobianDeterminantMatchFiniteDifferences)
 {
   std::mt19937 rng(11);
   vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
-  vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputData(mesh);
-  normals->SplittingOff();
-  normals->Update();
-  vtkPolyData* withNormals = normals->GetOutput();
+  vtkSmartPointer<vtkPolyData> withNormals = WithPointNormals(mesh);
 
   Pipeline pipeline(withNormals, vtkFFDBuildLattice::BERNSTEIN, 3, 3, 3);
   Perturb(pipeline.Lattice, rng, 0.1 * Diagonal(FrameOf(pipeline.Lattice)));

@@ -20,7 +20,6 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
-#include "vtkPolyDataNormals.h"
 #include "vtkStructuredGrid.h"
 #include "vtkTransform.h"
 #include "vtkTransformFilter.h"
@@ -525,11 +524,7 @@ TEST(vtkFFDDeformLocal, NormalsAndJacobianDeterminantMatchFiniteDifferences)
 {
   std::mt19937 rng(31337);
   vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
-  vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputData(mesh);
-  normals->SplittingOff();
-  normals->Update();
-  vtkPolyData* withNormals = normals->GetOutput();
+  vtkSmartPointer<vtkPolyData> withNormals = WithPointNormals(mesh);
   vtkDataArray* inNormals = withNormals->GetPointData()->GetNormals();
   ASSERT_NE(inNormals, nullptr);
   const int n[3] = { 3, 4, 3 };

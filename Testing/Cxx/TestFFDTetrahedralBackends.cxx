@@ -15,7 +15,6 @@
 #include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
-#include "vtkPolyDataNormals.h"
 #include "vtkTransform.h"
 #include "vtkTransformFilter.h"
 #include "vtkUnstructuredGrid.h"
@@ -49,10 +48,7 @@ TEST(vtkFFDDeformTetrahedral, BackendChoiceAndCpuFallback)
 {
   std::mt19937 rng(23);
   vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("bear");
-  vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputData(mesh);
-  normals->SplittingOff(); // the same points as the mesh
-  normals->Update();
+  vtkSmartPointer<vtkPolyData> withNormals = ffdtest::WithPointNormals(mesh); // the same points as the mesh
 
   // The control mesh of the bear shrunk by 10 % about its centre: the points it leaves outside are clamped.
   double center[3];
@@ -74,7 +70,7 @@ TEST(vtkFFDDeformTetrahedral, BackendChoiceAndCpuFallback)
   Perturb(lattice, rng, 0.02 * diagonal);
 
   vtkNew<vtkFFDDeform> deform;
-  deform->SetInputData(normals->GetOutput());
+  deform->SetInputData(withNormals);
   deform->SetLatticeData(lattice);
   deform->SetOutsidePolicyToClampToEdge();
   deform->ComputeJacobianDeterminantOn();
