@@ -10,6 +10,7 @@
 #include "FFDReference.h"
 #include "FFDTestComparisons.h"
 
+#include "vtkAbstractTransform.h"
 #include "vtkDoubleArray.h"
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDataContract.h"
@@ -21,6 +22,7 @@
 #include "vtkPolyDataNormals.h"
 #include "vtkSmartPointer.h"
 #include "vtkStructuredGrid.h"
+#include "vtkTransformFilter.h"
 
 #include <gtest/gtest.h>
 
@@ -300,6 +302,28 @@ struct Pipeline
   vtkPointSet* Output() { return vtkPointSet::SafeDownCast(this->Deform->GetOutputDataObject(0)); }
   double Diagonal() { return ffdtest::Diagonal(FrameOf(this->Lattice)); }
 };
+
+// Moves the pipeline's lattice by `transform` through vtkTransformFilter (as any VTK filter could move it),
+// updates the deformation of `mesh` (the pipeline's input) and returns the largest distance between a deformed
+// point and the transform of its input point, over the frame's diagonal.
+inline double MaxRelativeErrorOfMovedLattice(Pipeline& pipeline, vtkPointSet* mesh, vtkAbstractTransform* transform)
+{
+  vtkNew<vtkTransformFilter> move;
+  move->SetInputData(pipeline.Lattice);
+  move->SetTransform(transform);
+  pipeline.Deform->SetLatticeConnection(move->GetOutputPort());
+  pipeline.Deform->Update();
+  double worst = 0.0;
+  for (vtkIdType i = 0; i < mesh->GetNumberOfPoints(); ++i)
+  {
+    double x[3], expected[3], y[3];
+    mesh->GetPoint(i, x);
+    transform->TransformPoint(x, expected);
+    pipeline.Output()->GetPoint(i, y);
+    worst = std::max(worst, std::hypot(y[0] - expected[0], y[1] - expected[1], y[2] - expected[2]));
+  }
+  return worst / pipeline.Diagonal();
+}
 
 } // namespace ffdtest
 

@@ -154,6 +154,13 @@ ffdtest::Mat CentralDifferences(const Vec& x, F&& f)
   return ffdtest::CentralDifferences(x, 1e-6, std::forward<F>(f));
 }
 
+/// The reference's Jacobian of the lattice's deformation at x: CentralDifferences() of ffdref::DeformLocal.
+ffdtest::Mat ReferenceJacobianAt(const GridLattice& lat, const Vec& x)
+{
+  return CentralDifferences(
+    x, [&](const Vec& y) { return ffdref::DeformLocal(lat.Basis, lat.F, lat.Divisions.data(), lat.Points, y); });
+}
+
 TYPED_TEST(FFDGridDeformationTest, JacobianMatchesCentralDifferences)
 {
   // Deform's Jacobian against central differences of ffdref::DeformLocal in world coordinates, at points at
@@ -172,8 +179,7 @@ TYPED_TEST(FFDGridDeformationTest, JacobianMatchesCentralDifferences)
         ASSERT_GE(cell, 0);
         ffd::Mat3<Real> j;
         k.D.Deform(x, cell, j);
-        const ffdtest::Mat fd = CentralDifferences(ffdtest::ToRef(x),
-          [&](const Vec& y) { return ffdref::DeformLocal(lat.Basis, lat.F, lat.Divisions.data(), lat.Points, y); });
+        const ffdtest::Mat fd = ReferenceJacobianAt(lat, ffdtest::ToRef(x));
         const double tol = GradientTolerance<Real>() * ffdtest::MaxAbsEntry(fd, 1.0);
         ASSERT_TRUE(ffdtest::MatrixNear(j, fd, tol, "J", &worst)) << lat.Name() << " point " << p;
       }
@@ -202,8 +208,7 @@ TYPED_TEST(FFDGridDeformationTest, TransformNormalMatchesDeformedTangents)
         ASSERT_GE(cell, 0);
         ffd::Mat3<Real> j;
         k.D.Deform(x, cell, j);
-        const ffdtest::Mat fd = CentralDifferences(ffdtest::ToRef(x),
-          [&](const Vec& y) { return ffdref::DeformLocal(lat.Basis, lat.F, lat.Divisions.data(), lat.Points, y); });
+        const ffdtest::Mat fd = ReferenceJacobianAt(lat, ffdtest::ToRef(x));
         const double jmax = ffdtest::MaxAbsEntry(fd, 1.0);
         const Vec t1 = ffdtest::RandomVec(rng, -1.0, 1.0), t2 = ffdtest::RandomVec(rng, -1.0, 1.0);
         const Vec n = ffdref::Cross(t1, t2);
