@@ -7,7 +7,9 @@
 #ifndef FFDTestErrorObserver_h
 #define FFDTestErrorObserver_h
 
+#include "vtkAlgorithm.h"
 #include "vtkCommand.h"
+#include "vtkExecutive.h"
 #include "vtkObject.h"
 
 #include <string>
@@ -22,6 +24,13 @@ public:
   {
     object->AddObserver(vtkCommand::ErrorEvent, this);
     object->AddObserver(vtkCommand::WarningEvent, this);
+  }
+
+  /// Observes errors and warnings of an algorithm and of its executive (which reports a failed request too).
+  void WatchWithExecutive(vtkAlgorithm* algorithm)
+  {
+    this->Watch(algorithm);
+    this->Watch(algorithm->GetExecutive());
   }
 
   void Execute(vtkObject*, unsigned long event, void* callData) override

@@ -87,8 +87,7 @@ vtkSmartPointer<vtkStructuredGrid> MakeVoxelGrid(
 
 int RunPipeline(vtkFFDBuildLattice* filter, FFDTestErrorObserver* observer)
 {
-  observer->Watch(filter);
-  observer->Watch(filter->GetExecutive());
+  observer->WatchWithExecutive(filter);
   return filter->GetExecutive()->Update();
 }
 
@@ -98,8 +97,7 @@ vtkStructuredGrid* Build(vtkFFDBuildLattice* filter, vtkDataObject* grid)
   vtkNew<FFDTestErrorObserver> observer;
   filter->SetInputData(grid);
   // The producer of `grid` complains when asked for an extent it does not hold.
-  observer->Watch(filter->GetInputAlgorithm());
-  observer->Watch(filter->GetInputAlgorithm()->GetExecutive());
+  observer->WatchWithExecutive(filter->GetInputAlgorithm());
   EXPECT_EQ(RunPipeline(filter, observer), 1) << observer->Errors;
   EXPECT_EQ(observer->Errors, "");
   return filter->GetOutput();

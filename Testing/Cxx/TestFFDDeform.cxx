@@ -554,8 +554,7 @@ TEST(vtkFFDDeform, BadLatticesAreRefusedWithAClearError)
     deform->SetInputData(mesh);
     deform->SetLatticeData(lattice);
     vtkNew<FFDTestErrorObserver> observer;
-    observer->Watch(deform);
-    observer->Watch(deform->GetExecutive());
+    observer->WatchWithExecutive(deform);
     deform->Update();
     EXPECT_NE(observer->Errors.find(c.Expected), std::string::npos)
       << c.Name << ": got \"" << observer->Errors << "\"";

@@ -584,8 +584,7 @@ TEST(vtkFFDDeformLocal, LatticeSizedForAnotherBasisIsRefused)
     deform->SetInputData(mesh);
     deform->SetLatticeData(lattice);
     vtkNew<FFDTestErrorObserver> observer;
-    observer->Watch(deform);
-    observer->Watch(deform->GetExecutive());
+    observer->WatchWithExecutive(deform);
     deform->Update();
     const long need =
       long(PointsAlongAxis(c[1], n[0])) * PointsAlongAxis(c[1], n[1]) * PointsAlongAxis(c[1], n[2]);

@@ -656,8 +656,7 @@ TEST(vtkFFDDeformTetrahedral, InconsistentLatticesAreErrors)
     c.Break(lattice);
     vtkNew<FFDTestErrorObserver> observer;
     vtkNew<vtkFFDDeform> deform;
-    observer->Watch(deform);
-    observer->Watch(deform->GetExecutive());
+    observer->WatchWithExecutive(deform);
     deform->SetInputData(mesh);
     deform->SetLatticeData(lattice);
     deform->Update();
@@ -677,8 +676,7 @@ TEST(vtkFFDDeformTetrahedral, IdsChangedAfterAnUpdateAreCheckedAgain)
     auto lattice = BoxLattice(2, 0.0, 1.0, 0.0, false, 1);
     vtkNew<vtkFFDDeform> deform;
     vtkNew<FFDTestErrorObserver> observer;
-    observer->Watch(deform);
-    observer->Watch(deform->GetExecutive());
+    observer->WatchWithExecutive(deform);
     deform->SetInputData(mesh);
     deform->SetLatticeData(lattice);
     deform->Update();
@@ -715,8 +713,7 @@ TEST(vtkFFDDeformTetrahedral, ExtrapolateNeedsATetrahedralLattice)
   build->SetBasisToTrilinear();
   vtkNew<FFDTestErrorObserver> observer;
   vtkNew<vtkFFDDeform> deform;
-  observer->Watch(deform);
-  observer->Watch(deform->GetExecutive());
+  observer->WatchWithExecutive(deform);
   deform->SetInputData(mesh);
   deform->SetLatticeConnection(build->GetOutputPort());
   deform->SetOutsidePolicyToExtrapolate();
@@ -894,8 +891,7 @@ TEST(vtkFFDBuildTetrahedralLattice, SubdivisionsBeyondWhatALatticeHoldsAreErrors
   mesh->SetPoints(points);
   vtkNew<vtkFFDBuildTetrahedralLattice> build;
   vtkNew<FFDTestErrorObserver> observer;
-  observer->Watch(build);
-  observer->Watch(build->GetExecutive());
+  observer->WatchWithExecutive(build);
   build->SetInputData(mesh);
   build->SetSubdivisionLevels(12); // clamped to 5
   EXPECT_EQ(build->GetSubdivisionLevels(), 5);
@@ -921,8 +917,7 @@ TEST(vtkFFDBuildTetrahedralLattice, FlatOrTooFewPointsAreErrors)
     mesh->SetPoints(points);
     vtkNew<vtkFFDBuildTetrahedralLattice> build;
     vtkNew<FFDTestErrorObserver> observer;
-    observer->Watch(build);
-    observer->Watch(build->GetExecutive());
+    observer->WatchWithExecutive(build);
     build->SetInputData(mesh);
     build->Update();
     EXPECT_NE(observer->Errors.find(count < 4 ? "needs at least 4" : "coplanar"), std::string::npos)

@@ -121,8 +121,7 @@ std::set<Voxel> ShownVoxels(vtkStructuredGrid* grid, const int n[3])
 /// Runs the filter's pipeline; returns the executive's result with errors captured in `observer`.
 int RunPipeline(vtkFFDVoxelize* filter, FFDTestErrorObserver* observer)
 {
-  observer->Watch(filter);
-  observer->Watch(filter->GetExecutive());
+  observer->WatchWithExecutive(filter);
   return filter->GetExecutive()->Update();
 }
 
