@@ -15,7 +15,6 @@ namespace
 using ffdref::Vec;
 using ffdtest::DualNorm;
 using ffdtest::Eps;
-using ffdtest::MaxAbs;
 using ffdtest::Norm;
 using ffdtest::WorldScale;
 

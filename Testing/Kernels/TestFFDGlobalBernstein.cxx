@@ -27,7 +27,6 @@ using ffdtest::Eps;
 using ffdtest::EvaluationTolerance;
 using ffdtest::GradientTolerance;
 using ffdtest::MaxAbs;
-using ffdtest::MaxDiff;
 using ffdtest::WorstRatio;
 
 // Equation 3 through the kernels: the global basis is one cell of degree dims - 1 per axis.

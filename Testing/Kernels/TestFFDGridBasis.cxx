@@ -28,7 +28,6 @@ using ffdtest::Eps;
 using ffdtest::EvaluationTolerance;
 using ffdtest::GradientTolerance;
 using ffdtest::GridLattice;
-using ffdtest::MaxAbs;
 using ffdtest::MaxDiff;
 using ffdtest::WorstRatio;
 

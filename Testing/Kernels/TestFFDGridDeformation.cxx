@@ -29,7 +29,6 @@ using ffdtest::EvaluationTolerance;
 using ffdtest::GradientTolerance;
 using ffdtest::GridLattice;
 using ffdtest::MaxAbs;
-using ffdtest::MaxDiff;
 using ffdtest::WorstRatio;
 using ffdtest::PositionTolerance;
 using ffdtest::WithKernel;

@@ -81,6 +81,14 @@ def catch_errors(obj, executive=False):
     return catcher
 
 
+def run_with_errors(algorithm, data):
+    """Runs `algorithm` on `data` (SetInputData, Update) with its errors caught; returns their messages."""
+    algorithm.SetInputData(data)
+    catcher = catch_errors(algorithm)
+    algorithm.Update()
+    return catcher.messages
+
+
 def offscreen_window(renderer, size=None, multisamples=None):
     """An off-screen vtkRenderWindow showing `renderer`, of `size` (width, height) and `multisamples` where given
     (0 for the image tests: multisampling differs between GL drivers)."""

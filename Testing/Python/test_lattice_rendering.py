@@ -18,7 +18,7 @@ from vtkmodules.vtkRenderingCore import vtkInteractorObserver, vtkRenderer, vtkR
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
 
 import vtkffd
-from ffdtesting import build_lattice, catch_errors, offscreen_window  # the same folder
+from ffdtesting import build_lattice, catch_errors, offscreen_window, run_with_errors  # the same folder
 
 
 def cube_tetrahedra():
@@ -168,10 +168,8 @@ class LatticeActorTest(unittest.TestCase):
         bad.SetName("RestPosition")
         grid.GetPointData().AddArray(bad)
         control = vtkffd.vtkFFDControlPoints()
-        control.SetInputData(grid)
-        errors = catch_errors(control)
-        control.Update()
-        self.assertTrue(any("RestPosition" in m for m in errors.messages), errors.messages)
+        errors = run_with_errors(control, grid)
+        self.assertTrue(any("RestPosition" in m for m in errors), errors)
         self.assertEqual(control.GetOutput().GetNumberOfPoints(), 0)
 
     def test_cell_naming_a_missing_point_is_an_error(self):
@@ -179,10 +177,8 @@ class LatticeActorTest(unittest.TestCase):
         grid = cube_tetrahedra()
         grid.GetCells().ReplaceCellAtId(1, 4, [0, 1, 100000, 3])
         edges = vtkffd.vtkFFDCellEdges()
-        edges.SetInputData(grid)
-        errors = catch_errors(edges)
-        edges.Update()
-        self.assertTrue(any("names point 100000" in m for m in errors.messages), errors.messages)
+        errors = run_with_errors(edges, grid)
+        self.assertTrue(any("names point 100000" in m for m in errors), errors)
         self.assertEqual(edges.GetOutput().GetNumberOfLines(), 0)
 
     def test_no_input_renders_nothing_and_does_not_fail(self):
