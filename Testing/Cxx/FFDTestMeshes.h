@@ -13,10 +13,12 @@
 #include "vtkSmartPointer.h"
 #include "vtkXMLPolyDataReader.h"
 
+#include <array>
 #include <fstream>
 #include <iostream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 /// The mesh `name` (e.g. "bear"); throws with a hint when the set-up has not fetched it.
 inline vtkSmartPointer<vtkPolyData> ReadTestMesh(const std::string& name)
@@ -50,6 +52,20 @@ inline vtkSmartPointer<vtkPolyData> ReadTestMeshOrReport(const std::string& name
     std::cerr << e.what() << "\n";
     return nullptr;
   }
+}
+
+/// A point set of the given points (double precision), without cells.
+inline vtkSmartPointer<vtkPolyData> PointCloud(const std::vector<std::array<double, 3>>& xs)
+{
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  for (const std::array<double, 3>& x : xs)
+  {
+    points->InsertNextPoint(x.data());
+  }
+  auto cloud = vtkSmartPointer<vtkPolyData>::New();
+  cloud->SetPoints(points);
+  return cloud;
 }
 
 /// A copy of `mesh` (cells and arrays shared) whose points are stored as float: the float path of the filters.

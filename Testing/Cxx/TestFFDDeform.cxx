@@ -382,14 +382,7 @@ TEST(vtkFFDDeform, OutsidePointsStayAndBoundaryPointsDeform)
   };
   const std::vector<Vec> inputs = { at(0, 0, 0), at(1, 1, 1), at(1, 0, 1), at(0.5, 1, 0.3), at(0.2, 0.7, 0),
     at(-0.01, 0.5, 0.5), at(0.5, 1.02, 0.5), at(3, 3, 3) };
-  vtkNew<vtkPolyData> mesh;
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  for (const Vec& x : inputs)
-  {
-    points->InsertNextPoint(x.data());
-  }
-  mesh->SetPoints(points);
+  vtkSmartPointer<vtkPolyData> mesh = PointCloud(inputs);
 
   vtkNew<vtkFFDDeform> deform;
   deform->SetInputData(mesh);

@@ -429,14 +429,7 @@ TEST(vtkFFDDeformLocal, OutsidePolicyForEveryBasis)
   all.insert(all.end(), inside.begin(), inside.end());
   all.insert(all.end(), outside.begin(), outside.end());
   const size_t firstOutside = boundary.size() + inside.size();
-  vtkNew<vtkPolyData> mesh;
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  for (const Vec& x : all)
-  {
-    points->InsertNextPoint(x.data());
-  }
-  mesh->SetPoints(points);
+  vtkSmartPointer<vtkPolyData> mesh = PointCloud(all);
 
   for (int basis : AllBases)
   {

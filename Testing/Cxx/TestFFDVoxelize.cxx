@@ -38,19 +38,6 @@ namespace
 using Voxel = std::array<int, 3>;
 using ffdref::Vec;
 
-vtkSmartPointer<vtkPolyData> PointCloud(const std::vector<Vec>& xs)
-{
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  for (const Vec& x : xs)
-  {
-    points->InsertNextPoint(x.data());
-  }
-  auto cloud = vtkSmartPointer<vtkPolyData>::New();
-  cloud->SetPoints(points);
-  return cloud;
-}
-
 std::vector<Vec> PointsOf(vtkPointSet* data)
 {
   std::vector<Vec> xs(data->GetNumberOfPoints());
