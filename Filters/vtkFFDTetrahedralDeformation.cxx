@@ -521,7 +521,7 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
       continue;
     }
     double x[3], closest[3], dist2;
-    vtkIdType tetrahedron;
+    vtkIdType tetrahedron = -1; // VTK leaves it as is where no tetrahedron gives a distance (none has volume)
     int subId;
     points->GetPoint(id, x);
     buildLocator();

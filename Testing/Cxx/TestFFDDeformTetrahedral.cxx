@@ -545,6 +545,50 @@ TEST(vtkFFDDeformTetrahedral, DegenerateTetrahedraAreReportedAndSkipped)
   EXPECT_EQ(deform->GetNumberOfBindings(), 1);
 }
 
+// A lattice whose tetrahedra all lack volume binds no point: under every outside policy each point keeps its
+// position, also a non-finite one (VTK's locator finds no nearest tetrahedron: each reports a numerical error).
+TEST(vtkFFDDeformTetrahedral, LatticesWithoutVolumeKeepEveryPoint)
+{
+  auto box = BoxLattice(2, 0.0, 1.0, 0.0, false, 31);
+  vtkNew<vtkUnstructuredGrid> lattice;
+  lattice->SetPoints(box->GetPoints());
+  lattice->GetPointData()->ShallowCopy(box->GetPointData());
+  const vtkIdType repeated[4] = { 0, 1, 1, 4 };
+  const vtkIdType flat[4] = { 0, 1, 3, 4 };
+  lattice->Allocate(2);
+  lattice->InsertNextCell(VTK_TETRA, 4, repeated);
+  lattice->InsertNextCell(VTK_TETRA, 4, flat);
+  DisplaceNodes(lattice, 0.1, 47);
+  auto mesh = RandomPoints(200, -0.5, 1.5, VTK_DOUBLE, 53);
+  mesh->GetPoints()->InsertNextPoint(std::numeric_limits<double>::quiet_NaN(), 0.5, 0.5);
+  for (const int policy :
+    { vtkFFDDeform::KEEP_POSITION, vtkFFDDeform::CLAMP_TO_EDGE, vtkFFDDeform::EXTRAPOLATE })
+  {
+    SCOPED_TRACE("outside policy " + std::to_string(policy));
+    vtkNew<FFDTestErrorObserver> observer;
+    vtkNew<vtkFFDDeform> deform;
+    observer->Watch(deform);
+    deform->SetInputData(mesh);
+    deform->SetLatticeData(lattice);
+    deform->SetOutsidePolicy(policy);
+    deform->SetBackendToCPU();
+    deform->Update();
+    EXPECT_NE(observer->Warnings.find("2 of 2 tetrahedra of the lattice have no volume"), std::string::npos)
+      << observer->Warnings;
+    EXPECT_TRUE(observer->Errors.empty()) << observer->Errors;
+    vtkPoints* output = deform->GetOutput()->GetPoints();
+    ASSERT_EQ(output->GetNumberOfPoints(), mesh->GetNumberOfPoints());
+    for (vtkIdType i = 0; i < mesh->GetNumberOfPoints(); ++i)
+    {
+      const Vec x = Point(mesh->GetPoints(), i), y = Point(output, i);
+      for (int c = 0; c < 3; ++c)
+      {
+        EXPECT_TRUE(y[c] == x[c] || (std::isnan(y[c]) && std::isnan(x[c]))) << "point " << i;
+      }
+    }
+  }
+}
+
 // The binding is cached while only node positions change (also through a rebuilt but equal lattice), and
 // recomputed when the rest shape, the points or the outside policy change.
 TEST(vtkFFDDeformTetrahedral, BindingIsCachedAcrossNodeMoves)
