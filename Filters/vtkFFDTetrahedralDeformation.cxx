@@ -5,6 +5,7 @@
 #include "vtkFFDDeformPoints.h"
 #include "vtkFFDForInChunks.h"
 #include "vtkFFDLatticeDisplacements.h"
+#include "vtkFFDTetrahedronLocator.h"
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkArrayDispatch.h"
@@ -13,27 +14,17 @@
 #include "vtkDataArray.h"
 #include "vtkDataArrayRange.h"
 #include "vtkFieldData.h"
-#include "vtkGenericCell.h"
-#include "vtkIdList.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
-#include "vtkSMPThreadLocalObject.h"
 #include "vtkSMPTools.h"
-#include "vtkStaticCellLocator.h"
 #include "vtkUnstructuredGrid.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <limits>
 #include <sstream>
 
 namespace
 {
-// Weight units by which a point may lie outside its tetrahedron and still count as inside: the band that
-// absorbs rounding on faces, as ffd::ParametricTolerance() does for grid frames.
-constexpr double InsideTolerance = 1e-10;
-
 // Marks points that lie outside every tetrahedron until the outside policy decides, and points the walk
 // could not place (binding only).
 constexpr int Outside = -2;
@@ -44,76 +35,11 @@ bool IsFinite(const double x[3])
   return std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
 }
 
-//------------------------------------------------------------------------------------------------------------
-// Locating points in the rest tetrahedra: a walk through face neighbours from a nearby seed does most of the
-// work; VTK's vtkStaticCellLocator is the authority where the walk stops without an answer.
-struct Walker
-{
-  const std::vector<ffd::Frame<double>>& Frames;
-  const std::vector<unsigned char>& Degenerate;
-  const std::vector<int>& Neighbours; // 4 per tetrahedron: across the face opposite node i, -1 on the boundary
-
-  // Steps after which a walk gives up (it may cycle in a mesh that is not Delaunay); the locator takes over.
-  static constexpr int MaxSteps = 256;
-
-  /**
-   * The tetrahedron holding x (its smallest weight >= -InsideTolerance) reached from `start` by stepping across
-   * the face opposite the most negative weight, or -1 when the walk leaves the mesh, meets a tetrahedron without
-   * volume or runs too long; `last` is the last tetrahedron it visited.
-   */
-  int Walk(int start, const ffd::Vec3<double>& x, int& last) const
-  {
-    int t = start;
-    for (int step = 0; step < MaxSteps && t >= 0; ++step)
-    {
-      last = t;
-      if (this->Degenerate[t])
-      {
-        return -1;
-      }
-      const ffd::Vec3<double> stu = this->Frames[t].ToParametric(x);
-      const double w[4] = { 1.0 - stu.x - stu.y - stu.z, stu.x, stu.y, stu.z };
-      int k = 0;
-      for (int i = 1; i < 4; ++i)
-      {
-        k = w[i] < w[k] ? i : k;
-      }
-      if (w[k] >= -InsideTolerance)
-      {
-        return t;
-      }
-      t = this->Neighbours[4 * t + k];
-    }
-    return -1;
-  }
-};
-
-// A uniform grid over the rest nodes' bounds whose cells remember a tetrahedron near their centre, where walks
-// start.
-struct Seeds
-{
-  double Origin[3], Spacing[3];
-  int Size = 1;
-  std::vector<int> Tetrahedra;
-
-  int Of(const double x[3]) const
-  {
-    int index = 0;
-    for (int a = 2; a >= 0; --a)
-    {
-      const double c = std::floor((x[a] - this->Origin[a]) / this->Spacing[a]);
-      index = index * this->Size + static_cast<int>(std::min(std::max(c, 0.0), double(this->Size - 1)));
-    }
-    return this->Tetrahedra[index];
-  }
-};
-
 // Walks every point from its seed to its tetrahedron; points the walk leaves undecided go to LocateFunctor.
 struct WalkFunctor
 {
   vtkPoints* Points;
-  const Walker& Walk;
-  const Seeds& Starts;
+  const vtkFFDTetrahedronLocator& Locator;
   int* Cells;
 
   void operator()(vtkIdType begin, vtkIdType end) const
@@ -127,155 +53,32 @@ struct WalkFunctor
         this->Cells[id] = -1;
         continue;
       }
-      int last;
-      const int walked = this->Walk.Walk(this->Starts.Of(x), ffd::Vec3<double>::From(x), last);
+      const int walked = this->Locator.Walk(x);
       this->Cells[id] = walked >= 0 ? walked : Undecided;
     }
   }
 };
 
-// Locates the points the walks left undecided with VTK's locator: it proposes a tetrahedron (its own inside
-// test has a looser tolerance) that the weights of equation 5 confirm, and failing that, every tetrahedron of
-// the point's locator bin is tested and the one the point lies deepest in wins.
+// Places the points the walks left undecided by VTK's locator, or marks them Outside.
 struct LocateFunctor
 {
   vtkPoints* Points;
-  vtkStaticCellLocator* Locator;
-  const std::vector<ffd::Frame<double>>& Frames;
-  const std::vector<unsigned char>& Degenerate;
+  const vtkFFDTetrahedronLocator& Locator;
   const std::vector<vtkIdType>& Undecided;
   int* Cells;
-  vtkSMPThreadLocalObject<vtkGenericCell> Cell;
-  vtkSMPThreadLocalObject<vtkIdList> Candidates;
 
-  void Initialize() {}
-
-  double Margin(vtkIdType tetrahedron, const double x[3]) const
+  void operator()(vtkIdType begin, vtkIdType end) const
   {
-    return this->Degenerate[tetrahedron]
-      ? -std::numeric_limits<double>::infinity()
-      : ffd::InsideMargin(this->Frames[tetrahedron].ToParametric(ffd::Vec3<double>::From(x)));
-  }
-
-  void operator()(vtkIdType begin, vtkIdType end)
-  {
-    vtkGenericCell* cell = this->Cell.Local();
-    vtkIdList* candidates = this->Candidates.Local();
     for (vtkIdType u = begin; u < end; ++u)
     {
       const vtkIdType id = this->Undecided[u];
-      double x[3], pcoords[3], weights[4];
+      double x[3];
       this->Points->GetPoint(id, x);
-      const vtkIdType proposed = this->Locator->FindCell(x, 0.0, cell, pcoords, weights);
-      if (proposed >= 0 && this->Margin(proposed, x) >= 0.0)
-      {
-        this->Cells[id] = static_cast<int>(proposed);
-        continue;
-      }
-      double bounds[6] = { x[0], x[0], x[1], x[1], x[2], x[2] };
-      this->Locator->FindCellsWithinBounds(bounds, candidates);
-      vtkIdType best = -1;
-      double bestMargin = -std::numeric_limits<double>::infinity();
-      for (vtkIdType c = 0; c < candidates->GetNumberOfIds(); ++c)
-      {
-        const double margin = this->Margin(candidates->GetId(c), x);
-        if (margin > bestMargin)
-        {
-          bestMargin = margin;
-          best = candidates->GetId(c);
-        }
-      }
-      this->Cells[id] = bestMargin >= -InsideTolerance ? static_cast<int>(best) : Outside;
+      const int found = this->Locator.FindTetrahedron(x);
+      this->Cells[id] = found >= 0 ? found : Outside;
     }
   }
-
-  void Reduce() {}
 };
-
-// The face neighbours of every tetrahedron (4 per tetrahedron, across the face opposite node i; -1 on the
-// boundary), by sorting the faces.
-std::vector<int> FaceNeighbours(const std::vector<vtkIdType>& nodes)
-{
-  struct Face
-  {
-    std::array<vtkIdType, 3> Nodes;
-    int Side; // 4 * tetrahedron + the opposite node
-    bool operator<(const Face& o) const { return this->Nodes < o.Nodes; }
-  };
-  const int numberOfTetrahedra = static_cast<int>(nodes.size() / 4);
-  std::vector<Face> faces;
-  faces.reserve(4 * numberOfTetrahedra);
-  for (int t = 0; t < numberOfTetrahedra; ++t)
-  {
-    for (int i = 0; i < 4; ++i)
-    {
-      Face face{ {}, 4 * t + i };
-      for (int k = 0, n = 0; k < 4; ++k)
-      {
-        if (k != i)
-        {
-          face.Nodes[n++] = nodes[4 * t + k];
-        }
-      }
-      std::sort(face.Nodes.begin(), face.Nodes.end());
-      faces.push_back(face);
-    }
-  }
-  vtkSMPTools::Sort(faces.begin(), faces.end());
-  std::vector<int> neighbours(4 * numberOfTetrahedra, -1);
-  for (size_t f = 0; f + 1 < faces.size(); ++f)
-  {
-    if (faces[f].Nodes == faces[f + 1].Nodes)
-    {
-      neighbours[faces[f].Side] = faces[f + 1].Side / 4;
-      neighbours[faces[f + 1].Side] = faces[f].Side / 4;
-      ++f;
-    }
-  }
-  return neighbours;
-}
-
-// Seeds for the walks: about 8 tetrahedra per grid cell, each cell's tetrahedron found by a walk from its
-// neighbour's (or, outside the mesh, the boundary tetrahedron where that walk stopped).
-Seeds MakeSeeds(const std::vector<double>& rest, const Walker& walk)
-{
-  Seeds seeds;
-  double lo[3] = { rest[0], rest[1], rest[2] }, hi[3] = { rest[0], rest[1], rest[2] };
-  for (size_t i = 0; i < rest.size(); i += 3)
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      lo[a] = std::min(lo[a], rest[i + a]);
-      hi[a] = std::max(hi[a], rest[i + a]);
-    }
-  }
-  const double cells = static_cast<double>(walk.Frames.size()) / 8.0;
-  seeds.Size = std::max(1, std::min(64, static_cast<int>(std::cbrt(cells))));
-  for (int a = 0; a < 3; ++a)
-  {
-    seeds.Origin[a] = lo[a];
-    seeds.Spacing[a] = std::max(hi[a] - lo[a], std::numeric_limits<double>::min()) / seeds.Size;
-  }
-  seeds.Tetrahedra.resize(static_cast<size_t>(seeds.Size) * seeds.Size * seeds.Size);
-  int previous = static_cast<int>(
-    std::find(walk.Degenerate.begin(), walk.Degenerate.end(), 0) - walk.Degenerate.begin());
-  for (int k = 0, index = 0; k < seeds.Size; ++k)
-  {
-    for (int j = 0; j < seeds.Size; ++j)
-    {
-      for (int i = 0; i < seeds.Size; ++i, ++index)
-      {
-        const ffd::Vec3<double> centre = { seeds.Origin[0] + (i + 0.5) * seeds.Spacing[0],
-          seeds.Origin[1] + (j + 0.5) * seeds.Spacing[1], seeds.Origin[2] + (k + 0.5) * seeds.Spacing[2] };
-        int last = previous;
-        const int found = walk.Walk(previous, centre, last);
-        previous = found >= 0 ? found : (walk.Degenerate[last] ? previous : last);
-        seeds.Tetrahedra[index] = previous;
-      }
-    }
-  }
-  return seeds;
-}
 
 //------------------------------------------------------------------------------------------------------------
 template <typename Real>
@@ -447,28 +250,8 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
   const auto first = std::find(this->Degenerate.begin(), this->Degenerate.end(), 1);
   this->FirstDegenerate = first == this->Degenerate.end() ? -1 : first - this->Degenerate.begin();
 
-  // VTK's locators over the rest tetrahedra, built only when a walk leaves a point undecided or the outside
-  // policy needs nearest points.
-  vtkNew<vtkPoints> restPoints;
-  // vtkPoints::SetData() may rename or otherwise touch the array it is given: give it a copy that shares the
-  // lattice's memory, so the user's RestPosition keeps its modification time.
-  const auto restCopy = vtk::TakeSmartPointer(this->RestPositions->NewInstance());
-  restCopy->ShallowCopy(this->RestPositions);
-  restPoints->SetData(restCopy);
-  vtkNew<vtkUnstructuredGrid> rest;
-  rest->SetPoints(restPoints);
-  rest->SetCells(this->Lattice->GetCellTypesArray(), this->Lattice->GetCells());
-  vtkNew<vtkStaticCellLocator> locator;
-  auto buildLocator = [&]() {
-    if (!locator->GetDataSet())
-    {
-      locator->SetDataSet(rest);
-      locator->BuildLocator();
-      vtkNew<vtkGenericCell> warmUp;
-      rest->GetCell(0, warmUp); // the first GetCell() is not thread-safe (vtkDataSet)
-    }
-  };
-
+  vtkFFDTetrahedronLocator locator(
+    this->Frames, this->Degenerate, this->Nodes, this->RestValues, this->Lattice, this->RestPositions);
   const vtkIdType numberOfPoints = points->GetNumberOfPoints();
   this->Cells.resize(numberOfPoints);
   if (this->NumberOfDegenerate == numberOfTetrahedra)
@@ -477,10 +260,7 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
   }
   else
   {
-    this->Neighbours = FaceNeighbours(this->Nodes);
-    const Walker walker{ this->Frames, this->Degenerate, this->Neighbours };
-    const Seeds seeds = MakeSeeds(this->RestValues, walker);
-    WalkFunctor walk{ points, walker, seeds, this->Cells.data() };
+    WalkFunctor walk{ points, locator, this->Cells.data() };
     const double middle = progressBegin + 0.8 * (progressEnd - progressBegin);
     if (!vtkFFDForInChunks(self, numberOfPoints, 1024, walk, progressBegin, middle))
     {
@@ -497,8 +277,8 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
   }
   if (!undecided.empty())
   {
-    buildLocator();
-    LocateFunctor locate{ points, locator, this->Frames, this->Degenerate, undecided, this->Cells.data(), {}, {} };
+    locator.BuildCellLocator();
+    LocateFunctor locate{ points, locator, undecided, this->Cells.data() };
     if (!vtkFFDForInChunks(self, static_cast<vtkIdType>(undecided.size()), 256, locate,
           progressBegin + 0.8 * (progressEnd - progressBegin), progressEnd))
     {
@@ -508,7 +288,6 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
 
   // The outside policy, for the (usually few) points outside every tetrahedron.
   this->Clamped.clear();
-  vtkNew<vtkGenericCell> cell;
   for (vtkIdType id = 0; id < numberOfPoints; ++id)
   {
     if (this->Cells[id] != Outside)
@@ -520,25 +299,23 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
     {
       continue;
     }
-    double x[3], closest[3], dist2;
-    vtkIdType tetrahedron = -1; // VTK leaves it as is where no tetrahedron gives a distance (none has volume)
-    int subId;
+    double x[3], closest[3];
     points->GetPoint(id, x);
-    buildLocator();
-    locator->FindClosestPoint(x, closest, cell, tetrahedron, subId, dist2);
+    locator.BuildCellLocator();
+    const int tetrahedron = locator.FindClosestTetrahedron(x, closest);
     if (tetrahedron < 0 || this->Degenerate[tetrahedron])
     {
       continue; // its nearest tetrahedron has no map: it keeps its position
     }
     if (outsidePolicy == EXTRAPOLATE)
     {
-      this->Cells[id] = static_cast<int>(tetrahedron);
+      this->Cells[id] = tetrahedron;
       continue;
     }
     const ffd::Frame<double>& frame = this->Frames[tetrahedron];
     const ffd::Vec3<double> c = ffd::Vec3<double>::From(closest);
-    this->Clamped.push_back({ id, static_cast<int>(tetrahedron), c,
-      ffd::ClosestPointGradient(frame, frame.ToParametric(c), 1e-9) });
+    this->Clamped.push_back(
+      { id, tetrahedron, c, ffd::ClosestPointGradient(frame, frame.ToParametric(c), 1e-9) });
   }
   std::vector<unsigned char> used(numberOfTetrahedra, 0);
   for (const int tetrahedron : this->Cells)

@@ -8,14 +8,12 @@
  * point) and without the grid lattices' `FFDFrame`; its deformation is its points minus `RestPosition`.
  *
  * Binding, once per input points and lattice rest shape (ffd::TetrahedronFrame, Filters/Kernels/FFDTetrahedra.h):
- * every point is located in the rest tetrahedra by the weights of equation 5, walking across faces from a seed
- * of a coarse grid towards the face of the most negative weight; where a walk gives no answer (it left a
- * non-convex mesh, met a tetrahedron without volume, or cycled), VTK's vtkStaticCellLocator decides. VTK's
- * locator alone tests each candidate through vtkCell::EvaluatePosition, 10 times slower here on the long
- * tetrahedra of a hull's fan, whose bounds overlap by the hundreds. It stores one int
- * per point, the tetrahedron, or -1 for a point that keeps its position; it is kept while the points (their
- * vtkPoints, its modification time and count), the rest tetrahedra (by value) and the policy stay the same. Tetrahedra without volume
- * (ffd::CheckTetrahedron) are never bound to: points in them fall to a neighbour or to the outside policy.
+ * every point is located in the rest tetrahedra by the weights of equation 5 (vtkFFDTetrahedronLocator: a walk
+ * across faces from a seed, VTK's vtkStaticCellLocator where a walk gives no answer). It stores one int per
+ * point, the tetrahedron, or -1 for a point that keeps its position; it is kept while the points (their
+ * vtkPoints, its modification time and count), the rest tetrahedra (by value) and the policy stay the same.
+ * Tetrahedra without volume (ffd::CheckTetrahedron) are never bound to: points in them fall to a neighbour or to
+ * the outside policy.
  * Points outside every tetrahedron keep their position (KEEP_POSITION), take the displacement of the nearest
  * point of the control mesh (CLAMP_TO_EDGE, as grid lattices do), or follow the affine map of the nearest
  * tetrahedron (EXTRAPOLATE). Non-finite points always keep theirs.
@@ -45,7 +43,6 @@ class vtkAlgorithm;
 class vtkDataArray;
 class vtkDataObject;
 class vtkPoints;
-class vtkStaticCellLocator;
 class vtkUnstructuredGrid;
 
 class vtkFFDTetrahedralDeformation
@@ -169,7 +166,6 @@ private:
   vtkTimeStamp BindTime;
   std::vector<ffd::Frame<double>> Frames; // rest frame per tetrahedron
   std::vector<unsigned char> Degenerate;  // 1 per tetrahedron without volume
-  std::vector<int> Neighbours;            // 4 per tetrahedron: across the face opposite each node, or -1
   vtkIdType NumberOfDegenerate = 0;
   vtkIdType FirstDegenerate = -1;
   std::vector<int> Cells;
