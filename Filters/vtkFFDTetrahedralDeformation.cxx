@@ -35,51 +35,6 @@ bool IsFinite(const double x[3])
   return std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
 }
 
-// Walks every point from its seed to its tetrahedron; points the walk leaves undecided go to LocateFunctor.
-struct WalkFunctor
-{
-  vtkPoints* Points;
-  const vtkFFDTetrahedronLocator& Locator;
-  int* Cells;
-
-  void operator()(vtkIdType begin, vtkIdType end) const
-  {
-    for (vtkIdType id = begin; id < end; ++id)
-    {
-      double x[3];
-      this->Points->GetPoint(id, x);
-      if (!IsFinite(x))
-      {
-        this->Cells[id] = -1;
-        continue;
-      }
-      const int walked = this->Locator.Walk(x);
-      this->Cells[id] = walked >= 0 ? walked : Undecided;
-    }
-  }
-};
-
-// Places the points the walks left undecided by VTK's locator, or marks them Outside.
-struct LocateFunctor
-{
-  vtkPoints* Points;
-  const vtkFFDTetrahedronLocator& Locator;
-  const std::vector<vtkIdType>& Undecided;
-  int* Cells;
-
-  void operator()(vtkIdType begin, vtkIdType end) const
-  {
-    for (vtkIdType u = begin; u < end; ++u)
-    {
-      const vtkIdType id = this->Undecided[u];
-      double x[3];
-      this->Points->GetPoint(id, x);
-      const int found = this->Locator.FindTetrahedron(x);
-      this->Cells[id] = found >= 0 ? found : Outside;
-    }
-  }
-};
-
 //------------------------------------------------------------------------------------------------------------
 template <typename Real>
 struct EvaluateWorker
@@ -226,7 +181,32 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
   }
   this->Bound = Key();
 
-  // The rest frame of every tetrahedron; those without volume are never bound to.
+  this->ComputeRestFrames();
+  vtkFFDTetrahedronLocator locator(
+    this->Frames, this->Degenerate, this->Nodes, this->RestValues, this->Lattice, this->RestPositions);
+  // 80 % of the progress for the walks, which see every point; the rest for VTK's locator, which sees the few
+  // points they leave.
+  const double middle = progressBegin + 0.8 * (progressEnd - progressBegin);
+  if (!this->WalkPoints(points, locator, self, progressBegin, middle) ||
+    !this->LocateUndecidedPoints(points, locator, self, middle, progressEnd))
+  {
+    return false;
+  }
+  this->ApplyOutsidePolicy(points, outsidePolicy, locator);
+  this->ListUsedTetrahedra();
+
+  this->Bound = key;
+  this->BoundRest = this->RestValues;
+  this->BoundNodes = this->Nodes;
+  this->BindTime.Modified();
+  rebound = true;
+  return true;
+}
+
+//------------------------------------------------------------------------------------------------------------
+// The rest frame of every tetrahedron; those without volume are never bound to.
+void vtkFFDTetrahedralDeformation::ComputeRestFrames()
+{
   const vtkIdType numberOfTetrahedra = static_cast<vtkIdType>(this->Nodes.size() / 4);
   this->Frames.resize(numberOfTetrahedra);
   this->Degenerate.assign(numberOfTetrahedra, 0);
@@ -249,46 +229,78 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
   this->NumberOfDegenerate = std::count(this->Degenerate.begin(), this->Degenerate.end(), 1);
   const auto first = std::find(this->Degenerate.begin(), this->Degenerate.end(), 1);
   this->FirstDegenerate = first == this->Degenerate.end() ? -1 : first - this->Degenerate.begin();
+}
 
-  vtkFFDTetrahedronLocator locator(
-    this->Frames, this->Degenerate, this->Nodes, this->RestValues, this->Lattice, this->RestPositions);
+//------------------------------------------------------------------------------------------------------------
+// Every point's tetrahedron by a walk from its seed, or Undecided; -1 for a non-finite point, which keeps its
+// position. Without a tetrahedron of volume nothing walks: every point is Undecided.
+bool vtkFFDTetrahedralDeformation::WalkPoints(vtkPoints* points, const vtkFFDTetrahedronLocator& locator,
+  vtkAlgorithm* self, double progressBegin, double progressEnd)
+{
   const vtkIdType numberOfPoints = points->GetNumberOfPoints();
   this->Cells.resize(numberOfPoints);
-  if (this->NumberOfDegenerate == numberOfTetrahedra)
+  if (this->NumberOfDegenerate == this->GetNumberOfTetrahedra())
   {
     std::fill(this->Cells.begin(), this->Cells.end(), Undecided);
+    return true;
   }
-  else
-  {
-    WalkFunctor walk{ points, locator, this->Cells.data() };
-    const double middle = progressBegin + 0.8 * (progressEnd - progressBegin);
-    if (!vtkFFDForInChunks(self, numberOfPoints, 1024, walk, progressBegin, middle))
+  int* cells = this->Cells.data();
+  auto walk = [points, &locator, cells](vtkIdType begin, vtkIdType end) {
+    for (vtkIdType id = begin; id < end; ++id)
     {
-      return false;
+      double x[3];
+      points->GetPoint(id, x);
+      if (!IsFinite(x))
+      {
+        cells[id] = -1;
+        continue;
+      }
+      const int walked = locator.Walk(x);
+      cells[id] = walked >= 0 ? walked : Undecided;
     }
-  }
+  };
+  return vtkFFDForInChunks(self, numberOfPoints, 1024, walk, progressBegin, progressEnd);
+}
+
+//------------------------------------------------------------------------------------------------------------
+// The Undecided points' tetrahedra by VTK's locator, or Outside.
+bool vtkFFDTetrahedralDeformation::LocateUndecidedPoints(vtkPoints* points, vtkFFDTetrahedronLocator& locator,
+  vtkAlgorithm* self, double progressBegin, double progressEnd)
+{
   std::vector<vtkIdType> undecided;
-  for (vtkIdType id = 0; id < numberOfPoints; ++id)
+  for (vtkIdType id = 0; id < static_cast<vtkIdType>(this->Cells.size()); ++id)
   {
     if (this->Cells[id] == Undecided)
     {
       undecided.push_back(id);
     }
   }
-  if (!undecided.empty())
+  if (undecided.empty())
   {
-    locator.BuildCellLocator();
-    LocateFunctor locate{ points, locator, undecided, this->Cells.data() };
-    if (!vtkFFDForInChunks(self, static_cast<vtkIdType>(undecided.size()), 256, locate,
-          progressBegin + 0.8 * (progressEnd - progressBegin), progressEnd))
-    {
-      return false;
-    }
+    return true;
   }
+  locator.BuildCellLocator();
+  int* cells = this->Cells.data();
+  auto locate = [points, &locator, &undecided, cells](vtkIdType begin, vtkIdType end) {
+    for (vtkIdType u = begin; u < end; ++u)
+    {
+      double x[3];
+      points->GetPoint(undecided[u], x);
+      const int found = locator.FindTetrahedron(x);
+      cells[undecided[u]] = found >= 0 ? found : Outside;
+    }
+  };
+  return vtkFFDForInChunks(self, static_cast<vtkIdType>(undecided.size()), 256, locate, progressBegin, progressEnd);
+}
 
-  // The outside policy, for the (usually few) points outside every tetrahedron.
+//------------------------------------------------------------------------------------------------------------
+// The outside policy, for the (usually few) points outside every tetrahedron: they keep their position (-1),
+// follow their nearest tetrahedron (EXTRAPOLATE) or are clamped to its nearest point (CLAMP_TO_EDGE).
+void vtkFFDTetrahedralDeformation::ApplyOutsidePolicy(
+  vtkPoints* points, int outsidePolicy, vtkFFDTetrahedronLocator& locator)
+{
   this->Clamped.clear();
-  for (vtkIdType id = 0; id < numberOfPoints; ++id)
+  for (vtkIdType id = 0; id < static_cast<vtkIdType>(this->Cells.size()); ++id)
   {
     if (this->Cells[id] != Outside)
     {
@@ -314,10 +326,15 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
     }
     const ffd::Frame<double>& frame = this->Frames[tetrahedron];
     const ffd::Vec3<double> c = ffd::Vec3<double>::From(closest);
-    this->Clamped.push_back(
-      { id, tetrahedron, c, ffd::ClosestPointGradient(frame, frame.ToParametric(c), 1e-9) });
+    this->Clamped.push_back({ id, tetrahedron, c, ffd::ClosestPointGradient(frame, frame.ToParametric(c), 1e-9) });
   }
-  std::vector<unsigned char> used(numberOfTetrahedra, 0);
+}
+
+//------------------------------------------------------------------------------------------------------------
+// The tetrahedra some point is bound to, in increasing order: the only maps an evaluation computes.
+void vtkFFDTetrahedralDeformation::ListUsedTetrahedra()
+{
+  std::vector<unsigned char> used(this->Frames.size(), 0);
   for (const int tetrahedron : this->Cells)
   {
     if (tetrahedron >= 0)
@@ -326,19 +343,13 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
     }
   }
   this->Used.clear();
-  for (vtkIdType t = 0; t < numberOfTetrahedra; ++t)
+  for (size_t t = 0; t < used.size(); ++t)
   {
     if (used[t])
     {
       this->Used.push_back(static_cast<int>(t));
     }
   }
-  this->Bound = key;
-  this->BoundRest = this->RestValues;
-  this->BoundNodes = this->Nodes;
-  this->BindTime.Modified();
-  rebound = true;
-  return true;
 }
 
 //------------------------------------------------------------------------------------------------------------

@@ -42,6 +42,7 @@
 class vtkAlgorithm;
 class vtkDataArray;
 class vtkDataObject;
+class vtkFFDTetrahedronLocator;
 class vtkPoints;
 class vtkUnstructuredGrid;
 
@@ -147,6 +148,17 @@ private:
   /// Every tetrahedron's map, in the evaluation's precision.
   template <typename Real>
   void ComputeMaps(std::vector<ffd::TetrahedronMap<Real>>& maps) const;
+
+  ///@{
+  /// The steps of Bind(). The walks and VTK's locator return false when aborted.
+  void ComputeRestFrames();
+  bool WalkPoints(vtkPoints* points, const vtkFFDTetrahedronLocator& locator, vtkAlgorithm* self,
+    double progressBegin, double progressEnd);
+  bool LocateUndecidedPoints(vtkPoints* points, vtkFFDTetrahedronLocator& locator, vtkAlgorithm* self,
+    double progressBegin, double progressEnd);
+  void ApplyOutsidePolicy(vtkPoints* points, int outsidePolicy, vtkFFDTetrahedronLocator& locator);
+  void ListUsedTetrahedra();
+  ///@}
 
   // The lattice of SetLattice().
   vtkSmartPointer<vtkUnstructuredGrid> Lattice;
