@@ -3,7 +3,7 @@
 
 #include "vtkFFDDataContract.h"
 #include "vtkFFDMemory.h"
-#include "vtkFFDTetrahedralDeformation.h"
+#include "vtkFFDTetrahedralDeformer.h"
 
 #include "vtkCellArray.h"
 #include "vtkCellType.h"
@@ -303,9 +303,9 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   std::ostringstream request;
   request << "SubdivisionLevels " << this->SubdivisionLevels << " (" << this->NumberOfHullFaces
           << " hull faces, so " << finalTetrahedra << " tetrahedra)";
-  if (finalTetrahedra > double(vtkFFDTetrahedralDeformation::MaxTetrahedra))
+  if (finalTetrahedra > double(vtkFFDTetrahedralDeformer::MaxTetrahedra))
   {
-    vtkErrorMacro(<< request.str() << " exceeds the " << vtkFFDTetrahedralDeformation::MaxTetrahedra
+    vtkErrorMacro(<< request.str() << " exceeds the " << vtkFFDTetrahedralDeformer::MaxTetrahedra
                   << " tetrahedra a lattice may have: choose fewer levels.");
     return 0;
   }
@@ -348,11 +348,11 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
 
   // Active nodes: those with a weight for some input point in its tetrahedron, as vtkFFDDeform binds it. A
   // point on a face has a weight of (nearly) zero for the opposite node, which it does not move.
-  vtkFFDTetrahedralDeformation binding;
+  vtkFFDTetrahedralDeformer binding;
   const std::string problem = binding.SetLattice(output);
   bool rebound = false;
   if (!problem.empty() ||
-    !binding.Bind(input->GetPoints(), vtkFFDTetrahedralDeformation::KEEP_POSITION, this, 0.5, 1.0, rebound))
+    !binding.Bind(input->GetPoints(), vtkFFDTetrahedralDeformer::KEEP_POSITION, this, 0.5, 1.0, rebound))
   {
     if (!problem.empty())
     {
@@ -365,7 +365,7 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   active->SetName(vtkFFDDataContract::ActiveArrayName());
   active->SetNumberOfValues(numberOfNodes);
   active->FillValue(0);
-  const std::vector<int>& bound = binding.GetCells();
+  const std::vector<int>& bound = binding.GetCellOfPoint();
   for (vtkIdType id = 0; id < numberOfPoints; ++id)
   {
     if (bound[id] < 0)

@@ -9,7 +9,7 @@
 #ifdef VOXELFFD_HAS_CUDA
 #include "FFDCudaGridDeformer.h"
 #include "FFDCudaTetrahedralDeformer.h"
-#include "vtkFFDTetrahedralDeformation.h"
+#include "vtkFFDTetrahedralDeformer.h"
 #endif
 
 #include <algorithm>
@@ -105,7 +105,7 @@ struct vtkFFDCudaBackend::vtkState
   const vtkPoints* TetrahedraPoints = nullptr; // the tetrahedral device's points, their time and precision
   vtkMTimeType TetrahedraPointsMTime = 0;
   int TetrahedraType = 0;
-  vtkMTimeType TetrahedraBindTime = 0; // vtkFFDTetrahedralDeformation::GetBindTime() of its binding
+  vtkMTimeType TetrahedraBindTime = 0; // vtkFFDTetrahedralDeformer::GetBindTime() of its binding
   NormalsOnDevice TetrahedraNormals;
 
   template <typename Real>
@@ -132,7 +132,7 @@ struct vtkFFDCudaBackend::vtkState
   }
 
   template <typename Real>
-  bool RunTetrahedra(const vtkFFDTetrahedralDeformation& tetrahedra, vtkPoints* points, vtkDataArray* normals,
+  bool RunTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points, vtkDataArray* normals,
     vtkAOSDataArrayTemplate<Real>* outPoints, vtkDataArray* outNormals,
     vtkAOSDataArrayTemplate<Real>* outDeterminants)
   {
@@ -145,7 +145,7 @@ struct vtkFFDCudaBackend::vtkState
     auto bind = [&] {
       const std::vector<vtkIdType>& ids = tetrahedra.GetNodes();
       const std::vector<int> nodeIds(ids.begin(), ids.end());
-      return this->Tetrahedra.Bind(tetrahedra.GetCells().data(), tetrahedra.GetFrames().data(), nodeIds.data(),
+      return this->Tetrahedra.Bind(tetrahedra.GetCellOfPoint().data(), tetrahedra.GetFrames().data(), nodeIds.data(),
         tetrahedra.GetNumberOfTetrahedra(), nodes);
     };
     auto evaluate = [&](bool withNormals, bool withDeterminants) {
@@ -233,7 +233,7 @@ bool vtkFFDCudaBackend::Deform(const vtkFFDBindingKey& key, vtkPoints* points, v
 #endif
 }
 
-bool vtkFFDCudaBackend::DeformTetrahedra(const vtkFFDTetrahedralDeformation& tetrahedra, vtkPoints* points,
+bool vtkFFDCudaBackend::DeformTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points,
   vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
   std::string& why)
 {

@@ -7,7 +7,7 @@
  * ffd::cuda::TetrahedralDeformer per vtkFFDDeform, uploads the input's points and normals only when they change.
  * A grid lattice's points are re-bound on the device only when they or the lattice's rest frame, shape or the
  * outside policy change (the same key as the CPU binding, vtkFFDBindingKey); a tetrahedral lattice's binding is
- * the host's (vtkFFDTetrahedralDeformation: it needs VTK's cell locator), uploaded once per binding. An update
+ * the host's (vtkFFDTetrahedralDeformer: it needs VTK's cell locator), uploaded once per binding. An update
  * uploads only the lattice's displacements (of control points or of nodes) and downloads straight into the
  * output arrays.
  *
@@ -23,7 +23,7 @@
 #include <string>
 
 class vtkDataArray;
-class vtkFFDTetrahedralDeformation;
+class vtkFFDTetrahedralDeformer;
 class vtkPoints;
 
 class vtkFFDCudaBackend
@@ -55,7 +55,7 @@ public:
    * the points clamped to the control mesh on the host with its ApplyClampedPoints(), as the CPU does. Outputs
    * and failures as Deform().
    */
-  bool DeformTetrahedra(const vtkFFDTetrahedralDeformation& tetrahedra, vtkPoints* points, vtkDataArray* normals,
+  bool DeformTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points, vtkDataArray* normals,
     vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants, std::string& why);
 
 private:

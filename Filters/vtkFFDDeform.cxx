@@ -4,7 +4,7 @@
 #include "vtkFFDCudaBackend.h"
 #include "vtkFFDGridDeformer.h"
 #include "vtkFFDMemory.h"
-#include "vtkFFDTetrahedralDeformation.h"
+#include "vtkFFDTetrahedralDeformer.h"
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkCellData.h"
@@ -102,7 +102,7 @@ vtkSmartPointer<vtkDataArray> OutputArray(const KeptArrays& kept, vtkDataArray* 
 struct vtkFFDDeform::vtkInternals
 {
   vtkFFDGridDeformer Grid;
-  vtkFFDTetrahedralDeformation Tetrahedra;
+  vtkFFDTetrahedralDeformer Tetrahedra;
   vtkFFDCudaBackend Cuda;
   // The last outputs' arrays: the next update writes into those that nothing else holds any more (OutputArray()).
   KeptArrays KeptPoints, KeptNormals, KeptDeterminants;
@@ -167,7 +167,7 @@ int vtkFFDDeform::RequestData(
     return 1;
   }
 
-  vtkUnstructuredGrid* tetrahedra = vtkFFDTetrahedralDeformation::IsTetrahedralLattice(lattice)
+  vtkUnstructuredGrid* tetrahedra = vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice)
     ? vtkUnstructuredGrid::SafeDownCast(lattice)
     : nullptr;
   vtkInternals& internals = *this->Internals;
@@ -295,7 +295,7 @@ bool vtkFFDDeform::DeformByTetrahedra(vtkPoints* points, vtkDataArray* normals)
 {
   // The binding needs VTK's cell locator: on the CPU for either backend, then cached.
   vtkInternals& internals = *this->Internals;
-  vtkFFDTetrahedralDeformation& tetrahedra = internals.Tetrahedra;
+  vtkFFDTetrahedralDeformer& tetrahedra = internals.Tetrahedra;
   bool rebound = false;
   if (!tetrahedra.Bind(points, this->OutsidePolicy, this, 0.0, 0.5, rebound))
   {

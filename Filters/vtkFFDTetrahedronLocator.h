@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
  * @class   vtkFFDTetrahedronLocator
- * @brief   finds the rest tetrahedron of a tetrahedral lattice that holds a point, for vtkFFDTetrahedralDeformation
+ * @brief   finds the rest tetrahedron of a tetrahedral lattice that holds a point, for vtkFFDTetrahedralDeformer
  *
  * Private to the Filters module (not wrapped). Built once per binding from the rest tetrahedra: their frames
  * (ffd::TetrahedronFrame, whose parameters are the weights of equation 5), which of them have no volume, their
@@ -9,8 +9,8 @@
  * from a hint or from the seed nearest the point in a coarse grid (about 8 tetrahedra a grid cell). Where a walk
  * gives no answer (it left a non-convex mesh, met a tetrahedron without volume, or cycled), FindTetrahedron()
  * asks VTK's vtkStaticCellLocator for candidates and the weights decide: VTK's locator alone tests each
- * candidate through vtkCell::EvaluatePosition, 10 times slower here on the long tetrahedra of a hull's fan,
- * whose bounds overlap by the hundreds. FindClosestTetrahedron(), for points outside every tetrahedron, is VTK's
+ * candidate through vtkCell::EvaluatePosition, slow on the long tetrahedra of a hull's fan, whose bounds overlap
+ * by the hundreds (BENCHMARKS.md). FindClosestTetrahedron(), for points outside every tetrahedron, is VTK's
  * locator's nearest cell.
  *
  * A point counts as inside a tetrahedron when its smallest weight is at least -1e-10 (the band that absorbs

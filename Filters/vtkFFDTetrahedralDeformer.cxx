@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "vtkFFDTetrahedralDeformation.h"
+#include "vtkFFDTetrahedralDeformer.h"
 
 #include "vtkFFDDataContract.h"
 #include "vtkFFDDeformPoints.h"
@@ -53,24 +53,19 @@ struct EvaluateWorker
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
-bool vtkFFDTetrahedralDeformation::Key::operator==(const Key& o) const
-{
-  return this->Points == o.Points && this->PointsMTime == o.PointsMTime &&
-    this->NumberOfPoints == o.NumberOfPoints && this->Policy == o.Policy;
-}
 
-vtkFFDTetrahedralDeformation::vtkFFDTetrahedralDeformation() = default;
-vtkFFDTetrahedralDeformation::~vtkFFDTetrahedralDeformation() = default;
+vtkFFDTetrahedralDeformer::vtkFFDTetrahedralDeformer() = default;
+vtkFFDTetrahedralDeformer::~vtkFFDTetrahedralDeformer() = default;
 
 //------------------------------------------------------------------------------------------------------------
-bool vtkFFDTetrahedralDeformation::IsTetrahedralLattice(vtkDataObject* lattice)
+bool vtkFFDTetrahedralDeformer::IsTetrahedralLattice(vtkDataObject* lattice)
 {
   return vtkUnstructuredGrid::SafeDownCast(lattice) &&
     !lattice->GetFieldData()->GetAbstractArray(vtkFFDDataContract::FrameArrayName());
 }
 
 //------------------------------------------------------------------------------------------------------------
-std::string vtkFFDTetrahedralDeformation::SetLattice(vtkUnstructuredGrid* lattice)
+std::string vtkFFDTetrahedralDeformer::SetLattice(vtkUnstructuredGrid* lattice)
 {
   this->Lattice = lattice;
   const std::string fix = " Build it with vtkFFDBuildTetrahedralLattice, or give a vtkUnstructuredGrid of "
@@ -156,22 +151,11 @@ std::string vtkFFDTetrahedralDeformation::SetLattice(vtkUnstructuredGrid* lattic
 }
 
 //------------------------------------------------------------------------------------------------------------
-vtkFFDTetrahedralDeformation::Key vtkFFDTetrahedralDeformation::KeyOf(vtkPoints* points, int policy) const
-{
-  Key key;
-  key.Points = points;
-  key.PointsMTime = points->GetMTime();
-  key.NumberOfPoints = points->GetNumberOfPoints();
-  key.Policy = policy;
-  return key;
-}
-
-//------------------------------------------------------------------------------------------------------------
-bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vtkAlgorithm* self,
+bool vtkFFDTetrahedralDeformer::Bind(vtkPoints* points, int outsidePolicy, vtkAlgorithm* self,
   double progressBegin, double progressEnd, bool& rebound)
 {
   rebound = false;
-  const Key key = this->KeyOf(points, outsidePolicy);
+  const vtkFFDBindingKey key = vtkFFDBindingKey::Of(points, outsidePolicy);
   // The connectivity is compared only when it was read again (a rebuilt lattice): 6 MB for 181 k tetrahedra.
   const bool sameNodes = !this->NodesRead || this->Nodes == this->BoundNodes;
   this->NodesRead = false;
@@ -179,7 +163,7 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
   {
     return true;
   }
-  this->Bound = Key();
+  this->Bound = vtkFFDBindingKey();
 
   this->ComputeRestFrames();
   vtkFFDTetrahedronLocator locator(
@@ -205,7 +189,7 @@ bool vtkFFDTetrahedralDeformation::Bind(vtkPoints* points, int outsidePolicy, vt
 
 //------------------------------------------------------------------------------------------------------------
 // The rest frame of every tetrahedron; those without volume are never bound to.
-void vtkFFDTetrahedralDeformation::ComputeRestFrames()
+void vtkFFDTetrahedralDeformer::ComputeRestFrames()
 {
   const vtkIdType numberOfTetrahedra = static_cast<vtkIdType>(this->Nodes.size() / 4);
   this->Frames.resize(numberOfTetrahedra);
@@ -234,17 +218,17 @@ void vtkFFDTetrahedralDeformation::ComputeRestFrames()
 //------------------------------------------------------------------------------------------------------------
 // Every point's tetrahedron by a walk from its seed, or Undecided; -1 for a non-finite point, which keeps its
 // position. Without a tetrahedron of volume nothing walks: every point is Undecided.
-bool vtkFFDTetrahedralDeformation::WalkPoints(vtkPoints* points, const vtkFFDTetrahedronLocator& locator,
+bool vtkFFDTetrahedralDeformer::WalkPoints(vtkPoints* points, const vtkFFDTetrahedronLocator& locator,
   vtkAlgorithm* self, double progressBegin, double progressEnd)
 {
   const vtkIdType numberOfPoints = points->GetNumberOfPoints();
-  this->Cells.resize(numberOfPoints);
+  this->CellOfPoint.resize(numberOfPoints);
   if (this->NumberOfDegenerate == this->GetNumberOfTetrahedra())
   {
-    std::fill(this->Cells.begin(), this->Cells.end(), Undecided);
+    std::fill(this->CellOfPoint.begin(), this->CellOfPoint.end(), Undecided);
     return true;
   }
-  int* cells = this->Cells.data();
+  int* cells = this->CellOfPoint.data();
   auto walk = [points, &locator, cells](vtkIdType begin, vtkIdType end) {
     for (vtkIdType id = begin; id < end; ++id)
     {
@@ -264,13 +248,13 @@ bool vtkFFDTetrahedralDeformation::WalkPoints(vtkPoints* points, const vtkFFDTet
 
 //------------------------------------------------------------------------------------------------------------
 // The Undecided points' tetrahedra by VTK's locator, or Outside.
-bool vtkFFDTetrahedralDeformation::LocateUndecidedPoints(vtkPoints* points, vtkFFDTetrahedronLocator& locator,
+bool vtkFFDTetrahedralDeformer::LocateUndecidedPoints(vtkPoints* points, vtkFFDTetrahedronLocator& locator,
   vtkAlgorithm* self, double progressBegin, double progressEnd)
 {
   std::vector<vtkIdType> undecided;
-  for (vtkIdType id = 0; id < static_cast<vtkIdType>(this->Cells.size()); ++id)
+  for (vtkIdType id = 0; id < static_cast<vtkIdType>(this->CellOfPoint.size()); ++id)
   {
-    if (this->Cells[id] == Undecided)
+    if (this->CellOfPoint[id] == Undecided)
     {
       undecided.push_back(id);
     }
@@ -280,7 +264,7 @@ bool vtkFFDTetrahedralDeformation::LocateUndecidedPoints(vtkPoints* points, vtkF
     return true;
   }
   locator.BuildCellLocator();
-  int* cells = this->Cells.data();
+  int* cells = this->CellOfPoint.data();
   auto locate = [points, &locator, &undecided, cells](vtkIdType begin, vtkIdType end) {
     for (vtkIdType u = begin; u < end; ++u)
     {
@@ -296,17 +280,17 @@ bool vtkFFDTetrahedralDeformation::LocateUndecidedPoints(vtkPoints* points, vtkF
 //------------------------------------------------------------------------------------------------------------
 // The outside policy, for the (usually few) points outside every tetrahedron: they keep their position (-1),
 // follow their nearest tetrahedron (EXTRAPOLATE) or are clamped to its nearest point (CLAMP_TO_EDGE).
-void vtkFFDTetrahedralDeformation::ApplyOutsidePolicy(
+void vtkFFDTetrahedralDeformer::ApplyOutsidePolicy(
   vtkPoints* points, int outsidePolicy, vtkFFDTetrahedronLocator& locator)
 {
   this->Clamped.clear();
-  for (vtkIdType id = 0; id < static_cast<vtkIdType>(this->Cells.size()); ++id)
+  for (vtkIdType id = 0; id < static_cast<vtkIdType>(this->CellOfPoint.size()); ++id)
   {
-    if (this->Cells[id] != Outside)
+    if (this->CellOfPoint[id] != Outside)
     {
       continue;
     }
-    this->Cells[id] = -1;
+    this->CellOfPoint[id] = -1;
     if (outsidePolicy == KEEP_POSITION)
     {
       continue;
@@ -321,7 +305,7 @@ void vtkFFDTetrahedralDeformation::ApplyOutsidePolicy(
     }
     if (outsidePolicy == EXTRAPOLATE)
     {
-      this->Cells[id] = tetrahedron;
+      this->CellOfPoint[id] = tetrahedron;
       continue;
     }
     const ffd::Frame<double>& frame = this->Frames[tetrahedron];
@@ -332,10 +316,10 @@ void vtkFFDTetrahedralDeformation::ApplyOutsidePolicy(
 
 //------------------------------------------------------------------------------------------------------------
 // The tetrahedra some point is bound to, in increasing order: the only maps an evaluation computes.
-void vtkFFDTetrahedralDeformation::ListUsedTetrahedra()
+void vtkFFDTetrahedralDeformer::ListUsedTetrahedra()
 {
   std::vector<unsigned char> used(this->Frames.size(), 0);
-  for (const int tetrahedron : this->Cells)
+  for (const int tetrahedron : this->CellOfPoint)
   {
     if (tetrahedron >= 0)
     {
@@ -353,7 +337,7 @@ void vtkFFDTetrahedralDeformation::ListUsedTetrahedra()
 }
 
 //------------------------------------------------------------------------------------------------------------
-ffd::TetrahedronMap<double> vtkFFDTetrahedralDeformation::Map(vtkIdType tetrahedron) const
+ffd::TetrahedronMap<double> vtkFFDTetrahedralDeformer::Map(vtkIdType tetrahedron) const
 {
   if (this->Degenerate[tetrahedron])
   {
@@ -368,7 +352,7 @@ ffd::TetrahedronMap<double> vtkFFDTetrahedralDeformation::Map(vtkIdType tetrahed
 }
 
 template <typename Real>
-void vtkFFDTetrahedralDeformation::ComputeMaps(std::vector<ffd::TetrahedronMap<Real>>& maps) const
+void vtkFFDTetrahedralDeformer::ComputeMaps(std::vector<ffd::TetrahedronMap<Real>>& maps) const
 {
   // Only the tetrahedra some point is bound to: the others' maps are never read.
   maps.resize(this->Frames.size());
@@ -381,7 +365,7 @@ void vtkFFDTetrahedralDeformation::ComputeMaps(std::vector<ffd::TetrahedronMap<R
 }
 
 //------------------------------------------------------------------------------------------------------------
-bool vtkFFDTetrahedralDeformation::Evaluate(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints,
+bool vtkFFDTetrahedralDeformer::Evaluate(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints,
   vtkDataArray* outNormals, vtkDataArray* outDeterminants, vtkAlgorithm* self, double progressBegin,
   double progressEnd)
 {
@@ -395,10 +379,10 @@ bool vtkFFDTetrahedralDeformation::Evaluate(vtkPoints* points, vtkDataArray* nor
     Real* det = outDeterminants ? static_cast<RealArray*>(outDeterminants)->GetPointer(0) : nullptr;
     EvaluateWorker<Real> worker;
     if (!vtkArrayDispatch::DispatchByValueType<vtkArrayDispatch::Reals>::Execute(points->GetData(), worker,
-          this->Cells.data(), maps.data(), normals, outNormals, out, det, self, progressBegin, progressEnd,
+          this->CellOfPoint.data(), maps.data(), normals, outNormals, out, det, self, progressBegin, progressEnd,
           completed))
     {
-      worker(points->GetData(), this->Cells.data(), maps.data(), normals, outNormals, out, det, self,
+      worker(points->GetData(), this->CellOfPoint.data(), maps.data(), normals, outNormals, out, det, self,
         progressBegin, progressEnd, completed);
     }
   };
@@ -418,7 +402,7 @@ bool vtkFFDTetrahedralDeformation::Evaluate(vtkPoints* points, vtkDataArray* nor
 }
 
 //------------------------------------------------------------------------------------------------------------
-void vtkFFDTetrahedralDeformation::ApplyClampedPoints(vtkPoints* points, vtkDataArray* normals,
+void vtkFFDTetrahedralDeformer::ApplyClampedPoints(vtkPoints* points, vtkDataArray* normals,
   vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants) const
 {
   for (const ClampedPoint& p : this->Clamped)

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
- * @class   vtkFFDTetrahedralDeformation
+ * @class   vtkFFDTetrahedralDeformer
  * @brief   vtkFFDDeform's path for tetrahedral lattices: reading, binding and CPU evaluation
  *
  * Private to the Filters module (not wrapped). A tetrahedral lattice (paper section III.E) is a
@@ -27,9 +27,10 @@
  * The same binding serves vtkFFDBuildTetrahedralLattice, which marks the nodes of tetrahedra holding mesh points
  * `Active`.
  */
-#ifndef vtkFFDTetrahedralDeformation_h
-#define vtkFFDTetrahedralDeformation_h
+#ifndef vtkFFDTetrahedralDeformer_h
+#define vtkFFDTetrahedralDeformer_h
 
+#include "vtkFFDBindingKey.h"
 #include "vtkSmartPointer.h"
 #include "vtkTimeStamp.h"
 #include "vtkType.h"
@@ -46,13 +47,13 @@ class vtkFFDTetrahedronLocator;
 class vtkPoints;
 class vtkUnstructuredGrid;
 
-class vtkFFDTetrahedralDeformation
+class vtkFFDTetrahedralDeformer
 {
 public:
-  vtkFFDTetrahedralDeformation();
-  ~vtkFFDTetrahedralDeformation();
-  vtkFFDTetrahedralDeformation(const vtkFFDTetrahedralDeformation&) = delete;
-  vtkFFDTetrahedralDeformation& operator=(const vtkFFDTetrahedralDeformation&) = delete;
+  vtkFFDTetrahedralDeformer();
+  ~vtkFFDTetrahedralDeformer();
+  vtkFFDTetrahedralDeformer(const vtkFFDTetrahedralDeformer&) = delete;
+  vtkFFDTetrahedralDeformer& operator=(const vtkFFDTetrahedralDeformer&) = delete;
 
   /// Outside policies, vtkFFDDeform's values.
   enum Policies
@@ -105,7 +106,7 @@ public:
   /// The binding: per point its tetrahedron (-1: keeps its position, or clamped, see above); per tetrahedron its
   /// rest frame (zero for tetrahedra without volume, which nothing is bound to) and its 4 nodes; when it was
   /// computed (a vtkTimeStamp: a new binding has a later time).
-  const std::vector<int>& GetCells() const { return this->Cells; }
+  const std::vector<int>& GetCellOfPoint() const { return this->CellOfPoint; }
   vtkIdType GetNumberOfTetrahedra() const { return static_cast<vtkIdType>(this->Frames.size()); }
   const std::vector<ffd::Frame<double>>& GetFrames() const { return this->Frames; }
   const std::vector<vtkIdType>& GetNodes() const { return this->Nodes; }
@@ -123,16 +124,6 @@ public:
 
 
 private:
-  /// What a binding is for: the points (identity, modification time, count) and the policy; the rest
-  /// tetrahedra are compared by value (BoundRest, BoundNodes), so a rebuilt but identical lattice keeps it.
-  struct Key
-  {
-    const void* Points = nullptr;
-    vtkMTimeType PointsMTime = 0;
-    vtkIdType NumberOfPoints = -1;
-    int Policy = -1;
-    bool operator==(const Key& o) const;
-  };
   /// A point outside the control mesh clamped to it: it moves by the displacement of its nearest point there.
   struct ClampedPoint
   {
@@ -142,7 +133,6 @@ private:
     ffd::Mat3<double> Gradient; ///< d(Closest)/dX (ffd::ClosestPointGradient)
   };
 
-  Key KeyOf(vtkPoints* points, int policy) const;
   /// The map of a tetrahedron from its nodes' displacements (double precision).
   ffd::TetrahedronMap<double> Map(vtkIdType tetrahedron) const;
   /// Every tetrahedron's map, in the evaluation's precision.
@@ -172,7 +162,7 @@ private:
   bool NodesRead = false; // Nodes were read again since the last Bind()
 
   // The binding and what it is for.
-  Key Bound;
+  vtkFFDBindingKey Bound; // the points and policy of the binding; the rest tetrahedra are compared by value
   std::vector<double> BoundRest;
   std::vector<vtkIdType> BoundNodes;
   vtkTimeStamp BindTime;
@@ -180,7 +170,7 @@ private:
   std::vector<unsigned char> Degenerate;  // 1 per tetrahedron without volume
   vtkIdType NumberOfDegenerate = 0;
   vtkIdType FirstDegenerate = -1;
-  std::vector<int> Cells;
+  std::vector<int> CellOfPoint;
   std::vector<int> Used; // the tetrahedra some point is bound to (not a clamped one: those use Map())
   std::vector<ClampedPoint> Clamped;
 
