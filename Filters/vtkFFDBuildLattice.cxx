@@ -43,8 +43,8 @@ bool vtkFFDBuildLattice::GetControlPointsPerAxis(int basis, const int divisions[
   if (!ffd::IsGridBasis(basis))
   {
     std::ostringstream msg;
-    msg << "unknown basis " << basis << ": use one of BERNSTEIN (" << BERNSTEIN
-        << ") to CUBIC_BSPLINE (" << CUBIC_BSPLINE << ").";
+    msg << "unknown basis " << basis << ": use one of BERNSTEIN (" << BERNSTEIN << ") to CUBIC_BSPLINE ("
+        << CUBIC_BSPLINE << ").";
     why = msg.str();
     return false;
   }
@@ -55,8 +55,8 @@ bool vtkFFDBuildLattice::GetControlPointsPerAxis(int basis, const int divisions[
     if (grid == ffd::GridBasis::Bernstein && divisions[a] > ffd::MaxBernsteinDegree)
     {
       std::ostringstream msg;
-      msg << "the BERNSTEIN basis would have degree " << divisions[a] << " along axis " << a
-          << ", above the maximum " << ffd::MaxBernsteinDegree << ": use at most " << ffd::MaxBernsteinDegree
+      msg << "the BERNSTEIN basis would have degree " << divisions[a] << " along axis " << a << ", above the maximum "
+          << ffd::MaxBernsteinDegree << ": use at most " << ffd::MaxBernsteinDegree
           << " divisions per axis, or a local basis (e.g. TRILINEAR).";
       why = msg.str();
       return false;
@@ -73,8 +73,8 @@ bool vtkFFDBuildLattice::GetControlPointsPerAxis(int basis, const int divisions[
   if (double(points[0]) * points[1] * points[2] > double(VTK_INT_MAX))
   {
     std::ostringstream msg;
-    msg << "the " << GetBasisAsString(basis) << " lattice over " << divisions[0] << "x"
-        << divisions[1] << "x" << divisions[2] << " voxels would have more than 2^31 - 1 control points.";
+    msg << "the " << GetBasisAsString(basis) << " lattice over " << divisions[0] << "x" << divisions[1] << "x"
+        << divisions[2] << " voxels would have more than 2^31 - 1 control points.";
     why = msg.str();
     return false;
   }
@@ -136,8 +136,7 @@ int vtkFFDBuildLattice::RequestInformation(
 }
 
 //------------------------------------------------------------------------------
-int vtkFFDBuildLattice::RequestUpdateExtent(
-  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
+int vtkFFDBuildLattice::RequestUpdateExtent(vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
 {
   // The lattice's extent is not the voxel grid's (a quadratic lattice has 2n + 1 points per axis, a B-spline
   // lattice n + 3), and every control point depends on the whole grid through the culling: ask for all of it
@@ -196,9 +195,8 @@ int vtkFFDBuildLattice::RequestData(
   {
     vtkErrorMacro(<< "The input's dimensions (" << dims[0] << ", " << dims[1] << ", " << dims[2] << ") and "
                   << input->GetNumberOfPoints() << " points do not match its "
-                  << vtkFFDDataContract::DivisionsArrayName() << " ("
-                  << divisions[0] << ", " << divisions[1] << ", " << divisions[2]
-                  << ") plus one: connect the output of vtkFFDVoxelize.");
+                  << vtkFFDDataContract::DivisionsArrayName() << " (" << divisions[0] << ", " << divisions[1] << ", "
+                  << divisions[2] << ") plus one: connect the output of vtkFFDVoxelize.");
     return 0;
   }
   if (ffd::CheckFrame(frame) != ffd::FrameStatus::Valid)
@@ -225,8 +223,8 @@ int vtkFFDBuildLattice::RequestData(
   const vtkIdType numControlPoints = static_cast<vtkIdType>(nI) * nJ * nK;
   // Per control point: its position and RestPosition (24 bytes each), Active and the ghost array (1 each).
   std::ostringstream request;
-  request << "A " << GetBasisAsString(this->Basis) << " lattice over " << divisions[0] << "x" << divisions[1]
-          << "x" << divisions[2] << " voxels (" << nI << "x" << nJ << "x" << nK << " control points)";
+  request << "A " << GetBasisAsString(this->Basis) << " lattice over " << divisions[0] << "x" << divisions[1] << "x"
+          << divisions[2] << " voxels (" << nI << "x" << nJ << "x" << nK << " control points)";
   if (!vtkFFDCheckMemory(this, request.str(), 50.0 * double(numControlPoints)))
   {
     return 0;
@@ -299,18 +297,19 @@ int vtkFFDBuildLattice::RequestData(
   rest->SetNumberOfTuples(numControlPoints);
   double* pointValues = vtkDoubleArray::SafeDownCast(points->GetData())->GetPointer(0);
   double* restValues = rest->GetPointer(0);
-  vtkSMPTools::For(0, numControlPoints, [&](vtkIdType begin, vtkIdType end) {
-    for (vtkIdType id = begin; id < end; ++id)
+  vtkSMPTools::For(0, numControlPoints,
+    [&](vtkIdType begin, vtkIdType end)
     {
-      const vtkIdType i = id % nI, j = (id / nI) % nJ, k = id / (static_cast<vtkIdType>(nI) * nJ);
-      const ffd::Vec3<double> x =
-        bound.ToWorld({ restParameters[0][i], restParameters[1][j], restParameters[2][k] });
-      for (int c = 0; c < 3; ++c)
+      for (vtkIdType id = begin; id < end; ++id)
       {
-        pointValues[3 * id + c] = restValues[3 * id + c] = x[c];
+        const vtkIdType i = id % nI, j = (id / nI) % nJ, k = id / (static_cast<vtkIdType>(nI) * nJ);
+        const ffd::Vec3<double> x = bound.ToWorld({ restParameters[0][i], restParameters[1][j], restParameters[2][k] });
+        for (int c = 0; c < 3; ++c)
+        {
+          pointValues[3 * id + c] = restValues[3 * id + c] = x[c];
+        }
       }
-    }
-  });
+    });
 
   const vtkIdType numActive = std::count(active, active + numControlPoints, static_cast<unsigned char>(1));
 

@@ -51,8 +51,8 @@ struct TetrahedralMesh
   double SignedVolume6(const vtkIdType t[4]) const
   {
     const ffd::Vec3<double> a = ffd::Vec3<double>::From(this->Node(t[0]));
-    return ffd::Dot(ffd::Cross(ffd::Vec3<double>::From(this->Node(t[1])) - a,
-                      ffd::Vec3<double>::From(this->Node(t[2])) - a),
+    return ffd::Dot(
+      ffd::Cross(ffd::Vec3<double>::From(this->Node(t[1])) - a, ffd::Vec3<double>::From(this->Node(t[2])) - a),
       ffd::Vec3<double>::From(this->Node(t[3])) - a);
   }
 
@@ -134,7 +134,8 @@ TetrahedralMesh Subdivide(const TetrahedralMesh& coarse)
   fine.Nodes = coarse.Nodes;
   fine.Tetrahedra.reserve(8 * coarse.Tetrahedra.size());
   std::unordered_map<unsigned long long, vtkIdType> midpoints;
-  auto midpoint = [&](vtkIdType a, vtkIdType b) {
+  auto midpoint = [&](vtkIdType a, vtkIdType b)
+  {
     const unsigned long long key =
       (static_cast<unsigned long long>(std::min(a, b)) << 32) | static_cast<unsigned long long>(std::max(a, b));
     const auto found = midpoints.find(key);
@@ -174,8 +175,8 @@ TetrahedralMesh Subdivide(const TetrahedralMesh& coarse)
     double shortestLength = std::numeric_limits<double>::infinity();
     for (int d = 0; d < 3; ++d)
     {
-      const ffd::Vec3<double> e = ffd::Vec3<double>::From(fine.Node(diagonals[d][1])) -
-        ffd::Vec3<double>::From(fine.Node(diagonals[d][0]));
+      const ffd::Vec3<double> e =
+        ffd::Vec3<double>::From(fine.Node(diagonals[d][1])) - ffd::Vec3<double>::From(fine.Node(diagonals[d][0]));
       if (ffd::Dot(e, e) < shortestLength)
       {
         shortestLength = ffd::Dot(e, e);
@@ -262,8 +263,8 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   const std::string qhullMessage = ConvexHull(coordinates, triangles);
   if (!qhullMessage.empty() || triangles.empty())
   {
-    vtkErrorMacro("The convex hull of the input's points cannot be computed (are they coplanar?). Qhull says: "
-      << qhullMessage);
+    vtkErrorMacro(
+      "The convex hull of the input's points cannot be computed (are they coplanar?). Qhull says: " << qhullMessage);
     return 0;
   }
   this->UpdateProgress(0.3);
@@ -272,7 +273,8 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   TetrahedralMesh mesh;
   mesh.Nodes.assign(centroid, centroid + 3);
   std::unordered_map<int, vtkIdType> nodeOfPoint;
-  auto node = [&](int point) {
+  auto node = [&](int point)
+  {
     const auto found = nodeOfPoint.find(point);
     if (found != nodeOfPoint.end())
     {
@@ -301,8 +303,8 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   // share of the nodes (at most one node per tetrahedron, 3 copies of 24 bytes and the midpoints' index).
   const double finalTetrahedra = double(this->NumberOfHullFaces) * std::pow(8.0, this->SubdivisionLevels);
   std::ostringstream request;
-  request << "SubdivisionLevels " << this->SubdivisionLevels << " (" << this->NumberOfHullFaces
-          << " hull faces, so " << finalTetrahedra << " tetrahedra)";
+  request << "SubdivisionLevels " << this->SubdivisionLevels << " (" << this->NumberOfHullFaces << " hull faces, so "
+          << finalTetrahedra << " tetrahedra)";
   if (finalTetrahedra > double(vtkFFDTetrahedralDeformer::MaxTetrahedra))
   {
     vtkErrorMacro(<< request.str() << " exceeds the " << vtkFFDTetrahedralDeformer::MaxTetrahedra

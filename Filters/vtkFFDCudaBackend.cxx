@@ -80,8 +80,8 @@ bool Run(ffd::cuda::ResidentPoints& device, NormalsOnDevice& normalsOnDevice, bo
   }
   Real* normalsTarget = realNormals ? realNormals->GetPointer(0) : (outNormals ? normalsCopy.data() : nullptr);
   if (!evaluate(outNormals != nullptr, outDeterminants != nullptr) ||
-    !device.Download(outPoints->GetPointer(0), normalsTarget,
-      outDeterminants ? outDeterminants->GetPointer(0) : nullptr))
+    !device.Download(
+      outPoints->GetPointer(0), normalsTarget, outDeterminants ? outDeterminants->GetPointer(0) : nullptr))
   {
     return false;
   }
@@ -119,9 +119,8 @@ struct vtkFFDCudaBackend::vtkState
     if (!Run(
           this->Grid, this->GridNormals, rebind, rebind, points, normals, outPoints, outNormals, outDeterminants,
           [&] { return this->Grid.Bind(key.Frame.data(), key.Basis, key.Divisions.data(), key.ClampsOutside()); },
-          [&](bool withNormals, bool withDeterminants) {
-            return this->Grid.Evaluate(displacements, controlPoints, withNormals, withDeterminants);
-          }))
+          [&](bool withNormals, bool withDeterminants)
+          { return this->Grid.Evaluate(displacements, controlPoints, withNormals, withDeterminants); }))
     {
       return false;
     }
@@ -133,26 +132,25 @@ struct vtkFFDCudaBackend::vtkState
 
   template <typename Real>
   bool RunTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points, vtkDataArray* normals,
-    vtkAOSDataArrayTemplate<Real>* outPoints, vtkDataArray* outNormals,
-    vtkAOSDataArrayTemplate<Real>* outDeterminants)
+    vtkAOSDataArrayTemplate<Real>* outPoints, vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outDeterminants)
   {
     const int type = outPoints->GetDataType();
-    const bool uploadPoints = points != this->TetrahedraPoints ||
-      points->GetMTime() != this->TetrahedraPointsMTime || type != this->TetrahedraType;
+    const bool uploadPoints = points != this->TetrahedraPoints || points->GetMTime() != this->TetrahedraPointsMTime ||
+      type != this->TetrahedraType;
     const bool rebind = uploadPoints || tetrahedra.GetBindTime() != this->TetrahedraBindTime;
     this->TetrahedraPoints = nullptr; // valid again once everything succeeded
     const vtkIdType nodes = static_cast<vtkIdType>(tetrahedra.GetDisplacements().size() / 3);
-    auto bind = [&] {
+    auto bind = [&]
+    {
       const std::vector<vtkIdType>& ids = tetrahedra.GetNodes();
       const std::vector<int> nodeIds(ids.begin(), ids.end());
       return this->Tetrahedra.Bind(tetrahedra.GetCellOfPoint().data(), tetrahedra.GetFrames().data(), nodeIds.data(),
         tetrahedra.GetNumberOfTetrahedra(), nodes);
     };
-    auto evaluate = [&](bool withNormals, bool withDeterminants) {
-      return this->Tetrahedra.Evaluate(tetrahedra.GetDisplacements().data(), nodes, withNormals, withDeterminants);
-    };
-    if (!Run(this->Tetrahedra, this->TetrahedraNormals, uploadPoints, rebind, points, normals, outPoints,
-          outNormals, outDeterminants, bind, evaluate))
+    auto evaluate = [&](bool withNormals, bool withDeterminants)
+    { return this->Tetrahedra.Evaluate(tetrahedra.GetDisplacements().data(), nodes, withNormals, withDeterminants); };
+    if (!Run(this->Tetrahedra, this->TetrahedraNormals, uploadPoints, rebind, points, normals, outPoints, outNormals,
+          outDeterminants, bind, evaluate))
     {
       return false;
     }
@@ -210,10 +208,12 @@ bool vtkFFDCudaBackend::Deform(const vtkFFDBindingKey& key, vtkPoints* points, v
 {
   bound = false;
 #ifdef VOXELFFD_HAS_CUDA
-  const bool ok = vtkState::WithOutputs(outPoints, outDeterminants, [&](auto* out, auto* determinants) {
-    return this->State->RunGrid(
-      key, points, normals, displacements, controlPoints, out, outNormals, determinants, bound);
-  });
+  const bool ok = vtkState::WithOutputs(outPoints, outDeterminants,
+    [&](auto* out, auto* determinants)
+    {
+      return this->State->RunGrid(
+        key, points, normals, displacements, controlPoints, out, outNormals, determinants, bound);
+    });
   if (!ok)
   {
     why = this->State->Grid.GetLastError();
@@ -238,9 +238,9 @@ bool vtkFFDCudaBackend::DeformTetrahedra(const vtkFFDTetrahedralDeformer& tetrah
   std::string& why)
 {
 #ifdef VOXELFFD_HAS_CUDA
-  const bool ok = vtkState::WithOutputs(outPoints, outDeterminants, [&](auto* out, auto* determinants) {
-    return this->State->RunTetrahedra(tetrahedra, points, normals, out, outNormals, determinants);
-  });
+  const bool ok = vtkState::WithOutputs(outPoints, outDeterminants,
+    [&](auto* out, auto* determinants)
+    { return this->State->RunTetrahedra(tetrahedra, points, normals, out, outNormals, determinants); });
   if (!ok)
   {
     why = this->State->Tetrahedra.GetLastError();

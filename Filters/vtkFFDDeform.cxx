@@ -76,7 +76,8 @@ vtkSmartPointer<vtkDataArray> OutputArray(const KeptArrays& kept, vtkDataArray* 
   }
   const auto array = vtk::TakeSmartPointer(like->NewInstance());
   array->SetNumberOfComponents(components);
-  auto allocate = [&](auto* typed) {
+  auto allocate = [&](auto* typed)
+  {
     using Real = std::remove_pointer_t<decltype(typed->GetPointer(0))>;
     const vtkIdType values = tuples * components;
     const std::size_t bytes = (std::size_t(std::max<vtkIdType>(values, 1)) * sizeof(Real) + 63) / 64 * 64;
@@ -146,8 +147,7 @@ vtkTypeBool vtkFFDDeform::ProcessRequest(
 }
 
 //------------------------------------------------------------------------------------------------------------
-int vtkFFDDeform::RequestData(
-  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+int vtkFFDDeform::RequestData(vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkPointSet* input = vtkPointSet::GetData(inputVector[0]);
   vtkPointSet* lattice = vtkPointSet::GetData(inputVector[1]);
@@ -167,9 +167,8 @@ int vtkFFDDeform::RequestData(
     return 1;
   }
 
-  vtkUnstructuredGrid* tetrahedra = vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice)
-    ? vtkUnstructuredGrid::SafeDownCast(lattice)
-    : nullptr;
+  vtkUnstructuredGrid* tetrahedra =
+    vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice) ? vtkUnstructuredGrid::SafeDownCast(lattice) : nullptr;
   vtkInternals& internals = *this->Internals;
   const std::string problem =
     tetrahedra ? internals.Tetrahedra.SetLattice(tetrahedra) : internals.Grid.SetLattice(lattice);
@@ -187,8 +186,7 @@ int vtkFFDDeform::RequestData(
 
   vtkDataArray* normals = this->GetNormalsToTransform(input);
   this->MakeOutputArrays(points, normals);
-  const bool completed =
-    tetrahedra ? this->DeformByTetrahedra(points, normals) : this->DeformByGrid(points, normals);
+  const bool completed = tetrahedra ? this->DeformByTetrahedra(points, normals) : this->DeformByGrid(points, normals);
   if (completed) // else aborted: the output stays empty
   {
     this->FillOutput(input, output);
@@ -203,9 +201,9 @@ vtkDataArray* vtkFFDDeform::GetNormalsToTransform(vtkPointSet* input)
   const vtkIdType count = input->GetNumberOfPoints();
   if (normals && (normals->GetNumberOfComponents() != 3 || normals->GetNumberOfTuples() != count))
   {
-    vtkWarningMacro("The input's point normals have "
-      << normals->GetNumberOfTuples() << " tuples of " << normals->GetNumberOfComponents() << " components for "
-      << count << " points, not one of 3 per point; they are not transformed.");
+    vtkWarningMacro("The input's point normals have " << normals->GetNumberOfTuples() << " tuples of "
+                                                      << normals->GetNumberOfComponents() << " components for " << count
+                                                      << " points, not one of 3 per point; they are not transformed.");
     return nullptr;
   }
   return normals;
@@ -266,11 +264,13 @@ bool vtkFFDDeform::DeformByGrid(vtkPoints* points, vtkDataArray* normals)
   vtkFFDGridDeformer& grid = internals.Grid;
   const vtkFFDGridLattice& lattice = grid.GetLattice();
   bool rebound = false;
-  const bool onCuda = this->DeformedOnCuda([&](std::string& why) {
-    return internals.Cuda.Deform(grid.KeyOf(points, this->OutsidePolicy), points, normals,
-      lattice.Displacements.data(), vtkIdType(lattice.Displacements.size() / 3), internals.Points,
-      internals.Normals, internals.Determinants, rebound, why);
-  });
+  const bool onCuda = this->DeformedOnCuda(
+    [&](std::string& why)
+    {
+      return internals.Cuda.Deform(grid.KeyOf(points, this->OutsidePolicy), points, normals,
+        lattice.Displacements.data(), vtkIdType(lattice.Displacements.size() / 3), internals.Points, internals.Normals,
+        internals.Determinants, rebound, why);
+    });
   this->NumberOfBindings += rebound ? 1 : 0; // on the device, also where it failed after binding
   if (onCuda)
   {
@@ -306,18 +306,19 @@ bool vtkFFDDeform::DeformByTetrahedra(vtkPoints* points, vtkDataArray* normals)
     ++this->NumberOfBindings;
     if (tetrahedra.GetNumberOfDegenerateTetrahedra() > 0)
     {
-      vtkWarningMacro(<< tetrahedra.GetNumberOfDegenerateTetrahedra() << " of "
-                      << tetrahedra.GetNumberOfTetrahedra()
+      vtkWarningMacro(<< tetrahedra.GetNumberOfDegenerateTetrahedra() << " of " << tetrahedra.GetNumberOfTetrahedra()
                       << " tetrahedra of the lattice have no volume (the first is cell "
                       << tetrahedra.GetFirstDegenerateTetrahedron()
                       << "); they are skipped: points in them are bound to a neighbour or follow the "
                          "outside policy.");
     }
   }
-  if (this->DeformedOnCuda([&](std::string& why) {
-        return internals.Cuda.DeformTetrahedra(
-          tetrahedra, points, normals, internals.Points, internals.Normals, internals.Determinants, why);
-      }))
+  if (this->DeformedOnCuda(
+        [&](std::string& why)
+        {
+          return internals.Cuda.DeformTetrahedra(
+            tetrahedra, points, normals, internals.Points, internals.Normals, internals.Determinants, why);
+        }))
   {
     return true;
   }

@@ -51,8 +51,8 @@ struct vtkFFDDeformPointsFunctor
       }
       const Real n[3] = { Real(normal[0]), Real(normal[1]), Real(normal[2]) };
       Real m[3];
-      ffd::DeformBoundPoint<true>(this->Deformation, xr, this->CellOfPoint[id], out, n,
-        this->OutNormals ? m : nullptr, this->Determinants ? this->Determinants + id : nullptr);
+      ffd::DeformBoundPoint<true>(this->Deformation, xr, this->CellOfPoint[id], out, n, this->OutNormals ? m : nullptr,
+        this->Determinants ? this->Determinants + id : nullptr);
       if (this->OutNormals)
       {
         this->OutNormals->SetTuple3(id, m[0], m[1], m[2]);

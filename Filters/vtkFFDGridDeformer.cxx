@@ -75,14 +75,15 @@ std::string ReadLattice(vtkPointSet* lattice, vtkFFDGridLattice& view)
   {
     return "The lattice's FFDDivisions do not fit its FFDBasis: " + why;
   }
-  const vtkIdType expected = vtkIdType(view.ControlPointsPerAxis[0]) * view.ControlPointsPerAxis[1] * view.ControlPointsPerAxis[2];
+  const vtkIdType expected =
+    vtkIdType(view.ControlPointsPerAxis[0]) * view.ControlPointsPerAxis[1] * view.ControlPointsPerAxis[2];
   const vtkIdType count = lattice->GetNumberOfPoints();
   if (count != expected)
   {
     std::ostringstream msg;
-    msg << "The lattice has " << count << " points but its divisions " << view.Divisions[0] << "x"
-        << view.Divisions[1] << "x" << view.Divisions[2] << " and basis "
-        << vtkFFDBuildLattice::GetBasisAsString(basis) << " need " << expected << ".";
+    msg << "The lattice has " << count << " points but its divisions " << view.Divisions[0] << "x" << view.Divisions[1]
+        << "x" << view.Divisions[2] << " and basis " << vtkFFDBuildLattice::GetBasisAsString(basis) << " need "
+        << expected << ".";
     return msg.str();
   }
   vtkDataArray* rest = lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
@@ -130,9 +131,8 @@ struct BindFunctor
 struct BindWorker
 {
   template <typename PointArrayT>
-  void operator()(
-    PointArrayT* points, const BindSettings& settings, int* cells, vtkAlgorithm* self, double progressBegin,
-    double progressEnd, bool& completed)
+  void operator()(PointArrayT* points, const BindSettings& settings, int* cells, vtkAlgorithm* self,
+    double progressBegin, double progressEnd, bool& completed)
   {
     BindFunctor<PointArrayT> functor{ points, settings, cells };
     const vtkIdType n = points->GetNumberOfTuples();
@@ -147,9 +147,9 @@ struct BindWorker
 struct vtkFFDGridBinding
 {
   std::vector<int> CellOfPoint; // per input point: its cell (ffd::BindToGrid), -1 where it keeps its position
-  ffd::BlockCells Blocks;      // the cells of each block of points (ffd::ListBlockCells)
+  ffd::BlockCells Blocks;       // the cells of each block of points (ffd::ListBlockCells)
   ffd::GatheredPoints Gathered; // the points of blocks not deformed in place (ffd::ListGatheredPoints)
-  bool CellTable = false;      // evaluation from ffd::FillCellTable (ffd::WorthCellTable)
+  bool CellTable = false;       // evaluation from ffd::FillCellTable (ffd::WorthCellTable)
   // The gathered points' coordinates in their listed order (ffd::CopyGatheredPoints), in the precision of the
   // evaluations that needed them: copied from the input at the first, then read in order by every update.
   std::vector<float> ListedFloat;
@@ -167,9 +167,9 @@ struct vtkFFDGridBinding
     if (listed.size() != std::size_t(3 * count))
     {
       listed.resize(std::size_t(3 * count));
-      vtkSMPTools::For(0, count, vtkFFDGrain(count, 1.0), [&](vtkIdType begin, vtkIdType end) {
-        ffd::CopyGatheredPoints(inPoints, this->Gathered, begin, end, listed.data());
-      });
+      vtkSMPTools::For(0, count, vtkFFDGrain(count, 1.0),
+        [&](vtkIdType begin, vtkIdType end)
+        { ffd::CopyGatheredPoints(inPoints, this->Gathered, begin, end, listed.data()); });
     }
     return listed.data();
   }
@@ -211,8 +211,8 @@ struct LanesFunctor
     static const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
     if (this->GatheredPass)
     {
-      ffd::DeformGathered(level, this->Deformation, this->Listed, this->Binding.Gathered, this->OutPoints, begin,
-        end, this->Binding.template Staging<Real>());
+      ffd::DeformGathered(level, this->Deformation, this->Listed, this->Binding.Gathered, this->OutPoints, begin, end,
+        this->Binding.template Staging<Real>());
     }
     else
     {
@@ -252,7 +252,8 @@ struct EvaluateWorker
   template <typename PointArrayT>
   void operator()(PointArrayT* inPoints, const vtkFFDGridLattice& lattice, vtkFFDGridBinding& binding,
     vtkDataArray* inNormals, vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outPoints,
-    vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self, double progressBegin, double progressEnd, bool& completed)
+    vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self, double progressBegin, double progressEnd,
+    bool& completed)
   {
     const std::vector<Real> displacements(lattice.Displacements.begin(), lattice.Displacements.end());
     std::vector<Real> cellTable;
@@ -260,30 +261,35 @@ struct EvaluateWorker
     {
       const int cells = lattice.Divisions[0] * lattice.Divisions[1] * lattice.Divisions[2];
       cellTable.resize(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(lattice.Basis)));
-      vtkSMPTools::For(0, cells, 256, [&](int begin, int end) {
-        ffd::FillCellTable(
-          lattice.Basis, displacements.data(), lattice.Divisions, lattice.ControlPointsPerAxis, cellTable.data(), begin, end);
-      });
+      vtkSMPTools::For(0, cells, 256,
+        [&](int begin, int end)
+        {
+          ffd::FillCellTable(lattice.Basis, displacements.data(), lattice.Divisions, lattice.ControlPointsPerAxis,
+            cellTable.data(), begin, end);
+        });
     }
     // One instantiation per basis (ffd::WithStaticBasis); a local basis but the tricubic Bezier one also with
     // its cell table, where the binding chose one (ffd::WorthCellTable).
-    ffd::WithStaticBasis(lattice.Basis, [&](auto maxCount, auto basis) {
-      auto run = [&](auto withCellTable) {
-        this->Run<decltype(maxCount)::value, decltype(basis)::value, decltype(withCellTable)::value>(inPoints,
-          lattice, displacements.data(), cellTable.data(), binding, inNormals, outNormals, outPoints,
-          determinants, self, progressBegin, progressEnd, completed);
-      };
-      constexpr int Basis = decltype(basis)::value;
-      if constexpr (Basis != int(ffd::GridBasis::Bernstein) && Basis != int(ffd::GridBasis::TricubicBezier))
+    ffd::WithStaticBasis(lattice.Basis,
+      [&](auto maxCount, auto basis)
       {
-        if (binding.CellTable)
+        auto run = [&](auto withCellTable)
         {
-          run(std::true_type());
-          return;
+          this->Run<decltype(maxCount)::value, decltype(basis)::value, decltype(withCellTable)::value>(inPoints,
+            lattice, displacements.data(), cellTable.data(), binding, inNormals, outNormals, outPoints, determinants,
+            self, progressBegin, progressEnd, completed);
+        };
+        constexpr int Basis = decltype(basis)::value;
+        if constexpr (Basis != int(ffd::GridBasis::Bernstein) && Basis != int(ffd::GridBasis::TricubicBezier))
+        {
+          if (binding.CellTable)
+          {
+            run(std::true_type());
+            return;
+          }
         }
-      }
-      run(std::false_type());
-    });
+        run(std::false_type());
+      });
   }
 
   template <int MaxCount, int StaticBasis, bool WithCellTable, typename PointArrayT>
@@ -293,10 +299,9 @@ struct EvaluateWorker
     double progressBegin, double progressEnd, bool& completed)
   {
     using Deformation = ffd::GridDeformation<MaxCount, Real, StaticBasis, Real, WithCellTable>;
-    const Deformation deformation{ lattice.Basis,
-      { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] },
-      { lattice.ControlPointsPerAxis[0], lattice.ControlPointsPerAxis[1], lattice.ControlPointsPerAxis[2] }, displacements,
-      ffd::Frame<Real>::FromArray(lattice.Frame), cellTable };
+    const Deformation deformation{ lattice.Basis, { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] },
+      { lattice.ControlPointsPerAxis[0], lattice.ControlPointsPerAxis[1], lattice.ControlPointsPerAxis[2] },
+      displacements, ffd::Frame<Real>::FromArray(lattice.Frame), cellTable };
     const vtkIdType n = inPoints->GetNumberOfTuples();
     // The work of a point: the control points it reads, and 16 for its parameters and output.
     double reads = 1.0;
@@ -329,8 +334,8 @@ struct EvaluateWorker
       NormalArray* normalsOut = NormalArray::FastDownCast(outNormals);
       if (!inNormals || (normalsIn && normalsOut))
       {
-        JacobianFunctor<Deformation, Real> jacobian{ inPoints->GetPointer(0), outPoints->GetPointer(0), binding,
-          n, normalsIn ? normalsIn->GetPointer(0) : nullptr, normalsOut ? normalsOut->GetPointer(0) : nullptr,
+        JacobianFunctor<Deformation, Real> jacobian{ inPoints->GetPointer(0), outPoints->GetPointer(0), binding, n,
+          normalsIn ? normalsIn->GetPointer(0) : nullptr, normalsOut ? normalsOut->GetPointer(0) : nullptr,
           determinants ? determinants->GetPointer(0) : nullptr, deformation };
         completed = vtkFFDForInChunks(
           self, (n + ffd::BlockSize - 1) / ffd::BlockSize, blockGrain, jacobian, progressBegin, progressEnd);
@@ -338,8 +343,8 @@ struct EvaluateWorker
       }
     }
     completed = vtkFFDDeformPoints(inPoints, binding.CellOfPoint.data(), deformation, inNormals, outNormals,
-      outPoints->GetPointer(0), determinants ? determinants->GetPointer(0) : nullptr, self, pointGrain,
-      progressBegin, progressEnd);
+      outPoints->GetPointer(0), determinants ? determinants->GetPointer(0) : nullptr, self, pointGrain, progressBegin,
+      progressEnd);
   }
 };
 } // namespace
@@ -384,8 +389,8 @@ bool vtkFFDGridDeformer::Bind(
     { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] }, key.ClampsOutside() };
   bool completed = false;
   BindWorker bind;
-  if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(points->GetData(), bind, settings,
-        binding.CellOfPoint.data(), self, progressBegin, progressEnd, completed))
+  if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(
+        points->GetData(), bind, settings, binding.CellOfPoint.data(), self, progressBegin, progressEnd, completed))
   {
     bind(points->GetData(), settings, binding.CellOfPoint.data(), self, progressBegin, progressEnd, completed);
   }
@@ -400,8 +405,7 @@ bool vtkFFDGridDeformer::Bind(
   }
   const int* cells = binding.CellOfPoint.data();
   binding.CellTable = ffd::WorthCellTable(lattice.Basis, cellCount, n);
-  const int maxCellsInPlace =
-    ffd::MaxCellsInPlace(lattice.Basis, ffd::MeanCellsPerBlock(cells, n), binding.CellTable);
+  const int maxCellsInPlace = ffd::MaxCellsInPlace(lattice.Basis, ffd::MeanCellsPerBlock(cells, n), binding.CellTable);
   binding.Blocks = ffd::ListBlockCells(cells, n, maxCellsInPlace);
   binding.Gathered = ffd::ListGatheredPoints(cells, n, cellCount, maxCellsInPlace);
   binding.ListedFloat.clear();
@@ -413,11 +417,11 @@ bool vtkFFDGridDeformer::Bind(
 
 //------------------------------------------------------------------------------------------------------------
 bool vtkFFDGridDeformer::Evaluate(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints,
-  vtkDataArray* outNormals, vtkDataArray* outDeterminants, vtkAlgorithm* self, double progressBegin,
-  double progressEnd)
+  vtkDataArray* outNormals, vtkDataArray* outDeterminants, vtkAlgorithm* self, double progressBegin, double progressEnd)
 {
   bool completed = false;
-  auto evaluate = [&](auto* out) {
+  auto evaluate = [&](auto* out)
+  {
     using RealArray = std::remove_pointer_t<decltype(out)>;
     using Real = typename RealArray::ValueType;
     EvaluateWorker<Real> worker;

@@ -62,8 +62,8 @@ public:
    * goes to `self` from `progressBegin` to `progressEnd`. Returns false when aborted (the binding is then
    * dropped); `rebound` tells whether it bound.
    */
-  bool Bind(vtkPoints* points, int outsidePolicy, vtkAlgorithm* self, double progressBegin, double progressEnd,
-    bool& rebound);
+  bool Bind(
+    vtkPoints* points, int outsidePolicy, vtkAlgorithm* self, double progressBegin, double progressEnd, bool& rebound);
 
   /**
    * Deforms the bound points into outPoints (a float or double AOS array of their count), with the normals

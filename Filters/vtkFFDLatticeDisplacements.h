@@ -9,8 +9,8 @@
 #include "vtkArrayDispatch.h"
 #include "vtkDataArray.h"
 #include "vtkDataArrayRange.h"
-#include "vtkPoints.h"
 #include "vtkPointSet.h"
+#include "vtkPoints.h"
 #include "vtkSMPTools.h"
 
 #include <atomic>
@@ -38,33 +38,36 @@ inline vtkIdType vtkFFDReadLatticeDisplacements(
   std::atomic<vtkIdType> firstNotFinite(count);
   // Read through the arrays' own types where they are float or double (vtkArrayDispatch): vtkDataArray's
   // virtual tuple access is a noticeable part of an update's fixed cost.
-  auto read = [&](auto* points, auto* restPositions) {
+  auto read = [&](auto* points, auto* restPositions)
+  {
     const auto x = vtk::DataArrayTupleRange<3>(points);
     const auto x0 = vtk::DataArrayTupleRange<3>(restPositions);
     // In parallel: a lattice of 100 k nodes, read serially, would hold up every update by a millisecond; in
     // tasks of at least 4096 nodes, so that a small lattice is read in one.
-    vtkSMPTools::For(0, count, 4096, [&](vtkIdType begin, vtkIdType end) {
-      for (vtkIdType p = begin; p < end; ++p)
+    vtkSMPTools::For(0, count, 4096,
+      [&](vtkIdType begin, vtkIdType end)
       {
-        for (int c = 0; c < 3; ++c)
+        for (vtkIdType p = begin; p < end; ++p)
         {
-          const double rest0 = double(x0[p][c]);
-          const double d = double(x[p][c]) - rest0;
-          if (!std::isfinite(d))
+          for (int c = 0; c < 3; ++c)
           {
-            vtkIdType first = firstNotFinite.load();
-            while (p < first && !firstNotFinite.compare_exchange_weak(first, p))
+            const double rest0 = double(x0[p][c]);
+            const double d = double(x[p][c]) - rest0;
+            if (!std::isfinite(d))
             {
+              vtkIdType first = firstNotFinite.load();
+              while (p < first && !firstNotFinite.compare_exchange_weak(first, p))
+              {
+              }
+            }
+            displacements[3 * p + c] = d;
+            if (restValues)
+            {
+              (*restValues)[3 * p + c] = rest0;
             }
           }
-          displacements[3 * p + c] = d;
-          if (restValues)
-          {
-            (*restValues)[3 * p + c] = rest0;
-          }
         }
-      }
-    });
+      });
   };
   vtkDataArray* points = lattice->GetPoints()->GetData();
   if (!vtkArrayDispatch::Dispatch2ByValueType<vtkArrayDispatch::Reals, vtkArrayDispatch::Reals>::Execute(

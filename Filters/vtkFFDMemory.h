@@ -35,7 +35,8 @@
  */
 inline double vtkFFDAvailableMemory()
 {
-  auto readNumber = [](const char* path, const char* format, double& value) {
+  auto readNumber = [](const char* path, const char* format, double& value)
+  {
     FILE* file = std::fopen(path, "r");
     if (!file)
     {

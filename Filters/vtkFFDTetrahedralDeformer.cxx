@@ -46,8 +46,8 @@ struct EvaluateWorker
   {
     const vtkIdType n = inPoints->GetNumberOfTuples();
     // A point reads its tetrahedron's affine map (12 numbers) and applies it.
-    completed = vtkFFDDeformPoints(inPoints, cells, ffd::TetrahedralDeformation<Real>{ maps }, inNormals,
-      outNormals, outPoints, determinants, self, vtkFFDGrain(n, 8.0), progressBegin, progressEnd);
+    completed = vtkFFDDeformPoints(inPoints, cells, ffd::TetrahedralDeformation<Real>{ maps }, inNormals, outNormals,
+      outPoints, determinants, self, vtkFFDGrain(n, 8.0), progressBegin, progressEnd);
   }
 };
 } // namespace
@@ -93,8 +93,7 @@ std::string vtkFFDTetrahedralDeformer::SetLattice(vtkUnstructuredGrid* lattice)
     return "The tetrahedral lattice has no RestPosition point array of 3 components per point." + fix;
   }
   this->RestPositions = rest;
-  const vtkIdType notFinite =
-    vtkFFDReadLatticeDisplacements(lattice, rest, this->Displacements, &this->RestValues);
+  const vtkIdType notFinite = vtkFFDReadLatticeDisplacements(lattice, rest, this->Displacements, &this->RestValues);
   if (notFinite >= 0)
   {
     return "Tetrahedral lattice point " + std::to_string(notFinite) + " or its RestPosition is not finite.";
@@ -108,8 +107,8 @@ std::string vtkFFDTetrahedralDeformer::SetLattice(vtkUnstructuredGrid* lattice)
   // or its arrays edited in place (vtkCellArray's time does not follow theirs), or the count of nodes its ids
   // must stay below.
   vtkCellArray* cells = lattice->GetCells();
-  const vtkMTimeType cellsTime = std::max(
-    { cells->GetMTime(), cells->GetConnectivityArray()->GetMTime(), cells->GetOffsetsArray()->GetMTime() });
+  const vtkMTimeType cellsTime =
+    std::max({ cells->GetMTime(), cells->GetConnectivityArray()->GetMTime(), cells->GetOffsetsArray()->GetMTime() });
   if (cells != this->NodesSource || cellsTime != this->NodesSourceMTime ||
     numberOfNodes != this->NodesSourceNodeCount || this->Nodes.size() != static_cast<size_t>(4 * numberOfCells))
   {
@@ -151,8 +150,8 @@ std::string vtkFFDTetrahedralDeformer::SetLattice(vtkUnstructuredGrid* lattice)
 }
 
 //------------------------------------------------------------------------------------------------------------
-bool vtkFFDTetrahedralDeformer::Bind(vtkPoints* points, int outsidePolicy, vtkAlgorithm* self,
-  double progressBegin, double progressEnd, bool& rebound)
+bool vtkFFDTetrahedralDeformer::Bind(
+  vtkPoints* points, int outsidePolicy, vtkAlgorithm* self, double progressBegin, double progressEnd, bool& rebound)
 {
   rebound = false;
   const vtkFFDBindingKey key = vtkFFDBindingKey::Of(points, outsidePolicy);
@@ -194,22 +193,24 @@ void vtkFFDTetrahedralDeformer::ComputeRestFrames()
   const vtkIdType numberOfTetrahedra = static_cast<vtkIdType>(this->Nodes.size() / 4);
   this->Frames.resize(numberOfTetrahedra);
   this->Degenerate.assign(numberOfTetrahedra, 0);
-  vtkSMPTools::For(0, numberOfTetrahedra, [this](vtkIdType begin, vtkIdType end) {
-    for (vtkIdType t = begin; t < end; ++t)
+  vtkSMPTools::For(0, numberOfTetrahedra,
+    [this](vtkIdType begin, vtkIdType end)
     {
-      const double* corner[4];
-      for (int i = 0; i < 4; ++i)
+      for (vtkIdType t = begin; t < end; ++t)
       {
-        corner[i] = this->RestValues.data() + 3 * this->Nodes[4 * t + i];
+        const double* corner[4];
+        for (int i = 0; i < 4; ++i)
+        {
+          corner[i] = this->RestValues.data() + 3 * this->Nodes[4 * t + i];
+        }
+        if (ffd::CheckTetrahedron(corner[0], corner[1], corner[2], corner[3]) != ffd::FrameStatus::Valid)
+        {
+          this->Degenerate[t] = 1;
+          continue;
+        }
+        this->Frames[t] = ffd::TetrahedronFrame(corner[0], corner[1], corner[2], corner[3]);
       }
-      if (ffd::CheckTetrahedron(corner[0], corner[1], corner[2], corner[3]) != ffd::FrameStatus::Valid)
-      {
-        this->Degenerate[t] = 1;
-        continue;
-      }
-      this->Frames[t] = ffd::TetrahedronFrame(corner[0], corner[1], corner[2], corner[3]);
-    }
-  });
+    });
   this->NumberOfDegenerate = std::count(this->Degenerate.begin(), this->Degenerate.end(), 1);
   const auto first = std::find(this->Degenerate.begin(), this->Degenerate.end(), 1);
   this->FirstDegenerate = first == this->Degenerate.end() ? -1 : first - this->Degenerate.begin();
@@ -229,7 +230,8 @@ bool vtkFFDTetrahedralDeformer::WalkPoints(vtkPoints* points, const vtkFFDTetrah
     return true;
   }
   int* cells = this->CellOfPoint.data();
-  auto walk = [points, &locator, cells](vtkIdType begin, vtkIdType end) {
+  auto walk = [points, &locator, cells](vtkIdType begin, vtkIdType end)
+  {
     for (vtkIdType id = begin; id < end; ++id)
     {
       double x[3];
@@ -248,8 +250,8 @@ bool vtkFFDTetrahedralDeformer::WalkPoints(vtkPoints* points, const vtkFFDTetrah
 
 //------------------------------------------------------------------------------------------------------------
 // The Undecided points' tetrahedra by VTK's locator, or Outside.
-bool vtkFFDTetrahedralDeformer::LocateUndecidedPoints(vtkPoints* points, vtkFFDTetrahedronLocator& locator,
-  vtkAlgorithm* self, double progressBegin, double progressEnd)
+bool vtkFFDTetrahedralDeformer::LocateUndecidedPoints(
+  vtkPoints* points, vtkFFDTetrahedronLocator& locator, vtkAlgorithm* self, double progressBegin, double progressEnd)
 {
   std::vector<vtkIdType> undecided;
   for (vtkIdType id = 0; id < static_cast<vtkIdType>(this->CellOfPoint.size()); ++id)
@@ -265,7 +267,8 @@ bool vtkFFDTetrahedralDeformer::LocateUndecidedPoints(vtkPoints* points, vtkFFDT
   }
   locator.BuildCellLocator();
   int* cells = this->CellOfPoint.data();
-  auto locate = [points, &locator, &undecided, cells](vtkIdType begin, vtkIdType end) {
+  auto locate = [points, &locator, &undecided, cells](vtkIdType begin, vtkIdType end)
+  {
     for (vtkIdType u = begin; u < end; ++u)
     {
       double x[3];
@@ -356,21 +359,23 @@ void vtkFFDTetrahedralDeformer::ComputeMaps(std::vector<ffd::TetrahedronMap<Real
 {
   // Only the tetrahedra some point is bound to: the others' maps are never read.
   maps.resize(this->Frames.size());
-  vtkSMPTools::For(0, static_cast<vtkIdType>(this->Used.size()), [&](vtkIdType begin, vtkIdType end) {
-    for (vtkIdType u = begin; u < end; ++u)
+  vtkSMPTools::For(0, static_cast<vtkIdType>(this->Used.size()),
+    [&](vtkIdType begin, vtkIdType end)
     {
-      maps[this->Used[u]] = this->Map(this->Used[u]).template As<Real>();
-    }
-  });
+      for (vtkIdType u = begin; u < end; ++u)
+      {
+        maps[this->Used[u]] = this->Map(this->Used[u]).template As<Real>();
+      }
+    });
 }
 
 //------------------------------------------------------------------------------------------------------------
 bool vtkFFDTetrahedralDeformer::Evaluate(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints,
-  vtkDataArray* outNormals, vtkDataArray* outDeterminants, vtkAlgorithm* self, double progressBegin,
-  double progressEnd)
+  vtkDataArray* outNormals, vtkDataArray* outDeterminants, vtkAlgorithm* self, double progressBegin, double progressEnd)
 {
   bool completed = false;
-  auto evaluate = [&](auto realTag) {
+  auto evaluate = [&](auto realTag)
+  {
     using Real = decltype(realTag);
     using RealArray = vtkAOSDataArrayTemplate<Real>;
     std::vector<ffd::TetrahedronMap<Real>>& maps = this->MapsIn(Real());
@@ -402,8 +407,8 @@ bool vtkFFDTetrahedralDeformer::Evaluate(vtkPoints* points, vtkDataArray* normal
 }
 
 //------------------------------------------------------------------------------------------------------------
-void vtkFFDTetrahedralDeformer::ApplyClampedPoints(vtkPoints* points, vtkDataArray* normals,
-  vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants) const
+void vtkFFDTetrahedralDeformer::ApplyClampedPoints(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints,
+  vtkDataArray* outNormals, vtkDataArray* outDeterminants) const
 {
   for (const ClampedPoint& p : this->Clamped)
   {

@@ -83,8 +83,8 @@ public:
    * `progressBegin` to `progressEnd`. Returns false when aborted (the binding is then dropped); `rebound` tells
    * whether it bound.
    */
-  bool Bind(vtkPoints* points, int outsidePolicy, vtkAlgorithm* self, double progressBegin, double progressEnd,
-    bool& rebound);
+  bool Bind(
+    vtkPoints* points, int outsidePolicy, vtkAlgorithm* self, double progressBegin, double progressEnd, bool& rebound);
 
   /**
    * Deforms the bound points into outPoints (a float or double AOS array of their count), with the normals
@@ -99,8 +99,8 @@ public:
    * there, in double precision, over what the evaluation wrote for them (their position): the last step of
    * Evaluate(), and of the CUDA backend's evaluation, on the host. Arguments as Evaluate()'s.
    */
-  void ApplyClampedPoints(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints,
-    vtkDataArray* outNormals, vtkDataArray* outDeterminants) const;
+  void ApplyClampedPoints(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals,
+    vtkDataArray* outDeterminants) const;
 
   ///@{
   /// The binding: per point its tetrahedron (-1: keeps its position, or clamped, see above); per tetrahedron its
@@ -122,7 +122,6 @@ public:
   vtkIdType GetFirstDegenerateTetrahedron() const { return this->FirstDegenerate; }
   ///@}
 
-
 private:
   /// A point outside the control mesh clamped to it: it moves by the displacement of its nearest point there.
   struct ClampedPoint
@@ -142,10 +141,10 @@ private:
   ///@{
   /// The steps of Bind(). The walks and VTK's locator return false when aborted.
   void ComputeRestFrames();
-  bool WalkPoints(vtkPoints* points, const vtkFFDTetrahedronLocator& locator, vtkAlgorithm* self,
-    double progressBegin, double progressEnd);
-  bool LocateUndecidedPoints(vtkPoints* points, vtkFFDTetrahedronLocator& locator, vtkAlgorithm* self,
-    double progressBegin, double progressEnd);
+  bool WalkPoints(vtkPoints* points, const vtkFFDTetrahedronLocator& locator, vtkAlgorithm* self, double progressBegin,
+    double progressEnd);
+  bool LocateUndecidedPoints(
+    vtkPoints* points, vtkFFDTetrahedronLocator& locator, vtkAlgorithm* self, double progressBegin, double progressEnd);
   void ApplyOutsidePolicy(vtkPoints* points, int outsidePolicy, vtkFFDTetrahedronLocator& locator);
   void ListUsedTetrahedra();
   ///@}

@@ -110,8 +110,8 @@ void vtkFFDTetrahedronLocator::MakeSeeds(const std::vector<double>& rest)
     this->SeedSpacing[a] = std::max(hi[a] - lo[a], std::numeric_limits<double>::min()) / size;
   }
   this->Seeds.resize(static_cast<size_t>(size) * size * size);
-  int previous = static_cast<int>(
-    std::find(this->Degenerate.begin(), this->Degenerate.end(), 0) - this->Degenerate.begin());
+  int previous =
+    static_cast<int>(std::find(this->Degenerate.begin(), this->Degenerate.end(), 0) - this->Degenerate.begin());
   for (int k = 0, index = 0; k < size; ++k)
   {
     for (int j = 0; j < size; ++j)

@@ -70,20 +70,22 @@ struct OrientedBox
   /// Grows the box around every finite point, in the box's axes. Serial, so the result is deterministic.
   void Enclose(vtkDataArray* points)
   {
-    WithPointRange(points, [this](auto range) {
-      for (const auto p : range)
+    WithPointRange(points,
+      [this](auto range)
       {
-        if (!IsFinite(p))
+        for (const auto p : range)
         {
-          continue;
+          if (!IsFinite(p))
+          {
+            continue;
+          }
+          const Eigen::Vector3d x(p[0], p[1], p[2]);
+          const Eigen::Vector3d local = this->Axes.transpose() * (x - this->Anchor);
+          this->Min = this->Min.cwiseMin(local);
+          this->Max = this->Max.cwiseMax(local);
+          ++this->Count;
         }
-        const Eigen::Vector3d x(p[0], p[1], p[2]);
-        const Eigen::Vector3d local = this->Axes.transpose() * (x - this->Anchor);
-        this->Min = this->Min.cwiseMin(local);
-        this->Max = this->Max.cwiseMax(local);
-        ++this->Count;
-      }
-    });
+      });
   }
 
   /// Writes the frame of the box grown by `padding` times its largest extent on every side.
@@ -110,32 +112,36 @@ bool PrincipalAxes(vtkDataArray* points, Eigen::Vector3d& mean, Eigen::Matrix3d&
 {
   mean.setZero();
   vtkIdType count = 0;
-  WithPointRange(points, [&](auto range) {
-    for (const auto p : range)
+  WithPointRange(points,
+    [&](auto range)
     {
-      if (IsFinite(p))
+      for (const auto p : range)
       {
-        mean += Eigen::Vector3d(p[0], p[1], p[2]);
-        ++count;
+        if (IsFinite(p))
+        {
+          mean += Eigen::Vector3d(p[0], p[1], p[2]);
+          ++count;
+        }
       }
-    }
-  });
+    });
   if (count == 0)
   {
     return false;
   }
   mean /= static_cast<double>(count);
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  WithPointRange(points, [&](auto range) {
-    for (const auto p : range)
+  WithPointRange(points,
+    [&](auto range)
     {
-      if (IsFinite(p))
+      for (const auto p : range)
       {
-        const Eigen::Vector3d d = Eigen::Vector3d(p[0], p[1], p[2]) - mean;
-        covariance.noalias() += d * d.transpose();
+        if (IsFinite(p))
+        {
+          const Eigen::Vector3d d = Eigen::Vector3d(p[0], p[1], p[2]) - mean;
+          covariance.noalias() += d * d.transpose();
+        }
       }
-    }
-  });
+    });
   covariance /= static_cast<double>(count);
 
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
@@ -216,8 +222,7 @@ int vtkFFDVoxelize::FillInputPortInformation(int, vtkInformation* info)
 }
 
 //------------------------------------------------------------------------------
-int vtkFFDVoxelize::RequestInformation(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+int vtkFFDVoxelize::RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   const int* n = this->Divisions;
   if (n[0] < 1 || n[1] < 1 || n[2] < 1)
@@ -240,8 +245,7 @@ vtkTypeBool vtkFFDVoxelize::ProcessRequest(
 }
 
 //------------------------------------------------------------------------------
-int vtkFFDVoxelize::RequestData(
-  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkPointSet* input = vtkPointSet::GetData(inputVector[0]);
   vtkStructuredGrid* output = vtkStructuredGrid::GetData(outputVector);
@@ -257,8 +261,8 @@ int vtkFFDVoxelize::RequestData(
   // each input point takes 12 bytes meanwhile.
   const double voxelCount = double(nx) * ny * nz, cornerCount = (nx + 1.0) * (ny + 1.0) * (nz + 1.0);
   std::ostringstream request;
-  request << "Divisions (" << nx << ", " << ny << ", " << nz << "): a voxel grid of " << voxelCount
-          << " voxels and " << cornerCount << " corner points";
+  request << "Divisions (" << nx << ", " << ny << ", " << nz << "): a voxel grid of " << voxelCount << " voxels and "
+          << cornerCount << " corner points";
   if (!vtkFFDCheckMemory(this, request.str(), 24.0 * cornerCount + voxelCount + 12.0 * double(numPoints)))
   {
     return 0;
@@ -306,8 +310,7 @@ int vtkFFDVoxelize::RequestData(
                     << " frame has a NaN or infinite component: give SetFrame() finite numbers.");
       return 0;
     case ffd::FrameStatus::ZeroVolume:
-      vtkErrorMacro(<< "The " << this->GetFrameModeAsString()
-                    << " frame has (nearly) zero volume: "
+      vtkErrorMacro(<< "The " << this->GetFrameModeAsString() << " frame has (nearly) zero volume: "
                     << (this->FrameMode == EXPLICIT
                            ? "give SetFrame() three linearly independent edge vectors S, T, U."
                            : "the input is flat; set a Padding above 0 or an explicit frame."));
@@ -326,27 +329,31 @@ int vtkFFDVoxelize::RequestData(
   // belongs to the last voxel.
   std::vector<VoxelIndex> voxels(static_cast<size_t>(numPoints));
   const ffd::Frame<double> bound = ffd::Frame<double>::FromArray(frame);
-  WithPointRange(points, [&](auto range) {
-    vtkSMPTools::For(0, numPoints, [&](vtkIdType begin, vtkIdType end) {
-      for (vtkIdType id = begin; id < end; ++id)
-      {
-        const auto p = range[id];
-        const ffd::Vec3<double> x{ static_cast<double>(p[0]), static_cast<double>(p[1]),
-          static_cast<double>(p[2]) };
-        ffd::Vec3<double> stu;
-        VoxelIndex& v = voxels[id];
-        if (!bound.Bind(x, stu))
+  WithPointRange(points,
+    [&](auto range)
+    {
+      vtkSMPTools::For(0, numPoints,
+        [&](vtkIdType begin, vtkIdType end)
         {
-          v = { -1, -1, -1 };
-          continue;
-        }
-        v = { std::min(static_cast<int>(stu.x * nx), nx - 1), std::min(static_cast<int>(stu.y * ny), ny - 1),
-          std::min(static_cast<int>(stu.z * nz), nz - 1) };
-      }
+          for (vtkIdType id = begin; id < end; ++id)
+          {
+            const auto p = range[id];
+            const ffd::Vec3<double> x{ static_cast<double>(p[0]), static_cast<double>(p[1]),
+              static_cast<double>(p[2]) };
+            ffd::Vec3<double> stu;
+            VoxelIndex& v = voxels[id];
+            if (!bound.Bind(x, stu))
+            {
+              v = { -1, -1, -1 };
+              continue;
+            }
+            v = { std::min(static_cast<int>(stu.x * nx), nx - 1), std::min(static_cast<int>(stu.y * ny), ny - 1),
+              std::min(static_cast<int>(stu.z * nz), nz - 1) };
+          }
+        });
     });
-  });
-  voxels.erase(std::remove_if(voxels.begin(), voxels.end(), [](const VoxelIndex& v) { return v[0] < 0; }),
-    voxels.end());
+  voxels.erase(
+    std::remove_if(voxels.begin(), voxels.end(), [](const VoxelIndex& v) { return v[0] < 0; }), voxels.end());
   this->UpdateProgress(0.4);
   if (this->GetAbortExecute())
   {
@@ -385,15 +392,17 @@ int vtkFFDVoxelize::RequestData(
   corners->SetDataTypeToDouble();
   corners->SetNumberOfPoints(numCorners);
   vtkDoubleArray* cornerArray = vtkDoubleArray::SafeDownCast(corners->GetData());
-  vtkSMPTools::For(0, numCorners, [&](vtkIdType begin, vtkIdType end) {
-    for (vtkIdType id = begin; id < end; ++id)
+  vtkSMPTools::For(0, numCorners,
+    [&](vtkIdType begin, vtkIdType end)
     {
-      const vtkIdType i = id % cx, j = (id / cx) % cy, k = id / (cx * cy);
-      const ffd::Vec3<double> x =
-        bound.ToWorld({ static_cast<double>(i) / nx, static_cast<double>(j) / ny, static_cast<double>(k) / nz });
-      cornerArray->SetTypedTuple(id, &x.x);
-    }
-  });
+      for (vtkIdType id = begin; id < end; ++id)
+      {
+        const vtkIdType i = id % cx, j = (id / cx) % cy, k = id / (cx * cy);
+        const ffd::Vec3<double> x =
+          bound.ToWorld({ static_cast<double>(i) / nx, static_cast<double>(j) / ny, static_cast<double>(k) / nz });
+        cornerArray->SetTypedTuple(id, &x.x);
+      }
+    });
   output->SetExtent(0, nx, 0, ny, 0, nz);
   output->SetPoints(corners);
   output->GetCellData()->AddArray(ghosts);

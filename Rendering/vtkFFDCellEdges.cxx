@@ -67,7 +67,8 @@ int vtkFFDCellEdges::RequestData(
   // Unique edges, ordered by their point ids so that the output does not depend on hashing. A set is enough:
   // lattices and voxel grids have thousands of cells, not millions.
   std::set<std::pair<vtkIdType, vtkIdType>> edges;
-  auto addEdge = [&edges](vtkIdType a, vtkIdType b) {
+  auto addEdge = [&edges](vtkIdType a, vtkIdType b)
+  {
     if (a != b)
     {
       edges.emplace(std::min(a, b), std::max(a, b));

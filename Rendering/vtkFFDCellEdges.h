@@ -10,8 +10,8 @@
  * merged: two control points dragged onto each other keep their own edges.
  *
  * It works for any cell type with edges (hexahedra of a structured lattice or voxel grid, tetrahedra of an
- * unstructured lattice); polylines give their segments; vertices give nothing. Unlike vtkExtractEdges of VTK 9.1, it skips hidden
- * cells, which is the whole point for a voxel grid whose inactive voxels must not be drawn.
+ * unstructured lattice); polylines give their segments; vertices give nothing. Unlike vtkExtractEdges of VTK 9.1, it
+ * skips hidden cells, which is the whole point for a voxel grid whose inactive voxels must not be drawn.
  *
  * @sa vtkFFDLatticeActor vtkFFDVoxelize vtkExtractEdges
  */

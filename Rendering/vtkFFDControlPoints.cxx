@@ -62,18 +62,18 @@ int vtkFFDControlPoints::RequestData(
   if (active && (active->GetNumberOfComponents() != 1 || active->GetNumberOfTuples() != n))
   {
     vtkErrorMacro("The lattice's `" << vtkFFDDataContract::ActiveArrayName() << "` array has "
-                                     << active->GetNumberOfComponents() << " components and "
-                                     << active->GetNumberOfTuples() << " tuples; the data contract asks for one "
-                                     << "component per control point (" << n << ").");
+                                    << active->GetNumberOfComponents() << " components and "
+                                    << active->GetNumberOfTuples() << " tuples; the data contract asks for one "
+                                    << "component per control point (" << n << ").");
     return 0;
   }
   vtkDataArray* rest = pd->GetArray(vtkFFDDataContract::RestPositionArrayName());
   if (rest && (rest->GetNumberOfComponents() != 3 || rest->GetNumberOfTuples() != n))
   {
     vtkErrorMacro("The lattice's `" << vtkFFDDataContract::RestPositionArrayName() << "` array has "
-                                     << rest->GetNumberOfComponents() << " components and "
-                                     << rest->GetNumberOfTuples() << " tuples; the data contract asks for "
-                                     << "three components per control point (" << n << ").");
+                                    << rest->GetNumberOfComponents() << " components and " << rest->GetNumberOfTuples()
+                                    << " tuples; the data contract asks for "
+                                    << "three components per control point (" << n << ").");
     return 0;
   }
 
@@ -98,8 +98,7 @@ int vtkFFDControlPoints::RequestData(
     {
       double r[3];
       rest->GetTuple(id, r);
-      length = std::sqrt((x[0] - r[0]) * (x[0] - r[0]) + (x[1] - r[1]) * (x[1] - r[1]) +
-        (x[2] - r[2]) * (x[2] - r[2]));
+      length = std::sqrt((x[0] - r[0]) * (x[0] - r[0]) + (x[1] - r[1]) * (x[1] - r[1]) + (x[2] - r[2]) * (x[2] - r[2]));
     }
     points->InsertNextPoint(x);
     ids->InsertNextValue(id);

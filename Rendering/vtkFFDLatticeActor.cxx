@@ -275,8 +275,7 @@ void vtkFFDLatticeActor::PrintSelf(ostream& os, vtkIndent indent)
   vtkInternals& in = *this->Internals;
   os << indent << "Lattice: " << (in.HasLattice ? "set" : "(none)") << "\n";
   os << indent << "VoxelGrid: " << (in.HasVoxelGrid ? "set" : "(none)") << "\n";
-  os << indent << "PointRadius: " << this->PointRadius << (this->PointRadius > 0.0 ? "" : " (automatic)")
-     << "\n";
+  os << indent << "PointRadius: " << this->PointRadius << (this->PointRadius > 0.0 ? "" : " (automatic)") << "\n";
   os << indent << "RenderedPointRadius: " << in.Sphere->GetRadius() << "\n";
   os << indent << "ShowCulledPoints: " << (this->ShowCulledPoints ? "On" : "Off") << "\n";
   os << indent << "ShowEdges: " << (this->ShowEdges ? "On" : "Off") << "\n";

@@ -215,14 +215,13 @@ bool vtkFFDLatticeRepresentation::ResetLatticeToRest()
     return false;
   }
   const vtkIdType n = this->Lattice->GetNumberOfPoints();
-  vtkDataArray* rest =
-    this->Lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
+  vtkDataArray* rest = this->Lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
   if (!rest || rest->GetNumberOfComponents() != 3 || rest->GetNumberOfTuples() != n)
   {
     vtkErrorMacro("The lattice has no `" << vtkFFDDataContract::RestPositionArrayName()
-                                          << "` point array of 3 components per control point (" << n
-                                          << "), so its rest positions are unknown: build it with "
-                                          << "vtkFFDBuildLattice or add that array.");
+                                         << "` point array of 3 components per control point (" << n
+                                         << "), so its rest positions are unknown: build it with "
+                                         << "vtkFFDBuildLattice or add that array.");
     return false;
   }
   vtkPoints* points = this->Lattice->GetPoints();
@@ -342,8 +341,8 @@ void vtkFFDLatticeRepresentation::EndWidgetInteraction(double eventPosition[2])
 void vtkFFDLatticeRepresentation::BuildRepresentation()
 {
   vtkInternals& in = *this->Internals;
-  const bool stale = this->GetMTime() > this->BuildTime ||
-    (this->Lattice && this->Lattice->GetMTime() > this->BuildTime);
+  const bool stale =
+    this->GetMTime() > this->BuildTime || (this->Lattice && this->Lattice->GetMTime() > this->BuildTime);
   if (!stale)
   {
     return;

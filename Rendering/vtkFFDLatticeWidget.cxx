@@ -23,16 +23,15 @@ vtkFFDLatticeWidget::vtkFFDLatticeWidget()
     vtkWidgetEvent::Select, this, vtkFFDLatticeWidget::SelectAction);
   mapper->SetCallbackMethod(vtkCommand::LeftButtonPressEvent, vtkEvent::ShiftModifier, 0, 0, nullptr,
     vtkWidgetEvent::AddPoint, this, vtkFFDLatticeWidget::ToggleSelectAction);
-  mapper->SetCallbackMethod(
-    vtkCommand::MouseMoveEvent, vtkWidgetEvent::Move, this, vtkFFDLatticeWidget::MoveAction);
+  mapper->SetCallbackMethod(vtkCommand::MouseMoveEvent, vtkWidgetEvent::Move, this, vtkFFDLatticeWidget::MoveAction);
   mapper->SetCallbackMethod(vtkCommand::LeftButtonReleaseEvent, vtkEvent::AnyModifier, 0, 0, nullptr,
     vtkWidgetEvent::EndSelect, this, vtkFFDLatticeWidget::EndSelectAction);
   // Key presses, not characters: the interactor style acts on characters (CharEvent), and `x` and Escape are
   // none of its keys, so the two never fight.
   mapper->SetCallbackMethod(vtkCommand::KeyPressEvent, vtkEvent::AnyModifier, GetResetKey(), 0, "x",
     vtkWidgetEvent::Reset, this, vtkFFDLatticeWidget::ResetAction);
-  mapper->SetCallbackMethod(vtkCommand::KeyPressEvent, vtkEvent::AnyModifier, 27, 0, "Escape",
-    vtkWidgetEvent::Delete, this, vtkFFDLatticeWidget::ClearSelectionAction);
+  mapper->SetCallbackMethod(vtkCommand::KeyPressEvent, vtkEvent::AnyModifier, 27, 0, "Escape", vtkWidgetEvent::Delete,
+    this, vtkFFDLatticeWidget::ClearSelectionAction);
 }
 
 //------------------------------------------------------------------------------

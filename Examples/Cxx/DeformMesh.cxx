@@ -68,8 +68,7 @@ constexpr int ImageSize = 800;
 bool DeformLattice(vtkStructuredGrid* lattice)
 {
   double frame[12];
-  vtkDataArray* rest =
-    lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
+  vtkDataArray* rest = lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
   if (!vtkFFDDataContract::GetFrame(lattice, frame) || !rest)
   {
     std::cerr << "the lattice lacks its FFDFrame or RestPosition array\n";
@@ -211,8 +210,7 @@ int main(int argc, char* argv[])
   const std::filesystem::path outputDir = positional.size() > 1 ? positional[1] : DEFORMMESH_DEFAULT_OUTPUT;
   if (!std::filesystem::is_regular_file(meshPath))
   {
-    std::cerr << meshPath.string()
-              << " is missing: pass a .vtp file, or run Utilities/setup.sh to fetch the meshes\n";
+    std::cerr << meshPath.string() << " is missing: pass a .vtp file, or run Utilities/setup.sh to fetch the meshes\n";
     return EXIT_FAILURE;
   }
   const std::string name = meshPath.stem().string();
@@ -276,12 +274,10 @@ int main(int argc, char* argv[])
   }
   if (deform->GetNumberOfBindings() != 1)
   {
-    std::cerr << "expected one binding, got " << deform->GetNumberOfBindings()
-              << ": the binding cache did not hold\n";
+    std::cerr << "expected one binding, got " << deform->GetNumberOfBindings() << ": the binding cache did not hold\n";
     return EXIT_FAILURE;
   }
-  std::nth_element(
-    evaluationRuns.begin(), evaluationRuns.begin() + EvaluationRuns / 2, evaluationRuns.end());
+  std::nth_element(evaluationRuns.begin(), evaluationRuns.begin() + EvaluationRuns / 2, evaluationRuns.end());
 
   // One framing for both images, so that they compare: the union of everything drawn.
   double bounds[6];
@@ -306,11 +302,10 @@ int main(int argc, char* argv[])
   lattice->GetDimensions(dims);
   std::cout << name << ": " << mesh->GetNumberOfPoints() << " vertices, " << lattice->GetNumberOfPoints()
             << " control points (" << dims[0] << "x" << dims[1] << "x" << dims[2] << "), "
-            << voxelize->GetNumberOfActiveVoxels() << " active voxels, "
-            << build->GetNumberOfActiveControlPoints() << " active control points\n"
+            << voxelize->GetNumberOfActiveVoxels() << " active voxels, " << build->GetNumberOfActiveControlPoints()
+            << " active control points\n"
             << std::fixed << std::setprecision(2) << "deformation: " << firstRun << " ms binding + evaluation, "
-            << evaluationRuns[EvaluationRuns / 2] << " ms evaluation only (median of " << EvaluationRuns
-            << ")\n"
+            << evaluationRuns[EvaluationRuns / 2] << " ms evaluation only (median of " << EvaluationRuns << ")\n"
             << "wrote " << beforePng << " and " << afterPng << "\n";
   return EXIT_SUCCESS;
 }

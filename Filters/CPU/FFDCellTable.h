@@ -20,9 +20,9 @@ namespace ffd
  * D = sum over i, j, k <= degree of C_ijk a^i b^j c^k, the C from the cell's (degree + 1)^3 control points by the
  * basis's change to monomials along each axis, in double. Horner's rule then takes (degree + 1)^3 - 1
  * multiply-adds a component, against about 1.3 times that and the weights for the weighted sum of the control
- * points (a half, and 14 against 7, for the trilinear basis). The rest lattice's coefficients are all 0, so it stays exactly the identity. `displacements`
- * as GridDeformation::Displacements on a grid of `dims`; `table` holds CellTableStride(CellDegree(basis)) Reals
- * per cell.
+ * points (a half, and 14 against 7, for the trilinear basis). The rest lattice's coefficients are all 0, so it stays
+ * exactly the identity. `displacements` as GridDeformation::Displacements on a grid of `dims`; `table` holds
+ * CellTableStride(CellDegree(basis)) Reals per cell.
  */
 namespace detail
 {
@@ -177,11 +177,9 @@ inline void FillCellTable(GridBasis basis, const Real* displacements, const int 
       return detail::FillCellTableOf<GridBasis::TriquadraticBezier>(
         displacements, voxels, dims, table, cellBegin, cellEnd);
     case GridBasis::TricubicBezier:
-      return detail::FillCellTableOf<GridBasis::TricubicBezier>(
-        displacements, voxels, dims, table, cellBegin, cellEnd);
+      return detail::FillCellTableOf<GridBasis::TricubicBezier>(displacements, voxels, dims, table, cellBegin, cellEnd);
     case GridBasis::CubicBSpline:
-      return detail::FillCellTableOf<GridBasis::CubicBSpline>(
-        displacements, voxels, dims, table, cellBegin, cellEnd);
+      return detail::FillCellTableOf<GridBasis::CubicBSpline>(displacements, voxels, dims, table, cellBegin, cellEnd);
     case GridBasis::Bernstein: // one cell: no table
       break;
   }

@@ -72,8 +72,8 @@ inline SimdLevel SimdLevelOfCpu()
 #if FFD_HAVE_LANES
   __builtin_cpu_init();
   SimdLevel level = SimdLevel::SSE2;
-  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-    __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw"))
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl") &&
+    __builtin_cpu_supports("avx512bw"))
   {
     level = SimdLevel::AVX512;
   }
@@ -347,8 +347,8 @@ inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in,
 
 template <int W, typename Deformation, typename Real>
 inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, const int* cells,
-  const BlockCells& blocks, const Real* inNormals, Real* out, Real* outNormals, Real* determinants,
-  std::int64_t begin, std::int64_t end)
+  const BlockCells& blocks, const Real* inNormals, Real* out, Real* outNormals, Real* determinants, std::int64_t begin,
+  std::int64_t end)
 {
   using Lane = Lanes<Real, W>;
   using Mask = typename Lane::IndexVector;
@@ -434,35 +434,35 @@ inline void GatheredInLanes(const Deformation& deformation, const Real* listed, 
 }
 
 // The wide variants of both passes, one function per instruction set (see the file's documentation).
-#define FFD_LANE_VARIANTS(Suffix, Target, Bytes)                                                              \
-  template <typename Deformation, typename Real>                                                              \
-  Target void BlocksInPlace##Suffix(const Deformation& deformation, const Real* in, const int* cells, Real* out, \
-    const BlockCells& blocks, std::int64_t blockBegin, std::int64_t blockEnd, bool stream)                    \
-  {                                                                                                           \
-    constexpr int W = Bytes / sizeof(Real);                                                                   \
-    if (stream)                                                                                               \
-    {                                                                                                         \
-      BlocksInPlaceInLanes<W, true>(deformation, in, cells, out, blocks, blockBegin, blockEnd, 0);            \
-      _mm_sfence(); /* the non-temporal stores are seen by other threads after this */                       \
-    }                                                                                                         \
-    else                                                                                                      \
-    {                                                                                                         \
-      BlocksInPlaceInLanes<W, false>(deformation, in, cells, out, blocks, blockBegin, blockEnd, 0);           \
-    }                                                                                                         \
-  }                                                                                                           \
-  template <typename Deformation, typename Real>                                                              \
-  Target void WithJacobian##Suffix(const Deformation& deformation, const Real* in, const int* cells,          \
-    const BlockCells& blocks, const Real* inNormals, Real* out, Real* outNormals, Real* determinants,          \
-    std::int64_t begin, std::int64_t end)                                                                     \
-  {                                                                                                           \
-    WithJacobianInLanes<Bytes / sizeof(Real)>(                                                                \
-      deformation, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);                 \
-  }                                                                                                           \
-  template <typename Deformation, typename Real>                                                              \
-  Target void Gathered##Suffix(const Deformation& deformation, const Real* listed, const GatheredPoints& gathered, \
-    std::int64_t t, Real* staged, Real* out)                                                                  \
-  {                                                                                                           \
-    GatheredInLanes<Bytes / sizeof(Real)>(deformation, listed, gathered, t, staged, out);                     \
+#define FFD_LANE_VARIANTS(Suffix, Target, Bytes)                                                                       \
+  template <typename Deformation, typename Real>                                                                       \
+  Target void BlocksInPlace##Suffix(const Deformation& deformation, const Real* in, const int* cells, Real* out,       \
+    const BlockCells& blocks, std::int64_t blockBegin, std::int64_t blockEnd, bool stream)                             \
+  {                                                                                                                    \
+    constexpr int W = Bytes / sizeof(Real);                                                                            \
+    if (stream)                                                                                                        \
+    {                                                                                                                  \
+      BlocksInPlaceInLanes<W, true>(deformation, in, cells, out, blocks, blockBegin, blockEnd, 0);                     \
+      _mm_sfence(); /* the non-temporal stores are seen by other threads after this */                                 \
+    }                                                                                                                  \
+    else                                                                                                               \
+    {                                                                                                                  \
+      BlocksInPlaceInLanes<W, false>(deformation, in, cells, out, blocks, blockBegin, blockEnd, 0);                    \
+    }                                                                                                                  \
+  }                                                                                                                    \
+  template <typename Deformation, typename Real>                                                                       \
+  Target void WithJacobian##Suffix(const Deformation& deformation, const Real* in, const int* cells,                   \
+    const BlockCells& blocks, const Real* inNormals, Real* out, Real* outNormals, Real* determinants,                  \
+    std::int64_t begin, std::int64_t end)                                                                              \
+  {                                                                                                                    \
+    WithJacobianInLanes<Bytes / sizeof(Real)>(                                                                         \
+      deformation, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);                           \
+  }                                                                                                                    \
+  template <typename Deformation, typename Real>                                                                       \
+  Target void Gathered##Suffix(const Deformation& deformation, const Real* listed, const GatheredPoints& gathered,     \
+    std::int64_t t, Real* staged, Real* out)                                                                           \
+  {                                                                                                                    \
+    GatheredInLanes<Bytes / sizeof(Real)>(deformation, listed, gathered, t, staged, out);                              \
   }
 FFD_LANE_VARIANTS(AVX512, FFD_TARGET_AVX512, 64)
 FFD_LANE_VARIANTS(AVX2, FFD_TARGET_AVX2, 32)
@@ -516,8 +516,8 @@ inline void DeformBlocksInPlace(SimdLevel level, const Deformation& deformation,
  */
 template <typename Deformation, typename Real>
 inline void DeformWithJacobian(SimdLevel level, const Deformation& deformation, const Real* in, const int* cells,
-  const BlockCells& blocks, const Real* inNormals, Real* out, Real* outNormals, Real* determinants,
-  std::int64_t begin, std::int64_t end)
+  const BlockCells& blocks, const Real* inNormals, Real* out, Real* outNormals, Real* determinants, std::int64_t begin,
+  std::int64_t end)
 {
 #if FFD_HAVE_LANES
   switch (level)

@@ -219,8 +219,8 @@ struct Lanes
   /// `mask ? a : b` lane by lane, with branches, where the mask is not a comparison in the same expression.
   friend Lanes Select(const IndexVector& mask, const Lanes& a, const Lanes& b)
   {
-    return Lanes(reinterpret_cast<Vector>((reinterpret_cast<IndexVector>(a.V) & mask) |
-      (reinterpret_cast<IndexVector>(b.V) & ~mask)));
+    return Lanes(reinterpret_cast<Vector>(
+      (reinterpret_cast<IndexVector>(a.V) & mask) | (reinterpret_cast<IndexVector>(b.V) & ~mask)));
   }
 
   Lanes& operator+=(const Lanes& a)
@@ -230,10 +230,7 @@ struct Lanes
   }
 
   // The conditions of the kernels (FFDVector.h), lane by lane.
-  friend IndexVector InRange(const Lanes& v, const Lanes& lo, const Lanes& hi)
-  {
-    return (v.V >= lo.V) & (v.V <= hi.V);
-  }
+  friend IndexVector InRange(const Lanes& v, const Lanes& lo, const Lanes& hi) { return (v.V >= lo.V) & (v.V <= hi.V); }
   friend Lanes KeepWhere(const IndexVector& keep, const Lanes& v)
   {
     return Lanes(reinterpret_cast<Vector>(reinterpret_cast<IndexVector>(v.V) & keep));
@@ -296,7 +293,8 @@ private:
   static void Scatter(const Vector& x, const Vector& y, const Vector& z, T* p, std::index_sequence<J...>)
   {
     constexpr Index w = W;
-    const IndexVector fromXY = { Index(((K * W + J) % 3 == 1 ? w : 0) + ((K * W + J) % 3 == 2 ? 0 : (K * W + J) / 3))... };
+    const IndexVector fromXY = { Index(
+      ((K * W + J) % 3 == 1 ? w : 0) + ((K * W + J) % 3 == 2 ? 0 : (K * W + J) / 3))... };
     const IndexVector withZ = { Index((K * W + J) % 3 == 2 ? w + Index((K * W + J) / 3) : Index(J))... };
     const Vector v = __builtin_shuffle(__builtin_shuffle(x, y, fromXY), z, withZ);
     if constexpr (Streaming)

@@ -174,8 +174,8 @@ inline std::vector<std::int64_t> GatheredBlocks(const int* cells, std::int64_t n
  * in input order (two stable counting sorts: by cell, then by tile). For DeformGathered(); `cellCount` is the
  * number of cells of the binding.
  */
-inline std::vector<int> GatherByCell(const int* cells, std::int64_t n, int cellCount,
-  const std::vector<std::int64_t>& sources, int tile = GatherTile)
+inline std::vector<int> GatherByCell(
+  const int* cells, std::int64_t n, int cellCount, const std::vector<std::int64_t>& sources, int tile = GatherTile)
 {
   std::vector<std::int64_t> offsets(std::size_t(cellCount) + 2, 0);
   for (std::int64_t b : sources)

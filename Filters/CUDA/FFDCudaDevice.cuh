@@ -101,9 +101,8 @@ struct Buffer
 // (BENCHMARKS.md).
 template <typename Deformation, typename Real, bool WithJacobian>
 __global__ void __launch_bounds__(ThreadsPerBlock, WithJacobian ? 4 : 6) DeformKernel(const Real* __restrict__ points,
-  const int* __restrict__ cells, std::int64_t count, Deformation deformation,
-  Real* __restrict__ outPoints, const Real* __restrict__ normals, Real* __restrict__ outNormals,
-  Real* __restrict__ determinants)
+  const int* __restrict__ cells, std::int64_t count, Deformation deformation, Real* __restrict__ outPoints,
+  const Real* __restrict__ normals, Real* __restrict__ outNormals, Real* __restrict__ determinants)
 {
   constexpr int PointsPerThread = WithJacobian ? 1 : 4;
   FFD_UNROLL
@@ -115,8 +114,8 @@ __global__ void __launch_bounds__(ThreadsPerBlock, WithJacobian ? 4 : 6) DeformK
     {
       return;
     }
-    ffd::DeformBoundPoint<WithJacobian>(deformation, ffd::Vec3<Real>::From(points + 3 * i), cells[i],
-      outPoints + 3 * i, outNormals ? normals + 3 * i : nullptr, outNormals ? outNormals + 3 * i : nullptr,
+    ffd::DeformBoundPoint<WithJacobian>(deformation, ffd::Vec3<Real>::From(points + 3 * i), cells[i], outPoints + 3 * i,
+      outNormals ? normals + 3 * i : nullptr, outNormals ? outNormals + 3 * i : nullptr,
       determinants ? determinants + i : nullptr);
   }
 }
@@ -128,7 +127,8 @@ template <typename Deformation>
 __global__ void __launch_bounds__(ThreadsPerBlock, 4) DeformPointsKernel(const float* __restrict__ points,
   const int* __restrict__ cells, std::int64_t count, Deformation deformation, float* __restrict__ outPoints)
 {
-  auto deform = [&](ffd::Vec3<float>& x, int cell) {
+  auto deform = [&](ffd::Vec3<float>& x, int cell)
+  {
     if (cell >= 0)
     {
       x = deformation.Deform(x, cell);
@@ -182,12 +182,11 @@ void LaunchDeform(const Deformation& deformation, const Real* points, const int*
 
 // Launches DeformPointsKernel over `count` float32 points on `stream`.
 template <typename Deformation>
-void LaunchDeformPoints(
-  const Deformation& deformation, const float* points, const int* cells, std::int64_t count, float* outPoints,
-  cudaStream_t stream)
+void LaunchDeformPoints(const Deformation& deformation, const float* points, const int* cells, std::int64_t count,
+  float* outPoints, cudaStream_t stream)
 {
-  DeformPointsKernel<Deformation><<<BlocksFor((count + 3) / 4), ThreadsPerBlock, 0, stream>>>(
-    points, cells, count, deformation, outPoints);
+  DeformPointsKernel<Deformation>
+    <<<BlocksFor((count + 3) / 4), ThreadsPerBlock, 0, stream>>>(points, cells, count, deformation, outPoints);
 }
 } // namespace detail
 

@@ -58,8 +58,8 @@ __global__ void BindKernel(const Real* points, std::int64_t count, ffd::Frame<do
   }
   const int voxels[3] = { voxelsS, voxelsT, voxelsU };
   const Real* p = points + 3 * i;
-  cells[i] = ffd::BindToGrid(frame, basis, voxels, ffd::Vec3<double>{ double(p[0]), double(p[1]), double(p[2]) },
-    clampOutside);
+  cells[i] =
+    ffd::BindToGrid(frame, basis, voxels, ffd::Vec3<double>{ double(p[0]), double(p[1]), double(p[2]) }, clampOutside);
 }
 
 // The global basis without Jacobian on small lattices (under 400 control points; BernsteinTensorKernel takes the
@@ -329,8 +329,8 @@ __global__ void __launch_bounds__(32 * TensorWarps, 2) BernsteinTensorKernel(con
         FFD_UNROLL
         for (int mt = 0; mt < 2; ++mt)
         {
-          const float a[4] = { as[mt][0][ks][0] * bu[mt][0], as[mt][1][ks][0] * bu[mt][1],
-            as[mt][0][ks][1] * bu[mt][0], as[mt][1][ks][1] * bu[mt][1] };
+          const float a[4] = { as[mt][0][ks][0] * bu[mt][0], as[mt][1][ks][0] * bu[mt][1], as[mt][0][ks][1] * bu[mt][0],
+            as[mt][1][ks][1] * bu[mt][1] };
           FFD_UNROLL
           for (int e = 0; e < 4; ++e)
           {
@@ -421,8 +421,8 @@ struct GridDeformer::Impl : ResidentPoints::State
   template <typename Real>
   void RunBind(const ffd::Frame<double>& frame, bool clampOutside)
   {
-    BindKernel<Real><<<BlocksFor(this->Count), ThreadsPerBlock, 0, this->Stream>>>(this->Points.As<Real>(),
-      this->Count, frame, this->Basis, this->Divisions[0], this->Divisions[1], this->Divisions[2], clampOutside,
+    BindKernel<Real><<<BlocksFor(this->Count), ThreadsPerBlock, 0, this->Stream>>>(this->Points.As<Real>(), this->Count,
+      frame, this->Basis, this->Divisions[0], this->Divisions[1], this->Divisions[2], clampOutside,
       this->Cells.As<int>());
     Check(cudaGetLastError(), "launching the binding");
     Check(cudaStreamSynchronize(this->Stream), "binding the points");
@@ -488,13 +488,15 @@ struct GridDeformer::Impl : ResidentPoints::State
   void LaunchGeneric(const Real* d, const int dims[3], Real* normalsOut, Real* determinantsOut)
   {
     const ffd::Frame<Real> frame = ffd::Frame<Real>::FromArray(this->Frame);
-    ffd::WithStaticBasis(this->Basis, [&](auto maxCount, auto basis) {
-      using Deformation = ffd::GridDeformation<decltype(maxCount)::value, Real, decltype(basis)::value>;
-      const Deformation deformation{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
-        { dims[0], dims[1], dims[2] }, d, frame };
-      detail::LaunchDeform(deformation, this->Points.As<Real>(), this->Cells.As<int>(), this->Count,
-        this->OutPoints.As<Real>(), this->Normals.As<Real>(), normalsOut, determinantsOut, this->Stream);
-    });
+    ffd::WithStaticBasis(this->Basis,
+      [&](auto maxCount, auto basis)
+      {
+        using Deformation = ffd::GridDeformation<decltype(maxCount)::value, Real, decltype(basis)::value>;
+        const Deformation deformation{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
+          { dims[0], dims[1], dims[2] }, d, frame };
+        detail::LaunchDeform(deformation, this->Points.As<Real>(), this->Cells.As<int>(), this->Count,
+          this->OutPoints.As<Real>(), this->Normals.As<Real>(), normalsOut, determinantsOut, this->Stream);
+      });
   }
 
   // Float32 without the Jacobian on the float4 lattice (trilinear and the global basis): the global basis's own
@@ -503,7 +505,8 @@ struct GridDeformer::Impl : ResidentPoints::State
   {
     const ffd::Frame<float> frame = ffd::Frame<float>::FromArray(this->Frame);
     const ffd::CellSplit split = ffd::CellSplit::For(this->Basis, this->Divisions);
-    auto launch = [&](auto maxCount, auto basis) {
+    auto launch = [&](auto maxCount, auto basis)
+    {
       using Deformation = ffd::GridDeformation<decltype(maxCount)::value, float4, decltype(basis)::value, float>;
       const Deformation grid{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
         { dims[0], dims[1], dims[2] }, d, frame };
@@ -538,7 +541,8 @@ struct GridDeformer::Impl : ResidentPoints::State
     {
       const int ks = (dims[0] + 7) / 8, nt = (3 * dims[1] + 7) / 8;
       const std::size_t shared = TensorSharedBytes(ks, nt, dims[2]);
-      auto launch = [&](auto ksConstant, auto ntConstant) {
+      auto launch = [&](auto ksConstant, auto ntConstant)
+      {
         const auto kernel = BernsteinTensorKernel<decltype(ksConstant)::value, decltype(ntConstant)::value>;
         cudaFuncAttributes attributes;
         Check(cudaFuncGetAttributes(&attributes, kernel), "querying the evaluation kernel");
@@ -553,21 +557,35 @@ struct GridDeformer::Impl : ResidentPoints::State
         Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&perMultiprocessor, kernel, 32 * TensorWarps, shared),
           "sizing the evaluation");
         const std::int64_t tiles = (this->Count + TensorTilePoints - 1) / TensorTilePoints;
-        const std::int64_t blocks = std::min<std::int64_t>(std::int64_t(std::max(perMultiprocessor, 1)) *
-            this->Multiprocessors, (tiles + TensorWarps - 1) / TensorWarps);
+        const std::int64_t blocks =
+          std::min<std::int64_t>(std::int64_t(std::max(perMultiprocessor, 1)) * this->Multiprocessors,
+            (tiles + TensorWarps - 1) / TensorWarps);
         kernel<<<unsigned(blocks), 32 * TensorWarps, shared, this->Stream>>>(this->Points.As<float>(),
           this->Cells.As<int>(), this->Count, frame, dims[0], dims[1], dims[2], displacements,
           this->OutPoints.As<float>());
       };
-      auto withNT = [&](auto ksConstant) {
+      auto withNT = [&](auto ksConstant)
+      {
         switch (nt)
         {
-          case 1: launch(ksConstant, std::integral_constant<int, 1>()); break;
-          case 2: launch(ksConstant, std::integral_constant<int, 2>()); break;
-          case 3: launch(ksConstant, std::integral_constant<int, 3>()); break;
-          case 4: launch(ksConstant, std::integral_constant<int, 4>()); break;
-          case 5: launch(ksConstant, std::integral_constant<int, 5>()); break;
-          default: launch(ksConstant, std::integral_constant<int, 6>()); break;
+          case 1:
+            launch(ksConstant, std::integral_constant<int, 1>());
+            break;
+          case 2:
+            launch(ksConstant, std::integral_constant<int, 2>());
+            break;
+          case 3:
+            launch(ksConstant, std::integral_constant<int, 3>());
+            break;
+          case 4:
+            launch(ksConstant, std::integral_constant<int, 4>());
+            break;
+          case 5:
+            launch(ksConstant, std::integral_constant<int, 5>());
+            break;
+          default:
+            launch(ksConstant, std::integral_constant<int, 6>());
+            break;
         }
       };
       if (ks == 1)
@@ -591,10 +609,11 @@ struct GridDeformer::Impl : ResidentPoints::State
     const unsigned blocks = unsigned((this->Count + 4 * ThreadsPerBlock - 1) / (4 * ThreadsPerBlock));
     // The smaller instantiation that holds the lattice's axes. (A third one, for up to 12 control points per
     // axis, made 11^3 lattices slower: 3.4 instead of 3.6 G points/s on an H200.)
-    auto launch = [&](auto maxCount) {
-      BernsteinKernel<decltype(maxCount)::value><<<blocks, ThreadsPerBlock, shared, this->Stream>>>(
-        this->Points.As<float>(), this->Cells.As<int>(), this->Count, frame, dims[0], dims[1], dims[2],
-        displacements, this->OutPoints.As<float>());
+    auto launch = [&](auto maxCount)
+    {
+      BernsteinKernel<decltype(maxCount)::value>
+        <<<blocks, ThreadsPerBlock, shared, this->Stream>>>(this->Points.As<float>(), this->Cells.As<int>(),
+          this->Count, frame, dims[0], dims[1], dims[2], displacements, this->OutPoints.As<float>());
     };
     if (largest <= 8)
     {
@@ -606,7 +625,6 @@ struct GridDeformer::Impl : ResidentPoints::State
     }
     return true;
   }
-
 };
 
 //------------------------------------------------------------------------------------------------------------
@@ -618,44 +636,48 @@ GridDeformer::GridDeformer()
 bool GridDeformer::Bind(const double frame[12], int basis, const int divisions[3], bool clampOutside)
 {
   Impl& p = static_cast<Impl&>(*this->S);
-  return p.Guard([&] {
-    if (p.Count == 0 || !ffd::IsGridBasis(basis))
+  return p.Guard(
+    [&]
     {
-      throw CudaError{ cudaErrorInvalidValue, "binding: no points, or an unknown basis" };
-    }
-    std::copy(frame, frame + 12, p.Frame);
-    std::copy(divisions, divisions + 3, p.Divisions);
-    p.Basis = static_cast<ffd::GridBasis>(basis);
-    p.Cells.Reserve(std::size_t(p.Count) * sizeof(int), "allocating the binding");
-    const ffd::Frame<double> f = ffd::Frame<double>::FromArray(frame);
-    if (p.IsDouble)
-    {
-      p.RunBind<double>(f, clampOutside);
-    }
-    else
-    {
-      p.RunBind<float>(f, clampOutside);
-    }
-    p.Bound = true;
-    p.Evaluated = false;
-    ++p.Counts.Bindings;
-  });
+      if (p.Count == 0 || !ffd::IsGridBasis(basis))
+      {
+        throw CudaError{ cudaErrorInvalidValue, "binding: no points, or an unknown basis" };
+      }
+      std::copy(frame, frame + 12, p.Frame);
+      std::copy(divisions, divisions + 3, p.Divisions);
+      p.Basis = static_cast<ffd::GridBasis>(basis);
+      p.Cells.Reserve(std::size_t(p.Count) * sizeof(int), "allocating the binding");
+      const ffd::Frame<double> f = ffd::Frame<double>::FromArray(frame);
+      if (p.IsDouble)
+      {
+        p.RunBind<double>(f, clampOutside);
+      }
+      else
+      {
+        p.RunBind<float>(f, clampOutside);
+      }
+      p.Bound = true;
+      p.Evaluated = false;
+      ++p.Counts.Bindings;
+    });
 }
 
-bool GridDeformer::Evaluate(const double* displacements, std::int64_t controlPoints, bool withNormals,
-  bool withDeterminants)
+bool GridDeformer::Evaluate(
+  const double* displacements, std::int64_t controlPoints, bool withNormals, bool withDeterminants)
 {
   Impl& p = static_cast<Impl&>(*this->S);
-  return p.Guard([&] {
-    if (p.IsDouble)
+  return p.Guard(
+    [&]
     {
-      p.RunEvaluate<double>(displacements, controlPoints, withNormals, withDeterminants);
-    }
-    else
-    {
-      p.RunEvaluate<float>(displacements, controlPoints, withNormals, withDeterminants);
-    }
-  });
+      if (p.IsDouble)
+      {
+        p.RunEvaluate<double>(displacements, controlPoints, withNormals, withDeterminants);
+      }
+      else
+      {
+        p.RunEvaluate<float>(displacements, controlPoints, withNormals, withDeterminants);
+      }
+    });
 }
 
 } // namespace cuda

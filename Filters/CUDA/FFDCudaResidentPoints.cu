@@ -36,8 +36,8 @@ void ResidentPoints::State::EnsureStream()
   {
     int device = 0;
     Check(cudaGetDevice(&device), "querying the device");
-    Check(cudaDeviceGetAttribute(&this->Multiprocessors, cudaDevAttrMultiProcessorCount, device),
-      "querying the device");
+    Check(
+      cudaDeviceGetAttribute(&this->Multiprocessors, cudaDevAttrMultiProcessorCount, device), "querying the device");
     Check(cudaStreamCreateWithFlags(&this->Stream, cudaStreamNonBlocking), "creating a stream");
     Check(cudaEventCreateWithFlags(&this->ChunkDone[0], cudaEventDisableTiming), "creating an event");
     Check(cudaEventCreateWithFlags(&this->ChunkDone[1], cudaEventDisableTiming), "creating an event");
@@ -49,8 +49,8 @@ void ResidentPoints::State::EnsureStream()
 
 void ResidentPoints::State::Release()
 {
-  for (Buffer* b : { &this->Points, &this->Normals, &this->Cells, &this->Lattice, &this->OutPoints,
-         &this->OutNormals, &this->OutDeterminants, &this->Staging[0], &this->Staging[1], &this->LatticeStaging })
+  for (Buffer* b : { &this->Points, &this->Normals, &this->Cells, &this->Lattice, &this->OutPoints, &this->OutNormals,
+         &this->OutDeterminants, &this->Staging[0], &this->Staging[1], &this->LatticeStaging })
   {
     b->Free();
   }
@@ -114,8 +114,8 @@ void ResidentPoints::State::FinishEvaluation(bool withNormals, bool withDetermin
   Check(cudaEventRecord(this->KernelStop, this->Stream), "recording an event");
   Check(cudaStreamSynchronize(this->Stream), "evaluating");
   cudaEvent_t pointsStart = withLatticeKernels ? this->LatticeDone : this->KernelStart;
-  Check(cudaEventElapsedTime(&this->Counts.LastKernelMilliseconds, pointsStart, this->KernelStop),
-    "timing the evaluation");
+  Check(
+    cudaEventElapsedTime(&this->Counts.LastKernelMilliseconds, pointsStart, this->KernelStop), "timing the evaluation");
   this->Counts.LastLatticeKernelMilliseconds = 0;
   if (withLatticeKernels)
   {

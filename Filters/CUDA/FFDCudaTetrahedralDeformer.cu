@@ -107,9 +107,9 @@ struct TetrahedralDeformer::Impl : ResidentPoints::State
     auto* maps = this->Maps.As<ffd::TetrahedronMap<Real>>();
     if (this->Tetrahedra > 0)
     {
-      MapKernel<Real><<<BlocksFor(this->Tetrahedra), ThreadsPerBlock, 0, this->Stream>>>(
-        this->Frames.As<ffd::Frame<double>>(), this->Nodes.As<int4>(), this->Tetrahedra,
-        this->Lattice.As<double>(), maps);
+      MapKernel<Real>
+        <<<BlocksFor(this->Tetrahedra), ThreadsPerBlock, 0, this->Stream>>>(this->Frames.As<ffd::Frame<double>>(),
+          this->Nodes.As<int4>(), this->Tetrahedra, this->Lattice.As<double>(), maps);
     }
     this->LatticeKernelsDone();
     const ffd::TetrahedralDeformation<Real> deformation{ maps };
@@ -146,20 +146,22 @@ bool TetrahedralDeformer::Bind(const int* tetrahedronOfPoint, const ffd::Frame<d
   return p.Guard([&] { p.RunBind(tetrahedronOfPoint, restFrames, tetrahedronNodes, tetrahedra, nodes); });
 }
 
-bool TetrahedralDeformer::Evaluate(const double* displacements, std::int64_t nodes, bool withNormals,
-  bool withDeterminants)
+bool TetrahedralDeformer::Evaluate(
+  const double* displacements, std::int64_t nodes, bool withNormals, bool withDeterminants)
 {
   Impl& p = static_cast<Impl&>(*this->S);
-  return p.Guard([&] {
-    if (p.IsDouble)
+  return p.Guard(
+    [&]
     {
-      p.RunEvaluate<double>(displacements, nodes, withNormals, withDeterminants);
-    }
-    else
-    {
-      p.RunEvaluate<float>(displacements, nodes, withNormals, withDeterminants);
-    }
-  });
+      if (p.IsDouble)
+      {
+        p.RunEvaluate<double>(displacements, nodes, withNormals, withDeterminants);
+      }
+      else
+      {
+        p.RunEvaluate<float>(displacements, nodes, withNormals, withDeterminants);
+      }
+    });
 }
 
 } // namespace cuda

@@ -62,7 +62,7 @@ FFD_INLINE Real ParametricTolerance()
 template <typename Real>
 struct Frame
 {
-  Vec3<Real> Origin, S, T, U;    ///< X = Origin + s S + t T + u U
+  Vec3<Real> Origin, S, T, U;     ///< X = Origin + s S + t T + u U
   Vec3<Real> DualS, DualT, DualU; ///< rows of d(s,t,u)/dX (equation 2)
 
   /// Builds the frame and its dual basis in double precision, then rounds to Real.
@@ -90,10 +90,7 @@ struct Frame
   }
 
   /// The lattice space X(s, t, u) = X0 + sS + tT + uU.
-  FFD_INLINE Vec3<Real> ToWorld(const Vec3<Real>& p) const
-  {
-    return Origin + p.x * S + p.y * T + p.z * U;
-  }
+  FFD_INLINE Vec3<Real> ToWorld(const Vec3<Real>& p) const { return Origin + p.x * S + p.y * T + p.z * U; }
 
   /// d(s,t,u)/dX as a matrix whose rows are the dual vectors.
   FFD_INLINE Mat3<Real> ParametricGradient() const { return Mat3<Real>::FromRows(DualS, DualT, DualU); }
@@ -120,8 +117,8 @@ struct Frame
   template <typename Other>
   Frame<Other> As() const
   {
-    return { Convert<Other>(Origin), Convert<Other>(S), Convert<Other>(T), Convert<Other>(U),
-      Convert<Other>(DualS), Convert<Other>(DualT), Convert<Other>(DualU) };
+    return { Convert<Other>(Origin), Convert<Other>(S), Convert<Other>(T), Convert<Other>(U), Convert<Other>(DualS),
+      Convert<Other>(DualT), Convert<Other>(DualU) };
   }
 
 private:

@@ -52,7 +52,7 @@ FFD_INLINE bool IsGridBasis(int basis)
 /// Polynomial degree of a Bezier basis in each voxel (1, 2, 3), 0 for the others.
 FFD_INLINE constexpr int BezierDegree(GridBasis basis)
 {
-  return basis == GridBasis::Trilinear ? 1
+  return basis == GridBasis::Trilinear       ? 1
     : basis == GridBasis::TriquadraticBezier ? 2
     : basis == GridBasis::TricubicBezier     ? 3
                                              : 0;

@@ -248,18 +248,15 @@ struct GridDeformation
   GridDeformation<MaxCount, Real, StaticBasis, OtherLane, WithCellTable> WithLanes() const
   {
     return { this->Basis, { this->Voxels[0], this->Voxels[1], this->Voxels[2] },
-      { this->Dims[0], this->Dims[1], this->Dims[2] }, this->Displacements,
-      this->Frame.template As<OtherLane>(), this->CellTable };
+      { this->Dims[0], this->Dims[1], this->Dims[2] }, this->Displacements, this->Frame.template As<OtherLane>(),
+      this->CellTable };
   }
 
   /// True where cells are evaluated from CellTable (a compile-time constant).
   static constexpr bool UsesCellTable() { return WithCellTable; }
 
   /// The basis: StaticBasis where it is known at compile time (constant-folded), else Basis.
-  FFD_INLINE GridBasis BasisOf() const
-  {
-    return StaticBasis >= 0 ? static_cast<GridBasis>(StaticBasis) : this->Basis;
-  }
+  FFD_INLINE GridBasis BasisOf() const { return StaticBasis >= 0 ? static_cast<GridBasis>(StaticBasis) : this->Basis; }
 
   /// X + D(s, t, u) for a point bound to `cell` (not -1); with lanes, every lane is bound to `cell`.
   FFD_INLINE Vec3<Lane> Deform(const Vec3<Lane>& x, int cell) const
@@ -420,9 +417,9 @@ private:
         ck = { Lane(group.Indices[k][0]), Lane(group.Indices[k][1]), Lane(group.Indices[k][2]) };
       }
       const auto& lanes = group.Lanes[k];
-      index = k == 0 ? ck
-                     : Vec3<Lane>{ Select(lanes, ck.x, index.x), Select(lanes, ck.y, index.y),
-                         Select(lanes, ck.z, index.z) };
+      index = k == 0
+        ? ck
+        : Vec3<Lane>{ Select(lanes, ck.x, index.x), Select(lanes, ck.y, index.y), Select(lanes, ck.z, index.z) };
     }
     Lane r[3];
     AxisWeights<MaxCount, Lane> axes[3];

@@ -72,8 +72,8 @@ FFD_INLINE Real InsideMargin(const Vec3<Real>& stu)
 template <typename Real>
 struct alignas(16 * sizeof(Real)) TetrahedronMap
 {
-  Vec3<Real> Corner;  ///< rest position of node A
-  Vec3<Real> Offset;  ///< displacement of node A
+  Vec3<Real> Corner;   ///< rest position of node A
+  Vec3<Real> Offset;   ///< displacement of node A
   Mat3<Real> Gradient; ///< dD/dX, constant in the tetrahedron
 
   FFD_INLINE Vec3<Real> Displacement(const Vec3<Real>& x) const { return Offset + Gradient * (x - Corner); }

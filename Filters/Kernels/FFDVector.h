@@ -115,8 +115,7 @@ struct Mat3
 template <typename Real>
 FFD_INLINE Vec3<Real> operator*(const Mat3<Real>& a, const Vec3<Real>& v)
 {
-  return { a.M[0][0] * v.x + a.M[0][1] * v.y + a.M[0][2] * v.z,
-    a.M[1][0] * v.x + a.M[1][1] * v.y + a.M[1][2] * v.z,
+  return { a.M[0][0] * v.x + a.M[0][1] * v.y + a.M[0][2] * v.z, a.M[1][0] * v.x + a.M[1][1] * v.y + a.M[1][2] * v.z,
     a.M[2][0] * v.x + a.M[2][1] * v.y + a.M[2][2] * v.z };
 }
 

@@ -152,11 +152,13 @@ Times TimeEvaluations(const ffd::cuda::ResidentPoints& gpu, Evaluate&& evaluate)
 {
   evaluate();
   std::vector<double> lattice, points;
-  const double call = MedianSeconds(20, [&] {
-    evaluate();
-    lattice.push_back(gpu.GetCounters().LastLatticeKernelMilliseconds * 1e-3);
-    points.push_back(gpu.GetCounters().LastKernelMilliseconds * 1e-3);
-  });
+  const double call = MedianSeconds(20,
+    [&]
+    {
+      evaluate();
+      lattice.push_back(gpu.GetCounters().LastLatticeKernelMilliseconds * 1e-3);
+      points.push_back(gpu.GetCounters().LastKernelMilliseconds * 1e-3);
+    });
   return { call, Median(lattice), Median(points) };
 }
 
@@ -197,10 +199,12 @@ void TetrahedraSection(const std::vector<std::int64_t>& sizes, double bandwidth,
       const int divisions[3] = { c.Divisions, c.Divisions, c.Divisions };
       ffd::cuda::GridDeformer gpu;
       Require(gpu.SetPoints(points.data(), n) && gpu.Bind(Frame, int(c.Basis), divisions, false), gpu, "Bind");
-      const Times t = TimeEvaluations(gpu, [&] {
-        Require(gpu.Evaluate(displacements.data(), std::int64_t(displacements.size() / 3), false, false), gpu,
-          "Evaluate");
-      });
+      const Times t = TimeEvaluations(gpu,
+        [&]
+        {
+          Require(
+            gpu.Evaluate(displacements.data(), std::int64_t(displacements.size() / 3), false, false), gpu, "Evaluate");
+        });
       PrintRow<Real>(c.Name, n, t, bandwidth);
     }
     for (const ffdtest::TetrahedralMesh& mesh : meshes)
@@ -219,12 +223,11 @@ void TetrahedraSection(const std::vector<std::int64_t>& sizes, double bandwidth,
       }
       ffd::cuda::TetrahedralDeformer gpu;
       Require(gpu.SetPoints(points.data(), n) &&
-          gpu.Bind(cells.data(), frames.data(), mesh.Tetrahedra.data(), mesh.NumberOfTetrahedra(),
-            mesh.NumberOfNodes()),
+          gpu.Bind(
+            cells.data(), frames.data(), mesh.Tetrahedra.data(), mesh.NumberOfTetrahedra(), mesh.NumberOfNodes()),
         gpu, "Bind");
-      const Times t = TimeEvaluations(gpu, [&] {
-        Require(gpu.Evaluate(displacements.data(), mesh.NumberOfNodes(), false, false), gpu, "Evaluate");
-      });
+      const Times t = TimeEvaluations(
+        gpu, [&] { Require(gpu.Evaluate(displacements.data(), mesh.NumberOfNodes(), false, false), gpu, "Evaluate"); });
       const std::string name = "TETRAHEDRA " + std::to_string(mesh.NumberOfTetrahedra());
       PrintRow<Real>(name.c_str(), n, t, bandwidth);
     }
@@ -253,31 +256,30 @@ void UpdateCostSection(std::mt19937& rng)
     Require(gpu.SetPoints(points.data(), std::int64_t(cells.size())) &&
         gpu.Bind(cells.data(), frames.data(), mesh.Tetrahedra.data(), tetrahedra, mesh.NumberOfNodes()),
       gpu, "Bind");
-    const Times t = TimeEvaluations(gpu, [&] {
-      Require(gpu.Evaluate(displacements.data(), mesh.NumberOfNodes(), false, false), gpu, "Evaluate");
-    });
+    const Times t = TimeEvaluations(
+      gpu, [&] { Require(gpu.Evaluate(displacements.data(), mesh.NumberOfNodes(), false, false), gpu, "Evaluate"); });
 
     std::vector<ffd::TetrahedronMap<Real>> maps(tetrahedra);
-    const double host = MedianSeconds(20, [&] {
-      for (std::int64_t k = 0; k < tetrahedra; ++k)
+    const double host = MedianSeconds(20,
+      [&]
       {
-        auto node = [&](int corner) {
-          return ffd::Vec3<double>::From(displacements.data() + 3 * mesh.Tetrahedra[4 * k + corner]);
-        };
-        maps[k] = ffd::MakeTetrahedronMap(frames[k], node(0), node(1), node(2), node(3)).template As<Real>();
-      }
-    });
+        for (std::int64_t k = 0; k < tetrahedra; ++k)
+        {
+          auto node = [&](int corner)
+          { return ffd::Vec3<double>::From(displacements.data() + 3 * mesh.Tetrahedra[4 * k + corner]); };
+          maps[k] = ffd::MakeTetrahedronMap(frames[k], node(0), node(1), node(2), node(3)).template As<Real>();
+        }
+      });
     const std::size_t mapBytes = maps.size() * sizeof(ffd::TetrahedronMap<Real>);
     void* device = nullptr;
     RequireCuda(cudaMalloc(&device, mapBytes), "cudaMalloc");
-    const double upload = MedianSeconds(20, [&] {
-      RequireCuda(cudaMemcpy(device, maps.data(), mapBytes, cudaMemcpyHostToDevice), "cudaMemcpy");
-    });
+    const double upload = MedianSeconds(
+      20, [&] { RequireCuda(cudaMemcpy(device, maps.data(), mapBytes, cudaMemcpyHostToDevice), "cudaMemcpy"); });
     cudaFree(device);
     std::printf("| %lld | %lld | %s | %.0f | %.3f (maps kernel %.3f) | %.0f | %.3f + %.3f = %.3f |\n",
       static_cast<long long>(tetrahedra), static_cast<long long>(mesh.NumberOfNodes()), PrecisionName<Real>(),
-      mesh.NumberOfNodes() * 24 / 1024.0, t.Call * 1e3, t.Lattice * 1e3, mapBytes / 1024.0, host * 1e3,
-      upload * 1e3, (host + upload) * 1e3);
+      mesh.NumberOfNodes() * 24 / 1024.0, t.Call * 1e3, t.Lattice * 1e3, mapBytes / 1024.0, host * 1e3, upload * 1e3,
+      (host + upload) * 1e3);
   }
 }
 
@@ -315,16 +317,19 @@ void Tetrahedra(const std::vector<std::int64_t>& sizes, double bandwidth, std::m
     gpu, "Bind");
   std::vector<float> out(points.size());
   Require(gpu.Evaluate(displacements.data(), mesh.NumberOfNodes(), false, false), gpu, "Evaluate");
-  const double endToEnd = MedianSeconds(20, [&] {
-    Require(gpu.Evaluate(displacements.data(), mesh.NumberOfNodes(), false, false) &&
-        gpu.Download(out.data(), nullptr, nullptr),
-      gpu, "Evaluate");
-  });
+  const double endToEnd = MedianSeconds(20,
+    [&]
+    {
+      Require(gpu.Evaluate(displacements.data(), mesh.NumberOfNodes(), false, false) &&
+          gpu.Download(out.data(), nullptr, nullptr),
+        gpu, "Evaluate");
+    });
   void* device = nullptr;
   RequireCuda(cudaMalloc(&device, points.size() * sizeof(float)), "cudaMalloc");
-  const double bare = MedianSeconds(20, [&] {
-    RequireCuda(cudaMemcpy(out.data(), device, points.size() * sizeof(float), cudaMemcpyDeviceToHost), "cudaMemcpy");
-  });
+  const double bare = MedianSeconds(20,
+    [&] {
+      RequireCuda(cudaMemcpy(out.data(), device, points.size() * sizeof(float), cudaMemcpyDeviceToHost), "cudaMemcpy");
+    });
   cudaFree(device);
   std::printf("\nEnd-to-end update of %lld float32 points in %lld tetrahedra (nodes' upload + maps + evaluation + "
               "download into pageable memory) against the bare download, median of 20: %.3f ms vs %.3f ms, "
@@ -391,10 +396,12 @@ int main(int argc, char* argv[])
       Require(gpu.Bind(Frame, int(c.Basis), divisions, false), gpu, "Bind");
       Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate"); // warm-up
       std::vector<double> kernelSeconds;
-      const double seconds = MedianSeconds(20, [&] {
-        Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate");
-        kernelSeconds.push_back(gpu.GetCounters().LastKernelMilliseconds * 1e-3);
-      });
+      const double seconds = MedianSeconds(20,
+        [&]
+        {
+          Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate");
+          kernelSeconds.push_back(gpu.GetCounters().LastKernelMilliseconds * 1e-3);
+        });
       const double kernel = Median(kernelSeconds);
       const double bytes = double(n) * (12 + 4 + 12);
       std::printf("| %s | %lld | %.3f | %.3f | %.2f | %.0f | %.0f %% |\n", c.Name, static_cast<long long>(n),
@@ -402,16 +409,19 @@ int main(int argc, char* argv[])
 
       if (n == sizes.front() && c.Basis == ffd::GridBasis::Trilinear)
       {
-        endToEnd = MedianSeconds(20, [&] {
-          Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate");
-          Require(gpu.Download(out.data(), nullptr, nullptr), gpu, "Download");
-        });
+        endToEnd = MedianSeconds(20,
+          [&]
+          {
+            Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate");
+            Require(gpu.Download(out.data(), nullptr, nullptr), gpu, "Download");
+          });
         void* device = nullptr;
         RequireCuda(cudaMalloc(&device, points.size() * sizeof(float)), "cudaMalloc");
-        bareDownload = MedianSeconds(20, [&] {
-          RequireCuda(cudaMemcpy(out.data(), device, points.size() * sizeof(float), cudaMemcpyDeviceToHost),
-            "cudaMemcpy");
-        });
+        bareDownload = MedianSeconds(20,
+          [&] {
+            RequireCuda(
+              cudaMemcpy(out.data(), device, points.size() * sizeof(float), cudaMemcpyDeviceToHost), "cudaMemcpy");
+          });
         cudaFree(device);
       }
     }
@@ -430,10 +440,12 @@ int main(int argc, char* argv[])
     const std::int64_t controlPoints = std::int64_t(displacements.size() / 3);
     Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate");
     std::vector<double> kernelSeconds;
-    const double seconds = MedianSeconds(20, [&] {
-      Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate");
-      kernelSeconds.push_back(gpu.GetCounters().LastKernelMilliseconds * 1e-3);
-    });
+    const double seconds = MedianSeconds(20,
+      [&]
+      {
+        Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate");
+        kernelSeconds.push_back(gpu.GetCounters().LastKernelMilliseconds * 1e-3);
+      });
     const double kernel = Median(kernelSeconds);
     const double bytes = double(n) * (12 + 4 + 12);
     std::printf("| %s, random point order | %lld | %.3f | %.3f | %.2f | %.0f | %.0f %% |\n", c.Name,

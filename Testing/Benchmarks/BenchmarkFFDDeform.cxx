@@ -72,30 +72,33 @@ double Seconds(Clock::time_point begin)
 // build still runs on any x86-64; the program asks the CPU which ones it can run.
 constexpr int Chains = 12;
 
-#define FFD_FMA_LOOP(Name, Target, Vec, Real, Set1, MulAdd, Lanes)                                           \
-  __attribute__((target(Target))) double Name(long iterations)                                              \
-  {                                                                                                          \
-    Vec acc[Chains];                                                                                         \
-    for (int c = 0; c < Chains; ++c)                                                                         \
-    {                                                                                                        \
-      acc[c] = Set1(Real(1) + Real(c) * Real(1e-3));                                                         \
-    }                                                                                                        \
-    const Vec a = Set1(Real(0.999999)), b = Set1(Real(1e-6));                                                \
-    for (long i = 0; i < iterations; ++i)                                                                    \
-    {                                                                                                        \
-      _Pragma("GCC unroll 12") for (int c = 0; c < Chains; ++c) { acc[c] = MulAdd(acc[c], a, b); }           \
-    }                                                                                                        \
-    Real lanes[Lanes];                                                                                       \
-    double sum = 0.0;                                                                                        \
-    for (int c = 0; c < Chains; ++c)                                                                         \
-    {                                                                                                        \
-      std::memcpy(lanes, &acc[c], sizeof(lanes));                                                            \
-      for (int l = 0; l < Lanes; ++l)                                                                        \
-      {                                                                                                      \
-        sum += double(lanes[l]);                                                                             \
-      }                                                                                                      \
-    }                                                                                                        \
-    return sum;                                                                                              \
+#define FFD_FMA_LOOP(Name, Target, Vec, Real, Set1, MulAdd, Lanes)                                                     \
+  __attribute__((target(Target))) double Name(long iterations)                                                         \
+  {                                                                                                                    \
+    Vec acc[Chains];                                                                                                   \
+    for (int c = 0; c < Chains; ++c)                                                                                   \
+    {                                                                                                                  \
+      acc[c] = Set1(Real(1) + Real(c) * Real(1e-3));                                                                   \
+    }                                                                                                                  \
+    const Vec a = Set1(Real(0.999999)), b = Set1(Real(1e-6));                                                          \
+    for (long i = 0; i < iterations; ++i)                                                                              \
+    {                                                                                                                  \
+      _Pragma("GCC unroll 12") for (int c = 0; c < Chains; ++c)                                                        \
+      {                                                                                                                \
+        acc[c] = MulAdd(acc[c], a, b);                                                                                 \
+      }                                                                                                                \
+    }                                                                                                                  \
+    Real lanes[Lanes];                                                                                                 \
+    double sum = 0.0;                                                                                                  \
+    for (int c = 0; c < Chains; ++c)                                                                                   \
+    {                                                                                                                  \
+      std::memcpy(lanes, &acc[c], sizeof(lanes));                                                                      \
+      for (int l = 0; l < Lanes; ++l)                                                                                  \
+      {                                                                                                                \
+        sum += double(lanes[l]);                                                                                       \
+      }                                                                                                                \
+    }                                                                                                                  \
+    return sum;                                                                                                        \
   }
 
 #define FFD_SSE_MULADD_PD(x, a, b) _mm_add_pd(_mm_mul_pd(x, a), b)
@@ -172,9 +175,9 @@ double MeasurePeak(const FmaKernel& kernel, bool useDouble, int threads, long it
 //------------------------------------------------------------------------------------------------------------
 /**
  * Operations per point of the global evaluation of degree (l, m, n), counted from the kernel
- * (FFDGridBasis.h, SumTensorProduct and BernsteinBasis): 3 FMAs per control point (sum over i), 3 per (j, k) and 3 per k (the outer sums),
- * 3 adds for X + D, and per axis of degree d the de Casteljau triangle's d(d+1)/2 steps of one FMA and one
- * multiply. Each counts as one operation, one issue of an FMA unit's lane.
+ * (FFDGridBasis.h, SumTensorProduct and BernsteinBasis): 3 FMAs per control point (sum over i), 3 per (j, k) and 3 per
+ * k (the outer sums), 3 adds for X + D, and per axis of degree d the de Casteljau triangle's d(d+1)/2 steps of one FMA
+ * and one multiply. Each counts as one operation, one issue of an FMA unit's lane.
  */
 double OperationsPerPoint(int l, int m, int n)
 {
@@ -261,10 +264,9 @@ void PrintRow(const Row& r)
 {
   const double pointsPerSecond = r.Points / r.Evaluation.Best;
   const double operations = pointsPerSecond * r.OperationsPerPoint;
-  std::printf("| %4d | %9lld | %-7s | %2d | %8.3f | %8.4f | %8.4f | %9.2f | %8.2f | %6.1f %% |\n",
-    r.ControlPoints, static_cast<long long>(r.Points), r.Precision, r.Threads, r.BindSeconds, r.Evaluation.Best,
-    r.Evaluation.Median, pointsPerSecond * 1e-6, operations * 1e-9,
-    r.PeakOperations > 0 ? 100.0 * operations / r.PeakOperations : 0.0);
+  std::printf("| %4d | %9lld | %-7s | %2d | %8.3f | %8.4f | %8.4f | %9.2f | %8.2f | %6.1f %% |\n", r.ControlPoints,
+    static_cast<long long>(r.Points), r.Precision, r.Threads, r.BindSeconds, r.Evaluation.Best, r.Evaluation.Median,
+    pointsPerSecond * 1e-6, operations * 1e-9, r.PeakOperations > 0 ? 100.0 * operations / r.PeakOperations : 0.0);
   std::fflush(stdout);
 }
 
@@ -343,12 +345,13 @@ Timing Repeat(Step&& step, int minRepeats, double minSeconds)
 
 /// Times vtkFFDDeform::Update() after moving the lattice's points (the binding cached), on the threads
 /// vtkSMPTools was initialized to; appends the times to `times`.
-void TimeUpdates(vtkFFDDeform* deform, BenchmarkLattice& lattice, std::mt19937& rng, int minRepeats,
-  double minSeconds, std::vector<double>& times)
+void TimeUpdates(vtkFFDDeform* deform, BenchmarkLattice& lattice, std::mt19937& rng, int minRepeats, double minSeconds,
+  std::vector<double>& times)
 {
   const vtkIdType bindings = deform->GetNumberOfBindings();
   RepeatInto(
-    [&]() {
+    [&]()
+    {
       MoveLattice(lattice.Grid, lattice.Rest, rng);
       const Clock::time_point begin = Clock::now();
       deform->Update();
@@ -362,8 +365,8 @@ void TimeUpdates(vtkFFDDeform* deform, BenchmarkLattice& lattice, std::mt19937& 
 }
 
 /// TimeUpdates() on `threads` threads; best and median.
-Timing TimeEvaluation(vtkFFDDeform* deform, BenchmarkLattice& lattice, std::mt19937& rng, int threads,
-  int minRepeats, double minSeconds)
+Timing TimeEvaluation(
+  vtkFFDDeform* deform, BenchmarkLattice& lattice, std::mt19937& rng, int threads, int minRepeats, double minSeconds)
 {
   vtkSMPTools::Initialize(threads);
   std::vector<double> times;
@@ -401,8 +404,8 @@ void BenchmarkMesh(vtkPolyData* mesh, bool useDouble, int divisions, const std::
 //------------------------------------------------------------------------------------------------------------
 // The global section: the FMA peak, then the Bernstein evaluation for 5^3 and 10^3 control points. Returns
 // false when a pipeline failed.
-bool RunGlobalSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, const std::vector<int>& threadCounts,
-  bool quick)
+bool RunGlobalSection(
+  const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, const std::vector<int>& threadCounts, bool quick)
 {
   // FMA peak, per thread count and precision (index 2 * thread + double).
   const long iterations = quick ? 2000000 : 50000000;
@@ -421,8 +424,8 @@ bool RunGlobalSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, c
     {
       const double f = MeasurePeak(*kernel, false, threads, iterations);
       const double d = MeasurePeak(*kernel, true, threads, iterations);
-      std::printf("  %-13s %2d thread(s): float32 %7.2f G/s, float64 %7.2f G/s\n", kernel->Name, threads,
-        f * 1e-9, d * 1e-9);
+      std::printf(
+        "  %-13s %2d thread(s): float32 %7.2f G/s, float64 %7.2f G/s\n", kernel->Name, threads, f * 1e-9, d * 1e-9);
       if (kernel == best)
       {
         peaks.push_back(f);
@@ -436,8 +439,10 @@ bool RunGlobalSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, c
               "%% of peak: (points/s * ops/point) / the FMA peak above for the same precision and threads.\n"
               "bind+1st: the first Update(), binding included, on all threads; best, median: evaluation only.\n\n",
     OperationsPerPoint(4, 4, 4), OperationsPerPoint(9, 9, 9));
-  std::printf("| ctrl | points    | type    | th | bind+1st | best (s) | median   | Mpoints/s | Gops/s   | %% peak   |\n");
-  std::printf("|-----:|----------:|---------|---:|---------:|---------:|---------:|----------:|---------:|---------:|\n");
+  std::printf(
+    "| ctrl | points    | type    | th | bind+1st | best (s) | median   | Mpoints/s | Gops/s   | %% peak   |\n");
+  std::printf(
+    "|-----:|----------:|---------|---:|---------:|---------:|---------:|----------:|---------:|---------:|\n");
   std::vector<Row> rows;
   const int minRepeats = quick ? 2 : 3;
   const double minSeconds = quick ? 0.0 : 1.0;
@@ -484,10 +489,12 @@ struct CopyBuffers
       const Clock::time_point begin = Clock::now();
       for (int t = 0; t < threads; ++t)
       {
-        pool.emplace_back([this, bytes, threads, t]() {
-          const size_t first = bytes * t / threads, last = bytes * (t + 1) / threads;
-          std::memcpy(this->Target.data() + first, this->Source.data() + first, last - first);
-        });
+        pool.emplace_back(
+          [this, bytes, threads, t]()
+          {
+            const size_t first = bytes * t / threads, last = bytes * (t + 1) / threads;
+            std::memcpy(this->Target.data() + first, this->Source.data() + first, last - first);
+          });
       }
       for (std::thread& th : pool)
       {
@@ -653,8 +660,8 @@ struct VtkRow
  * minutes apart). For CUBIC_BSPLINE over `vtkDivisions`, VTK's vtkBSplineTransform + vtkTransformFilter on the
  * same mesh and lattice, timed as in the global section. Returns false when a pipeline failed.
  */
-bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, const std::vector<int>& threadCounts,
-  bool quick)
+bool RunBasesSection(
+  const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, const std::vector<int>& threadCounts, bool quick)
 {
   // 256 MB per buffer: far beyond the caches (32 MB of L3 on this class of CPU), as the 5 M-point meshes are.
   CopyBuffers copy(size_t(quick ? 32 : 256) << 20);
@@ -662,11 +669,10 @@ bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, co
   // Every basis over 4 x 4 x 4 voxels (the global one's cost grows with its degree, so it stays at 4), and the
   // local ones again over lattices of about 10^3 control points: their cost per point should not change.
   const int vtkDivisions = 7;
-  const std::vector<BasisCase> cases = { { vtkFFDBuildLattice::BERNSTEIN, 4 },
-    { vtkFFDBuildLattice::TRILINEAR, 4 }, { vtkFFDBuildLattice::TRILINEAR, 9 },
-    { vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, 4 }, { vtkFFDBuildLattice::TRICUBIC_BEZIER, 4 },
-    { vtkFFDBuildLattice::TRICUBIC_BEZIER, 3 }, { vtkFFDBuildLattice::CUBIC_BSPLINE, 4 },
-    { vtkFFDBuildLattice::CUBIC_BSPLINE, vtkDivisions } };
+  const std::vector<BasisCase> cases = { { vtkFFDBuildLattice::BERNSTEIN, 4 }, { vtkFFDBuildLattice::TRILINEAR, 4 },
+    { vtkFFDBuildLattice::TRILINEAR, 9 }, { vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, 4 },
+    { vtkFFDBuildLattice::TRICUBIC_BEZIER, 4 }, { vtkFFDBuildLattice::TRICUBIC_BEZIER, 3 },
+    { vtkFFDBuildLattice::CUBIC_BSPLINE, 4 }, { vtkFFDBuildLattice::CUBIC_BSPLINE, vtkDivisions } };
   const int minRepeats = quick ? 2 : 3;
   const double minSeconds = quick ? 0.0 : 0.5;
   const int rounds = quick ? 1 : 5; // of MeasureSideBySide()
@@ -721,15 +727,16 @@ bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, co
             vtkFFDBuildLattice::GetBasisAsString(c.Basis), c.Divisions,
             static_cast<long long>(lattice.Grid->GetNumberOfPoints()),
             static_cast<long long>(input->GetNumberOfPoints()), useDouble ? "float64" : "float32",
-            vtkSMPTools::GetEstimatedNumberOfThreads(), bindSeconds, timing.Best, timing.Median,
-            pointsPerSecond * 1e-6, bytesPerSecond * 1e-9, bandwidth * 1e-9, 100.0 * bytesPerSecond / bandwidth);
+            vtkSMPTools::GetEstimatedNumberOfThreads(), bindSeconds, timing.Best, timing.Median, pointsPerSecond * 1e-6,
+            bytesPerSecond * 1e-9, bandwidth * 1e-9, 100.0 * bytesPerSecond / bandwidth);
           std::fflush(stdout);
           if (compare && ok)
           {
             // VTK on the same thread count (vtkSMPTools is still initialized to it), then both on one lattice
             // state, to check that they compute the same deformation.
             const Timing vtkTiming = Repeat(
-              [&]() {
+              [&]()
+              {
                 MoveLattice(lattice.Grid, lattice.Rest, rng);
                 return vtk.Run(lattice);
               },
@@ -758,9 +765,8 @@ bool RunBasesSection(const std::vector<vtkSmartPointer<vtkPolyData>>& meshes, co
   for (const VtkRow& r : vtkRows)
   {
     std::printf("| %9lld | %-7s | %2d | %12.4f | %10.4f | %13.2f | %13.4f | %14.2f | %7.1fx | %10.1e |\n",
-      static_cast<long long>(r.Points), r.Precision, r.Threads, r.Vtk.Best, r.Vtk.Median,
-      r.Points / r.Vtk.Best * 1e-6, r.Ours.Best, r.Points / r.Ours.Best * 1e-6, r.Vtk.Best / r.Ours.Best,
-      r.RelativeDifference);
+      static_cast<long long>(r.Points), r.Precision, r.Threads, r.Vtk.Best, r.Vtk.Median, r.Points / r.Vtk.Best * 1e-6,
+      r.Ours.Best, r.Points / r.Ours.Best * 1e-6, r.Vtk.Best / r.Ours.Best, r.RelativeDifference);
   }
   return ok && vtkRows.size() == 2 * 2 * threadCounts.size();
 }
@@ -828,8 +834,8 @@ int main(int argc, char* argv[])
   const Clock::time_point subdivideBegin = Clock::now();
   meshes.push_back(Subdivide(base, levels[0]));
   meshes.push_back(Subdivide(meshes[0], levels[1] - levels[0]));
-  std::printf("\nMesh %s: %lld points; subdivided %d and %d times: %lld and %lld points (%.1f s)\n",
-    meshPath.c_str(), static_cast<long long>(base->GetNumberOfPoints()), levels[0], levels[1],
+  std::printf("\nMesh %s: %lld points; subdivided %d and %d times: %lld and %lld points (%.1f s)\n", meshPath.c_str(),
+    static_cast<long long>(base->GetNumberOfPoints()), levels[0], levels[1],
     static_cast<long long>(meshes[0]->GetNumberOfPoints()), static_cast<long long>(meshes[1]->GetNumberOfPoints()),
     Seconds(subdivideBegin));
 

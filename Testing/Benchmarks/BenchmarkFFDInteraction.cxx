@@ -19,8 +19,8 @@
  * Usage: BenchmarkFFDInteraction [--mesh FILE.vtp] [--levels N] [--moves N]   (in an X display:
  * Utilities/with-display.sh build/bin/BenchmarkFFDInteraction)
  */
-#include "vtkActor.h"
 #include "FFDBenchmarkMeshes.h"
+#include "vtkActor.h"
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDeform.h"
 #include "vtkFFDLatticeActor.h"
@@ -182,8 +182,8 @@ int main(int argc, char* argv[])
     std::printf("| %s | %lld (%lld) | %lld | %.1f (%.1f-%.1f) | %.1f (%.1f-%.1f) | %.1f | %.1f |\n",
       vtkFFDBuildLattice::GetBasisAsString(basis), static_cast<long long>(lattice->GetNumberOfPoints()),
       static_cast<long long>(build->GetNumberOfActiveControlPoints()),
-      static_cast<long long>(deform->GetNumberOfBindings()), p.Median, p.Min, p.Max, r.Median, r.Min, r.Max,
-      t.Median, u.Median);
+      static_cast<long long>(deform->GetNumberOfBindings()), p.Median, p.Min, p.Max, r.Median, r.Min, r.Max, t.Median,
+      u.Median);
   }
   return EXIT_SUCCESS;
 }

@@ -89,7 +89,8 @@ Row Measure(const std::string& name, vtkPolyData* mesh, vtkPointSet* lattice, in
   deform->Update();
   const double first = Seconds(begin);
   row.Evaluate = Median(
-    [&]() {
+    [&]()
+    {
       Move(lattice, rest, amplitude, rng);
       const Clock::time_point start = Clock::now();
       deform->Update();
@@ -207,15 +208,15 @@ int main(int argc, char* argv[])
   for (const int threads : { 1, 2 })
   {
     const Row trilinear = Measure("trilinear 10^3", mesh, grid, threads, amplitude);
-    std::printf("| %-20s | %10s | %9s | %2d | %8.4f | %11.2f | %8.4f | %11.2f | %16s |\n", "grid TRILINEAR 10^3",
-      "-", "-", threads, trilinear.Bind, n / trilinear.Bind * 1e-6, trilinear.Evaluate,
-      n / trilinear.Evaluate * 1e-6, "1.00");
+    std::printf("| %-20s | %10s | %9s | %2d | %8.4f | %11.2f | %8.4f | %11.2f | %16s |\n", "grid TRILINEAR 10^3", "-",
+      "-", threads, trilinear.Bind, n / trilinear.Bind * 1e-6, trilinear.Evaluate, n / trilinear.Evaluate * 1e-6,
+      "1.00");
     for (const Lattice& lattice : lattices)
     {
       const Row row = Measure(lattice.Name, mesh, lattice.Grid, threads, amplitude);
-      std::printf("| %-20s | %10lld | %9.3f | %2d | %8.4f | %11.2f | %8.4f | %11.2f | %16.2f |\n",
-        lattice.Name.c_str(), (long long)row.Tetrahedra, lattice.BuildSeconds, threads, row.Bind,
-        n / row.Bind * 1e-6, row.Evaluate, n / row.Evaluate * 1e-6, row.Evaluate / trilinear.Evaluate);
+      std::printf("| %-20s | %10lld | %9.3f | %2d | %8.4f | %11.2f | %8.4f | %11.2f | %16.2f |\n", lattice.Name.c_str(),
+        (long long)row.Tetrahedra, lattice.BuildSeconds, threads, row.Bind, n / row.Bind * 1e-6, row.Evaluate,
+        n / row.Evaluate * 1e-6, row.Evaluate / trilinear.Evaluate);
     }
   }
 
@@ -225,9 +226,12 @@ int main(int argc, char* argv[])
     // of our control mesh), computed once (its "binding"), then a weighted sum per update. Its cost grows with
     // points x control-mesh triangles, so only the smaller control meshes are timed.
     std::printf("\nPeer: VTK's vtkDeformPointSet with the surface of the same control mesh (its nodes moved the same\n"
-                "way), %d threads (it is serial where it is not SMP):\n\n", vtkSMPTools::GetEstimatedNumberOfThreads());
-    std::printf("| control mesh         | triangles | init (s) | init Mpts/s | eval (s) | eval Mpts/s | ours eval (s) |\n");
-    std::printf("|----------------------|----------:|---------:|------------:|---------:|------------:|--------------:|\n");
+                "way), %d threads (it is serial where it is not SMP):\n\n",
+      vtkSMPTools::GetEstimatedNumberOfThreads());
+    std::printf(
+      "| control mesh         | triangles | init (s) | init Mpts/s | eval (s) | eval Mpts/s | ours eval (s) |\n");
+    std::printf(
+      "|----------------------|----------:|---------:|------------:|---------:|------------:|--------------:|\n");
     vtkSMPTools::Initialize(0);
     for (const Lattice& lattice : lattices)
     {
@@ -250,7 +254,8 @@ int main(int argc, char* argv[])
       deform->Update();
       const double first = Seconds(begin);
       const double evaluate = Median(
-        [&]() {
+        [&]()
+        {
           Move(moving, control->GetPointData()->GetArray("RestPosition"), amplitude, rng);
           moving->Modified();
           const Clock::time_point start = Clock::now();

@@ -90,8 +90,8 @@ int main(int argc, char* argv[])
     return EXIT_FAILURE;
   }
   std::printf("mesh: %s subdivided twice: %lld points, normals; %d threads (%s); %d updates a lattice\n\n",
-    meshPath.c_str(), static_cast<long long>(mesh->GetNumberOfPoints()),
-    vtkSMPTools::GetEstimatedNumberOfThreads(), vtkSMPTools::GetBackend(), updates);
+    meshPath.c_str(), static_cast<long long>(mesh->GetNumberOfPoints()), vtkSMPTools::GetEstimatedNumberOfThreads(),
+    vtkSMPTools::GetBackend(), updates);
   std::printf("| lattice | control points | bindings | ms an update | RSS after 1,000 (MB) | RSS after %d (MB) | "
               "change |\n|---|---|---|---|---|---|---|\n",
     updates);

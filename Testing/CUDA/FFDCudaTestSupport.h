@@ -18,14 +18,14 @@
 #include <vector>
 
 /// Skips the current GoogleTest test, with the reason, where no CUDA device can be used.
-#define FFD_REQUIRE_DEVICE()                                                                                     \
-  do                                                                                                             \
-  {                                                                                                              \
-    std::string why;                                                                                             \
-    if (!ffd::cuda::DeviceAvailable(&why))                                                                       \
-    {                                                                                                            \
-      GTEST_SKIP() << why;                                                                                       \
-    }                                                                                                            \
+#define FFD_REQUIRE_DEVICE()                                                                                           \
+  do                                                                                                                   \
+  {                                                                                                                    \
+    std::string why;                                                                                                   \
+    if (!ffd::cuda::DeviceAvailable(&why))                                                                             \
+    {                                                                                                                  \
+      GTEST_SKIP() << why;                                                                                             \
+    }                                                                                                                  \
   } while (false)
 
 namespace ffdtest

@@ -55,7 +55,8 @@ struct Problem
     // Parameters keep 1e-4 away from the frame's faces: within float32 rounding of the band that counts as
     // inside (1e-5 wide in float32), the two sides could clamp differently and so differ in their Jacobians.
     std::uniform_real_distribution<double> parameter(-0.1, 1.1);
-    auto draw = [&] {
+    auto draw = [&]
+    {
       double v;
       do
       {
@@ -95,13 +96,13 @@ void CpuDeform(const Problem& p, bool clampOutside, std::vector<double>& points,
   const ffd::Frame<double> binding = ffd::Frame<double>::FromArray(p.Frame);
   const std::vector<Real> displacements(p.Displacements.begin(), p.Displacements.end());
   const ffd::GridDeformation<MaxCount, Real> deformation{ ffd::GridBasis(p.Basis),
-    { p.Divisions[0], p.Divisions[1], p.Divisions[2] }, { p.Dims[0], p.Dims[1], p.Dims[2] },
-    displacements.data(), ffd::Frame<Real>::FromArray(p.Frame) };
+    { p.Divisions[0], p.Divisions[1], p.Divisions[2] }, { p.Dims[0], p.Dims[1], p.Dims[2] }, displacements.data(),
+    ffd::Frame<Real>::FromArray(p.Frame) };
   for (std::int64_t i = 0; i < p.Count(); ++i)
   {
     const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&p.Points[3 * i]);
-    const int cell = ffd::BindToGrid(binding, ffd::GridBasis(p.Basis), p.Divisions,
-      { double(x.x), double(x.y), double(x.z) }, clampOutside);
+    const int cell = ffd::BindToGrid(
+      binding, ffd::GridBasis(p.Basis), p.Divisions, { double(x.x), double(x.y), double(x.z) }, clampOutside);
     ffd::Mat3<Real> j = ffd::Mat3<Real>::Identity();
     const ffd::Vec3<Real> y = cell >= 0 ? deformation.Deform(x, cell, j) : x;
     const ffd::Vec3<Real> n = ffd::TransformNormal(j, ffd::Vec3<Real>::From(&p.Normals[3 * i]));
@@ -170,17 +171,16 @@ TYPED_TEST(CudaGridDeformerTest, MatchesCpuForEveryBasis)
       // 1e-12 times it in double (normals are uploaded, transformed and downloaded in the points' precision).
       const bool single = sizeof(Real) == sizeof(float);
       ffdtest::Mismatches wrong;
-      const auto check = [&](const char* what, std::int64_t i, double got, double expected, double tol) {
-        wrong.Check(what, i, got, expected, tol);
-      };
+      const auto check = [&](const char* what, std::int64_t i, double got, double expected, double tol)
+      { wrong.Check(what, i, got, expected, tol); };
       for (std::int64_t i = 0; i < p.Count(); ++i)
       {
         for (int c = 0; c < 3; ++c)
         {
           check("position", i, double(outPoints[3 * i + c]), cpuPoints[3 * i + c], tolerance);
           const double conditioning = jacobianScales[i] / std::max(std::fabs(cpuDeterminants[i]), 1e-300);
-          check("normal", i, double(outNormals[3 * i + c]), cpuNormals[3 * i + c],
-            (single ? 1e-5 : 1e-12) * conditioning);
+          check(
+            "normal", i, double(outNormals[3 * i + c]), cpuNormals[3 * i + c], (single ? 1e-5 : 1e-12) * conditioning);
         }
         check("det", i, double(outDeterminants[i]), cpuDeterminants[i],
           (single ? 1e-5 : 1e-12) * std::max(1.0, jacobianScales[i]));
@@ -245,7 +245,8 @@ void ExpectFloatMatchesCpu(int basis, const int divisions[3], std::int64_t count
     }
   }
   EXPECT_EQ(wrong.Count, 0) << "basis " << basis << " divisions " << divisions[0] << "x" << divisions[1] << "x"
-                      << divisions[2] << ", " << count << " points" << (clamp ? " clamped" : "") << ": " << wrong.First;
+                            << divisions[2] << ", " << count << " points" << (clamp ? " clamped" : "") << ": "
+                            << wrong.First;
   if (worst)
   {
     *worst = std::max(*worst, largest);

@@ -108,12 +108,14 @@ Reference ReferenceDeform(const TetrahedralMesh& mesh, const std::vector<double>
   }
   r.Conditioning = r.Scale / std::max(std::fabs(r.Determinant), 1e-300);
 
-  auto cross = [](const double a[3], const double b[3], double out[3]) {
+  auto cross = [](const double a[3], const double b[3], double out[3])
+  {
     out[0] = a[1] * b[2] - a[2] * b[1];
     out[1] = a[2] * b[0] - a[0] * b[2];
     out[2] = a[0] * b[1] - a[1] * b[0];
   };
-  auto normalize = [](double v[3]) {
+  auto normalize = [](double v[3])
+  {
     const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
     for (int c = 0; c < 3; ++c)
     {
@@ -212,8 +214,8 @@ FFD_REAL_TYPED_TEST_SUITE(CudaTetrahedralDeformerTest);
 // points as the device has them). Tolerances, relative to the mesh's size (3): positions 1e-5 in float32 (the
 // issue's bound) and 1e-12 in float64; det J within the same of the size of its terms, |J e0||J e1||J e2|; unit
 // normals within 1e-5 times J's conditioning in float32, and 1e-12 times it in float64 (normals are uploaded,
-// transformed and downloaded in the points' precision). Kept points exactly. With and without normals and det J (different kernels), points in mesh and in
-// random order; outputs poisoned first, so unwritten values are caught.
+// transformed and downloaded in the points' precision). Kept points exactly. With and without normals and det J
+// (different kernels), points in mesh and in random order; outputs poisoned first, so unwritten values are caught.
 TYPED_TEST(CudaTetrahedralDeformerTest, MatchesFloat64Reference)
 {
   FFD_REQUIRE_DEVICE();
@@ -250,13 +252,12 @@ TYPED_TEST(CudaTetrahedralDeformerTest, MatchesFloat64Reference)
       std::vector<Real> outNormals(points.size(), poison);
       ASSERT_TRUE(gpu.Evaluate(p.Displacements.data(), p.Mesh.NumberOfNodes(), withJacobian, withJacobian))
         << gpu.GetLastError();
-      ASSERT_TRUE(gpu.Download(outPoints.data(), withJacobian ? outNormals.data() : nullptr,
-        withJacobian ? outDeterminants.data() : nullptr))
+      ASSERT_TRUE(gpu.Download(
+        outPoints.data(), withJacobian ? outNormals.data() : nullptr, withJacobian ? outDeterminants.data() : nullptr))
         << gpu.GetLastError();
       ffdtest::Mismatches wrong;
-      const auto check = [&](const char* what, std::int64_t i, double got, double want, double tolerance) {
-        wrong.Check(what, i, got, want, tolerance);
-      };
+      const auto check = [&](const char* what, std::int64_t i, double got, double want, double tolerance)
+      { wrong.Check(what, i, got, want, tolerance); };
       for (std::int64_t i = 0; i < p.Count(); ++i)
       {
         const Reference& r = expected[i];
@@ -277,8 +278,7 @@ TYPED_TEST(CudaTetrahedralDeformerTest, MatchesFloat64Reference)
         }
         if (withJacobian && p.Cells[i] >= 0)
         {
-          check("det", i, double(outDeterminants[i]), r.Determinant,
-            relative * std::max(1.0, r.Scale));
+          check("det", i, double(outDeterminants[i]), r.Determinant, relative * std::max(1.0, r.Scale));
         }
       }
       EXPECT_EQ(wrong.Count, 0) << (meshOrder ? "mesh order" : "random order")

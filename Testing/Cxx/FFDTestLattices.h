@@ -172,8 +172,8 @@ inline vtkSmartPointer<vtkStructuredGrid> MakeLattice(const ffdref::Frame& f, in
   }
   lattice->SetPoints(points);
   lattice->GetPointData()->AddArray(rest);
-  const double frame[12] = { f.X0[0], f.X0[1], f.X0[2], f.S[0], f.S[1], f.S[2], f.T[0], f.T[1], f.T[2], f.U[0],
-    f.U[1], f.U[2] };
+  const double frame[12] = { f.X0[0], f.X0[1], f.X0[2], f.S[0], f.S[1], f.S[2], f.T[0], f.T[1], f.T[2], f.U[0], f.U[1],
+    f.U[2] };
   vtkFFDDataContract::SetFrame(lattice, frame);
   vtkFFDDataContract::SetDivisions(lattice, n);
   vtkFFDDataContract::SetBasis(lattice, basis);
@@ -248,7 +248,8 @@ inline double MaxRelativeError(vtkPointSet* input, vtkPointSet* output, const Re
 // Largest distance any point moved, over the frame's diagonal: shows that a comparison could fail.
 inline double MaxRelativeMotion(vtkPointSet* input, vtkPointSet* output, const ffdref::Frame& f)
 {
-  return MaxScaledDistance(input, output, [](const Vec& x) { return x; }, Diagonal(f));
+  return MaxScaledDistance(
+    input, output, [](const Vec& x) { return x; }, Diagonal(f));
 }
 
 inline double Det(const Matrix& a)

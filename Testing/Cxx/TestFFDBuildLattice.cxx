@@ -185,7 +185,8 @@ bool VoxelTouchesPoint(int basis, int v, int a)
  * with `basis` over `voxels`, a voxel grid whose cell ghost array marks inactive voxels) against a brute
  * force: a control point is active when any active voxel lies in its support along all three axes.
  */
-void ExpectActiveFromSupports(int basis, vtkStructuredGrid* voxels, vtkFFDBuildLattice* build, vtkStructuredGrid* lattice)
+void ExpectActiveFromSupports(
+  int basis, vtkStructuredGrid* voxels, vtkFFDBuildLattice* build, vtkStructuredGrid* lattice)
 {
   int vd[3], pd[3];
   voxels->GetDimensions(vd);
@@ -512,10 +513,11 @@ TEST(vtkFFDBuildLattice, FigureCaptionStatisticsOfTheBear)
     vtkStructuredGrid* lattice = build->GetOutput();
     int dims[3];
     lattice->GetDimensions(dims);
-    std::cout << "bear " << vtkFFDBuildLattice::GetBasisAsString(basis) << " 5x5x5 voxels: "
-              << bear->GetNumberOfPoints() << " vertices, " << lattice->GetNumberOfPoints() << " control points ("
-              << dims[0] << "x" << dims[1] << "x" << dims[2] << "), " << voxelize->GetNumberOfActiveVoxels()
-              << " active voxels, " << build->GetNumberOfActiveControlPoints() << " active control points\n";
+    std::cout << "bear " << vtkFFDBuildLattice::GetBasisAsString(basis)
+              << " 5x5x5 voxels: " << bear->GetNumberOfPoints() << " vertices, " << lattice->GetNumberOfPoints()
+              << " control points (" << dims[0] << "x" << dims[1] << "x" << dims[2] << "), "
+              << voxelize->GetNumberOfActiveVoxels() << " active voxels, " << build->GetNumberOfActiveControlPoints()
+              << " active control points\n";
     if (basis != vtkFFDBuildLattice::TRILINEAR)
     {
       continue;
@@ -646,6 +648,6 @@ TEST(vtkFFDBuildLattice, DivisionsAboveTheMaximumBernsteinDegreeAreAnError)
   // The limit is the global basis's: a local basis takes any number of divisions.
   vtkNew<vtkFFDBuildLattice> local;
   local->SetBasisToCubicBSpline();
-  EXPECT_EQ(Build(local, MakeVoxelGrid(SkewedFrame, tooMany))->GetNumberOfPoints(),
-    4 * (ffd::MaxBernsteinDegree + 4) * 4);
+  EXPECT_EQ(
+    Build(local, MakeVoxelGrid(SkewedFrame, tooMany))->GetNumberOfPoints(), 4 * (ffd::MaxBernsteinDegree + 4) * 4);
 }

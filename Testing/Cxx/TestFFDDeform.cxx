@@ -224,7 +224,8 @@ TEST(vtkFFDDeform, OutputArraysAreReusedOnlyWhenNobodyElseHoldsThem)
     copies.push_back(vtk::TakeSmartPointer(kept->NewInstance()));
     copies.back()->DeepCopy(kept);
   }
-  auto unchanged = [&](vtkDataArray* kept, vtkDataArray* copy) {
+  auto unchanged = [&](vtkDataArray* kept, vtkDataArray* copy)
+  {
     for (vtkIdType v = 0; v < kept->GetNumberOfValues(); ++v)
     {
       if (kept->GetComponent(v / kept->GetNumberOfComponents(), v % kept->GetNumberOfComponents()) !=
@@ -376,7 +377,8 @@ TEST(vtkFFDDeform, OutsidePointsStayAndBoundaryPointsDeform)
   Perturb(lattice, rng, 0.3);
   const std::vector<Vec> p = ControlPoints(lattice);
 
-  auto at = [&](double s, double t, double u) {
+  auto at = [&](double s, double t, double u)
+  {
     return Vec{ f.X0[0] + s * f.S[0] + t * f.T[0] + u * f.U[0], f.X0[1] + s * f.S[1] + t * f.T[1] + u * f.U[1],
       f.X0[2] + s * f.S[2] + t * f.T[2] + u * f.U[2] };
   };
@@ -491,19 +493,16 @@ TEST(vtkFFDDeform, BadLatticesAreRefusedWithAClearError)
   const std::vector<Case> cases = {
     { "no frame", [](vtkStructuredGrid* l) { l->GetFieldData()->RemoveArray("FFDFrame"); }, "FFDFrame" },
     { "flat frame", [&](vtkStructuredGrid* l) { vtkFFDDataContract::SetFrame(l, flat); }, "no volume" },
-    { "non-finite frame", [&](vtkStructuredGrid* l) { vtkFFDDataContract::SetFrame(l, nonFinite); },
-      "FFDFrame" },
-    { "no divisions", [](vtkStructuredGrid* l) { l->GetFieldData()->RemoveArray("FFDDivisions"); },
-      "FFDDivisions" },
-    { "zero divisions", [&](vtkStructuredGrid* l) { vtkFFDDataContract::SetDivisions(l, zero); },
-      "FFDDivisions" },
+    { "non-finite frame", [&](vtkStructuredGrid* l) { vtkFFDDataContract::SetFrame(l, nonFinite); }, "FFDFrame" },
+    { "no divisions", [](vtkStructuredGrid* l) { l->GetFieldData()->RemoveArray("FFDDivisions"); }, "FFDDivisions" },
+    { "zero divisions", [&](vtkStructuredGrid* l) { vtkFFDDataContract::SetDivisions(l, zero); }, "FFDDivisions" },
     { "no basis", [](vtkStructuredGrid* l) { l->GetFieldData()->RemoveArray("FFDBasis"); }, "FFDBasis" },
     { "unknown basis", [](vtkStructuredGrid* l) { vtkFFDDataContract::SetBasis(l, 7); }, "not a known basis" },
     { "point count of another basis",
-      [](vtkStructuredGrid* l) { vtkFFDDataContract::SetBasis(l, vtkFFDBuildLattice::CUBIC_BSPLINE); },
-      "need 125" },
+      [](vtkStructuredGrid* l) { vtkFFDDataContract::SetBasis(l, vtkFFDBuildLattice::CUBIC_BSPLINE); }, "need 125" },
     { "wrong point count",
-      [](vtkStructuredGrid* l) {
+      [](vtkStructuredGrid* l)
+      {
         const int more[3] = { 2, 2, 3 };
         vtkFFDDataContract::SetDivisions(l, more);
       },
@@ -511,7 +510,8 @@ TEST(vtkFFDDeform, BadLatticesAreRefusedWithAClearError)
     { "no rest position", [](vtkStructuredGrid* l) { l->GetPointData()->RemoveArray("RestPosition"); },
       "RestPosition" },
     { "rest position of 2 components",
-      [](vtkStructuredGrid* l) {
+      [](vtkStructuredGrid* l)
+      {
         vtkNew<vtkDoubleArray> rest;
         rest->SetName("RestPosition");
         rest->SetNumberOfComponents(2);
@@ -520,18 +520,20 @@ TEST(vtkFFDDeform, BadLatticesAreRefusedWithAClearError)
         l->GetPointData()->AddArray(rest);
       },
       "RestPosition" },
-    { "non-finite control point",
-      [](vtkStructuredGrid* l) { l->GetPoints()->SetPoint(5, 0.0, std::nan(""), 0.0); }, "not finite" },
+    { "non-finite control point", [](vtkStructuredGrid* l) { l->GetPoints()->SetPoint(5, 0.0, std::nan(""), 0.0); },
+      "not finite" },
     // Divisions whose counts wrap in 32 or 64 bits (a product that wrapped to 0 once passed the point count).
     { "divisions beyond an int",
-      [](vtkStructuredGrid* l) {
+      [](vtkStructuredGrid* l)
+      {
         const int huge[3] = { 1431655765, 1, 1 };
         vtkFFDDataContract::SetBasis(l, vtkFFDBuildLattice::TRICUBIC_BEZIER);
         vtkFFDDataContract::SetDivisions(l, huge);
       },
       "is too large" },
     { "a product that wraps",
-      [](vtkStructuredGrid* l) {
+      [](vtkStructuredGrid* l)
+      {
         const int wrapping[3] = { 4194303, 2097151, 2097151 };
         vtkFFDDataContract::SetBasis(l, vtkFFDBuildLattice::TRILINEAR);
         vtkFFDDataContract::SetDivisions(l, wrapping);
@@ -549,8 +551,7 @@ TEST(vtkFFDDeform, BadLatticesAreRefusedWithAClearError)
     vtkNew<FFDTestErrorObserver> observer;
     observer->WatchWithExecutive(deform);
     deform->Update();
-    EXPECT_NE(observer->Errors.find(c.Expected), std::string::npos)
-      << c.Name << ": got \"" << observer->Errors << "\"";
+    EXPECT_NE(observer->Errors.find(c.Expected), std::string::npos) << c.Name << ": got \"" << observer->Errors << "\"";
     EXPECT_EQ(deform->GetOutput()->GetNumberOfPoints(), 0) << c.Name;
   }
 }
@@ -587,9 +588,8 @@ TEST(vtkFFDDeform, ReportsProgress)
   std::vector<double> progress;
   vtkNew<vtkCallbackCommand> onProgress;
   onProgress->SetClientData(&progress);
-  onProgress->SetCallback([](vtkObject* caller, unsigned long, void* data, void*) {
-    static_cast<std::vector<double>*>(data)->push_back(static_cast<vtkAlgorithm*>(caller)->GetProgress());
-  });
+  onProgress->SetCallback([](vtkObject* caller, unsigned long, void* data, void*)
+    { static_cast<std::vector<double>*>(data)->push_back(static_cast<vtkAlgorithm*>(caller)->GetProgress()); });
   pipeline.Deform->AddObserver(vtkCommand::ProgressEvent, onProgress);
   pipeline.Deform->Update();
   ASSERT_GE(progress.size(), 2u);

@@ -38,8 +38,7 @@ namespace
 using namespace ffdtest;
 
 const int AllBases[] = { vtkFFDBuildLattice::BERNSTEIN, vtkFFDBuildLattice::TRILINEAR,
-  vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, vtkFFDBuildLattice::TRICUBIC_BEZIER,
-  vtkFFDBuildLattice::CUBIC_BSPLINE };
+  vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, vtkFFDBuildLattice::TRICUBIC_BEZIER, vtkFFDBuildLattice::CUBIC_BSPLINE };
 const int LocalBases[] = { vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::TRIQUADRATIC_BEZIER,
   vtkFFDBuildLattice::TRICUBIC_BEZIER, vtkFFDBuildLattice::CUBIC_BSPLINE };
 
@@ -143,7 +142,8 @@ TEST(vtkFFDDeformLocal, RandomVertexOrderIsGatheredFromACopy)
     order[static_cast<std::size_t>(i)] = i;
   }
   std::shuffle(order.begin(), order.end(), rng);
-  auto pointsOnly = [&](bool shuffled, double shift) {
+  auto pointsOnly = [&](bool shuffled, double shift)
+  {
     vtkNew<vtkPoints> points;
     points->SetDataTypeToFloat();
     points->SetNumberOfPoints(n);
@@ -263,8 +263,7 @@ TEST(vtkFFDDeformLocal, CubicBSplineEqualsVTKBSplineTransform)
     ASSERT_EQ(f.U[0], 0.0);
     ASSERT_EQ(f.U[1], 0.0);
 
-    vtkDataArray* rest =
-      pipeline.Lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
+    vtkDataArray* rest = pipeline.Lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
     ASSERT_NE(rest, nullptr);
     double origin[3];
     rest->GetTuple(0, origin);
@@ -355,7 +354,8 @@ TEST(vtkFFDDeformLocal, MovingOneControlPointChangesOnlyItsSupport)
   {
     Pipeline pipeline(mesh, basis, n[0], n[1], n[2]);
     const ffdref::Frame f = FrameOf(pipeline.Lattice);
-    auto voxelOf = [&](const Vec& x) {
+    auto voxelOf = [&](const Vec& x)
+    {
       const Vec stu = ffdref::Parameters(f, x);
       return std::array<int, 3>{ VoxelOf(stu[0], n[0]), VoxelOf(stu[1], n[1]), VoxelOf(stu[2], n[2]) };
     };
@@ -579,8 +579,7 @@ TEST(vtkFFDDeformLocal, LatticeSizedForAnotherBasisIsRefused)
     vtkNew<FFDTestErrorObserver> observer;
     observer->WatchWithExecutive(deform);
     deform->Update();
-    const long need =
-      long(PointsAlongAxis(c[1], n[0])) * PointsAlongAxis(c[1], n[1]) * PointsAlongAxis(c[1], n[2]);
+    const long need = long(PointsAlongAxis(c[1], n[0])) * PointsAlongAxis(c[1], n[1]) * PointsAlongAxis(c[1], n[2]);
     EXPECT_NE(observer->Errors.find("need " + std::to_string(need)), std::string::npos)
       << name << ": got \"" << observer->Errors << "\"";
     EXPECT_NE(observer->Errors.find(BasisName(c[1])), std::string::npos) << name;

@@ -257,7 +257,8 @@ TEST(vtkFFDDeformTetrahedral, RestIsTheIdentityAndAffineMotionsAreReproducedOnAR
 
   const double m[3][3] = { { 1.1, 0.2, -0.1 }, { -0.15, 0.9, 0.05 }, { 0.1, 0.3, 1.2 } };
   const Vec b = { 0.3, -0.2, 0.5 };
-  auto affine = [&](const Vec& x) {
+  auto affine = [&](const Vec& x)
+  {
     Vec y;
     for (int r = 0; r < 3; ++r)
     {
@@ -479,7 +480,8 @@ TEST(vtkFFDDeformTetrahedral, OutsidePolicies)
   clamp->ComputeJacobianDeterminantOn();
   clamp->Update();
   vtkPointSet* clamped = clamp->GetOutput();
-  auto clampedReference = [&](const Vec& x) {
+  auto clampedReference = [&](const Vec& x)
+  {
     Vec c = { std::clamp(x[0], 0.0, 1.0), std::clamp(x[1], 0.0, 1.0), std::clamp(x[2], 0.0, 1.0) };
     const Vec d = ffdref::Sub(ReferenceDeform(lattice, ReferenceTetrahedron(lattice, c), c), c);
     return Vec{ x[0] + d[0], x[1] + d[1], x[2] + d[2] };
@@ -505,8 +507,8 @@ TEST(vtkFFDDeformTetrahedral, OutsidePolicies)
         j[r][c] = (yp[r] - ym[r]) / (2 * h);
       }
     }
-    EXPECT_NEAR(clamped->GetPointData()->GetArray("JacobianDeterminant")->GetTuple1(i),
-      vtkMath::Determinant3x3(j), 1e-8);
+    EXPECT_NEAR(
+      clamped->GetPointData()->GetArray("JacobianDeterminant")->GetTuple1(i), vtkMath::Determinant3x3(j), 1e-8);
   }
 }
 
@@ -561,8 +563,7 @@ TEST(vtkFFDDeformTetrahedral, LatticesWithoutVolumeKeepEveryPoint)
   DisplaceNodes(lattice, 0.1, 47);
   auto mesh = RandomPoints(200, -0.5, 1.5, VTK_DOUBLE, 53);
   mesh->GetPoints()->InsertNextPoint(std::numeric_limits<double>::quiet_NaN(), 0.5, 0.5);
-  for (const int policy :
-    { vtkFFDDeform::KEEP_POSITION, vtkFFDDeform::CLAMP_TO_EDGE, vtkFFDDeform::EXTRAPOLATE })
+  for (const int policy : { vtkFFDDeform::KEEP_POSITION, vtkFFDDeform::CLAMP_TO_EDGE, vtkFFDDeform::EXTRAPOLATE })
   {
     SCOPED_TRACE("outside policy " + std::to_string(policy));
     vtkNew<FFDTestErrorObserver> observer;
@@ -646,7 +647,8 @@ TEST(vtkFFDDeformTetrahedral, InconsistentLatticesAreErrors)
     { "no RestPosition", "no RestPosition point array",
       [](vtkUnstructuredGrid* g) { g->GetPointData()->RemoveArray("RestPosition"); } },
     { "2 components", "no RestPosition point array",
-      [](vtkUnstructuredGrid* g) {
+      [](vtkUnstructuredGrid* g)
+      {
         vtkNew<vtkDoubleArray> r;
         r->SetName("RestPosition");
         r->SetNumberOfComponents(2);
@@ -657,7 +659,8 @@ TEST(vtkFFDDeformTetrahedral, InconsistentLatticesAreErrors)
     { "too few tuples", "no RestPosition point array",
       [](vtkUnstructuredGrid* g) { g->GetPointData()->GetArray("RestPosition")->SetNumberOfTuples(3); } },
     { "a hexahedron", "cell 6 is not a tetrahedron (VTK cell type 12)",
-      [](vtkUnstructuredGrid* g) {
+      [](vtkUnstructuredGrid* g)
+      {
         const vtkIdType hex[8] = { 0, 1, 4, 3, 9, 10, 13, 12 };
         const vtkIdType keep = g->GetNumberOfCells();
         vtkNew<vtkUnstructuredGrid> copy;
@@ -678,18 +681,24 @@ TEST(vtkFFDDeformTetrahedral, InconsistentLatticesAreErrors)
     { "a NaN node", "point 5 or its RestPosition is not finite",
       [](vtkUnstructuredGrid* g) { g->GetPoints()->SetPoint(5, std::nan(""), 0.0, 0.0); } },
     { "no cells", "has no cells",
-      [](vtkUnstructuredGrid* g) {
+      [](vtkUnstructuredGrid* g)
+      {
         vtkNew<vtkCellArray> none;
         g->SetCells(VTK_TETRA, none);
       } },
     // Point ids outside the lattice, checked before any node is read through them (the id 77 of 4
     // points, a negative id, and a tetrahedron of three ids).
     { "id 77", "cell 2 names point 77, but the lattice has",
-      [](vtkUnstructuredGrid* g) { g->GetCells()->ReplaceCellAtId(2, { 0, 1, 77, 3 }); } },
-    { "id -1", "cell 0 names point -1",
-      [](vtkUnstructuredGrid* g) { g->GetCells()->ReplaceCellAtId(0, { 0, -1, 2, 3 }); } },
-    { "three ids", "is a tetrahedron of 3 point ids instead of 4",
       [](vtkUnstructuredGrid* g) {
+        g->GetCells()->ReplaceCellAtId(2, { 0, 1, 77, 3 });
+      } },
+    { "id -1", "cell 0 names point -1",
+      [](vtkUnstructuredGrid* g) {
+        g->GetCells()->ReplaceCellAtId(0, { 0, -1, 2, 3 });
+      } },
+    { "three ids", "is a tetrahedron of 3 point ids instead of 4",
+      [](vtkUnstructuredGrid* g)
+      {
         const vtkIdType three[3] = { 0, 1, 2 };
         g->InsertNextCell(VTK_TETRA, 3, three);
       } },
@@ -762,8 +771,7 @@ TEST(vtkFFDDeformTetrahedral, ExtrapolateNeedsATetrahedralLattice)
   deform->SetLatticeConnection(build->GetOutputPort());
   deform->SetOutsidePolicyToExtrapolate();
   deform->Update();
-  EXPECT_NE(observer->Errors.find("EXTRAPOLATE needs a tetrahedral lattice"), std::string::npos)
-    << observer->Errors;
+  EXPECT_NE(observer->Errors.find("EXTRAPOLATE needs a tetrahedral lattice"), std::string::npos) << observer->Errors;
   EXPECT_EQ(deform->GetOutput()->GetNumberOfPoints(), 0);
 }
 
@@ -885,7 +893,8 @@ TEST(vtkFFDBuildTetrahedralLattice, MarksTheNodesOfTetrahedraHoldingPointsActive
     const Vec x = Point(mesh->GetPoints(), i);
     const vtkIdType cell = ReferenceTetrahedron(lattice, x);
     ASSERT_GE(cell, 0) << "mesh point " << i << " is outside the control mesh";
-    const auto w = [&] {
+    const auto w = [&]
+    {
       const auto n = Nodes(lattice, cell);
       return ffdref::TetrahedronWeights(
         Rest(lattice, n[0]), Rest(lattice, n[1]), Rest(lattice, n[2]), Rest(lattice, n[3]), x);

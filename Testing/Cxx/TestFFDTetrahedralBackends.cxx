@@ -91,8 +91,8 @@ TEST(vtkFFDDeformTetrahedral, BackendChoiceAndCpuFallback)
     EXPECT_TRUE(observer->Errors.empty()) << observer->Errors;
     vtkPointSet* output = deform->GetOutput();
     const double points = LargestDifference(cpu->GetPoints()->GetData(), output->GetPoints()->GetData());
-    const double unitNormals = LargestDifference(
-      cpu->GetPointData()->GetNormals(), output->GetPointData()->GetNormals());
+    const double unitNormals =
+      LargestDifference(cpu->GetPointData()->GetNormals(), output->GetPointData()->GetNormals());
     const double determinants =
       LargestDifference(cpu->GetPointData()->GetArray(vtkFFDDeform::JacobianDeterminantArrayName()),
         output->GetPointData()->GetArray(vtkFFDDeform::JacobianDeterminantArrayName()));

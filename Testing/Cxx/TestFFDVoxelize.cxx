@@ -85,8 +85,8 @@ std::set<Voxel> BruteForceActiveVoxels(const std::vector<Vec>& xs, const ffdref:
 std::set<Voxel> ShownVoxels(vtkStructuredGrid* grid, const int n[3])
 {
   std::set<Voxel> shown;
-  vtkUnsignedCharArray* ghosts = vtkUnsignedCharArray::SafeDownCast(
-    grid->GetCellData()->GetArray(vtkDataSetAttributes::GhostArrayName()));
+  vtkUnsignedCharArray* ghosts =
+    vtkUnsignedCharArray::SafeDownCast(grid->GetCellData()->GetArray(vtkDataSetAttributes::GhostArrayName()));
   EXPECT_NE(ghosts, nullptr);
   if (!ghosts)
   {
@@ -209,8 +209,8 @@ TEST(vtkFFDVoxelize, AxisAlignedFrameIsThePaddedBounds)
     // The frame is a few additions away from the bounds: 1e-12 of the mesh size is far above rounding.
     const double tol = 1e-12 * largest;
     const Vec size = { hi[0] - lo[0] + 2 * pad, hi[1] - lo[1] + 2 * pad, hi[2] - lo[2] + 2 * pad };
-    const ffdref::Frame box = { { lo[0] - pad, lo[1] - pad, lo[2] - pad }, { size[0], 0.0, 0.0 },
-      { 0.0, size[1], 0.0 }, { 0.0, 0.0, size[2] } };
+    const ffdref::Frame box = { { lo[0] - pad, lo[1] - pad, lo[2] - pad }, { size[0], 0.0, 0.0 }, { 0.0, size[1], 0.0 },
+      { 0.0, 0.0, size[2] } };
     EXPECT_TRUE(ffdtest::FramesNear(f, box, tol));
     for (const Vec& x : xs)
     {

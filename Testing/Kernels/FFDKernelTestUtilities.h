@@ -89,7 +89,8 @@ inline double WorldScale(const ffdref::Frame& f, const ffdref::Vec& x)
  */
 inline ffdref::Frame RandomFrame(Rng& rng)
 {
-  const auto edge = [&rng]() {
+  const auto edge = [&rng]()
+  {
     ffdref::Vec d;
     do
     {
@@ -202,8 +203,8 @@ inline ::testing::AssertionResult MaxDiffWithin(
     return ::testing::AssertionSuccess();
   }
   std::ostringstream s;
-  s << std::setprecision(17) << "max |got - want| = " << diff << " > " << tol << ", got (" << got[0] << ", "
-    << got[1] << ", " << got[2] << "), expected (" << want[0] << ", " << want[1] << ", " << want[2] << ")";
+  s << std::setprecision(17) << "max |got - want| = " << diff << " > " << tol << ", got (" << got[0] << ", " << got[1]
+    << ", " << got[2] << "), expected (" << want[0] << ", " << want[1] << ", " << want[2] << ")";
   return ::testing::AssertionFailure() << s.str();
 }
 
@@ -270,8 +271,8 @@ struct GridLattice
   }
   std::string Name() const
   {
-    return BasisName(Basis) + " divisions (" + std::to_string(Divisions[0]) + "," + std::to_string(Divisions[1]) +
-      "," + std::to_string(Divisions[2]) + ")";
+    return BasisName(Basis) + " divisions (" + std::to_string(Divisions[0]) + "," + std::to_string(Divisions[1]) + "," +
+      std::to_string(Divisions[2]) + ")";
   }
 };
 
@@ -299,8 +300,7 @@ inline GridLattice RandomGridLattice(Rng& rng, ffdref::Basis basis, int maxDivis
  * 0..trials - 1, where f takes it too). Stops at the first fatal failure, as an ASSERT_* in the loop's body would.
  */
 template <typename F>
-void ForEachRandomLattice(
-  Rng& rng, std::initializer_list<ffdref::Basis> bases, int trials, int maxDivisions, F&& f)
+void ForEachRandomLattice(Rng& rng, std::initializer_list<ffdref::Basis> bases, int trials, int maxDivisions, F&& f)
 {
   for (ffdref::Basis b : bases)
   {
@@ -506,9 +506,9 @@ Mat CentralDifferences(const ffdref::Vec& x, double h, F&& f)
 struct ReferenceJacobian
 {
   Mat J;
-  ffdref::Vec Stu;            ///< the point's parameters, clamped to the frame
-  std::array<int, 3> Voxel;   ///< the voxel along each axis of the cell the kernel bound the point to
-  std::array<bool, 3> Free;   ///< false along the axes the point is clamped along
+  ffdref::Vec Stu;          ///< the point's parameters, clamped to the frame
+  std::array<int, 3> Voxel; ///< the voxel along each axis of the cell the kernel bound the point to
+  std::array<bool, 3> Free; ///< false along the axes the point is clamped along
 };
 
 /**
@@ -573,8 +573,8 @@ Mat JacobianErrorBound(const GridLattice& lat, const std::vector<ffdref::Vec>& d
     }
     std::array<int, 3> order = { 0, 0, 0 };
     ++order[a];
-    const ffdref::Vec first = ffdref::EvaluateLocalDerivative(
-      lat.Basis, lat.Divisions.data(), displacements, ref.Stu, order, ref.Voxel, true);
+    const ffdref::Vec first =
+      ffdref::EvaluateLocalDerivative(lat.Basis, lat.Divisions.data(), displacements, ref.Stu, order, ref.Voxel, true);
     ffdref::Vec moved = { 0, 0, 0 }; // |d(dD/d stu_a)| from the parameters' errors
     for (int b = 0; b < 3; ++b)
     {

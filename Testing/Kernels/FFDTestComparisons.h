@@ -31,11 +31,11 @@ using RealTypes = ::testing::Types<float, double>;
 
 /// Declares the typed test suite `Suite`, an empty fixture whose TYPED_TESTs run once with TypeParam = float and
 /// once with TypeParam = double.
-#define FFD_REAL_TYPED_TEST_SUITE(Suite)                                                                          \
-  template <typename Real>                                                                                       \
-  class Suite : public ::testing::Test                                                                           \
-  {                                                                                                              \
-  };                                                                                                             \
+#define FFD_REAL_TYPED_TEST_SUITE(Suite)                                                                               \
+  template <typename Real>                                                                                             \
+  class Suite : public ::testing::Test                                                                                 \
+  {                                                                                                                    \
+  };                                                                                                                   \
   TYPED_TEST_SUITE(Suite, ::ffdtest::RealTypes)
 
 /// Tracks the worst error / tolerance ratio of a test and records it in the XML output (--gtest_output=xml),
@@ -207,8 +207,7 @@ template <typename A, typename B>
     {
       if (!(got.M[r][c] == want.M[r][c]))
       {
-        detail::Mismatch(
-          result, failed, detail::Index(name, r, c), double(got.M[r][c]), double(want.M[r][c]), "");
+        detail::Mismatch(result, failed, detail::Index(name, r, c), double(got.M[r][c]), double(want.M[r][c]), "");
       }
     }
   }

@@ -98,8 +98,7 @@ TYPED_TEST(FFDBernsteinTest, DerivativeMatchesAnalyticFormula)
       ffd::BernsteinBasis(n, x, bOnly);
       for (int k = 0; k <= n; ++k)
       {
-        ASSERT_NEAR(double(db[k]), ReferenceDerivative(n, k, double(x)), tol)
-          << "n=" << n << " k=" << k << " x=" << x;
+        ASSERT_NEAR(double(db[k]), ReferenceDerivative(n, k, double(x)), tol) << "n=" << n << " k=" << k << " x=" << x;
         // The values that come with the derivative are the basis itself, to the last bit of their reference.
         ASSERT_LE(std::fabs(double(b[k]) - ffdref::Bernstein(n, k, double(x))),
           4.0 * (n + 1) * Eps<Real>() * ffdref::Bernstein(n, k, double(x)) +

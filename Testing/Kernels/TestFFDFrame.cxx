@@ -89,7 +89,8 @@ TYPED_TEST(FFDFrameTest, BindKeepsCornersFacesAndInterior)
     const ffd::Frame<Real> frame = KernelFrame<Real>(f);
     // Bound parameters are clamped to [0, 1] and, inside, equal the reference's to the tolerance of
     // ToParametricMatchesReference.
-    const auto expectBound = [&](const V& x, const Vec& stu, const char* what) {
+    const auto expectBound = [&](const V& x, const Vec& stu, const char* what)
+    {
       V got;
       ASSERT_TRUE(frame.Bind(x, got)) << what << ", frame " << trial;
       const Vec g = ffdtest::ToRef(got);

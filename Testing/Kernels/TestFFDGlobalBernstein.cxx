@@ -268,7 +268,8 @@ Lattice Elevate(const Lattice& lat, int axis)
         const int q = ijk[axis];
         const double w = double(q) / (degree + 1);
         Vec& target = e.Points[i + out[0] * (j + out[1] * k)];
-        const auto add = [&](int index, double weight) {
+        const auto add = [&](int index, double weight)
+        {
           if (weight == 0.0)
           {
             return;
@@ -364,8 +365,7 @@ TYPED_TEST(FFDGlobalBernsteinTest, DeformationJacobianMatchesCentralDifferences)
     const ffd::Frame<Real> frame = ffd::Frame<Real>::FromArray(fa);
     for (int p = 0; p < 10; ++p)
     {
-      const ffd::Vec3<Real> x =
-        ffdtest::ToKernel<Real>(ffdtest::ToWorld(lat.F, ffdtest::RandomVec(rng, 0.01, 0.99)));
+      const ffd::Vec3<Real> x = ffdtest::ToKernel<Real>(ffdtest::ToWorld(lat.F, ffdtest::RandomVec(rng, 0.01, 0.99)));
       const Vec xd = ffdtest::ToRef(x);
       ffd::Vec3<Real> stu;
       ASSERT_TRUE(frame.Bind(x, stu));
@@ -478,8 +478,7 @@ TYPED_TEST(FFDGlobalBernsteinTest, CofactorIsDeterminantTimesInverseTranspose)
       a[2][c] = double(ak.M[2][c]);
       amax = std::max(amax, std::fabs(a[2][c]));
     }
-    const Vec rows[3] = { { a[0][0], a[0][1], a[0][2] }, { a[1][0], a[1][1], a[1][2] },
-      { a[2][0], a[2][1], a[2][2] } };
+    const Vec rows[3] = { { a[0][0], a[0][1], a[0][2] }, { a[1][0], a[1][1], a[1][2] }, { a[2][0], a[2][1], a[2][2] } };
     ffdtest::Mat crosses; // row r: the cross product of the other two rows
     for (int r = 0; r < 3; ++r)
     {

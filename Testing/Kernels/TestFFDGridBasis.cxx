@@ -66,8 +66,8 @@ Vec Evaluate(const GridLattice& lat, const std::vector<Real>& values, const Vec&
 
 /// ffd::SumTensorProductWithGradient: the value, and gradient[r][c] = d x_r / d stu_c.
 template <typename Real>
-Vec EvaluateWithGradient(const GridLattice& lat, const std::vector<Real>& values, const Vec& stu,
-  double gradient[3][3], const int* cells = nullptr)
+Vec EvaluateWithGradient(const GridLattice& lat, const std::vector<Real>& values, const Vec& stu, double gradient[3][3],
+  const int* cells = nullptr)
 {
   Axes<Real> axes[3];
   KernelAxes(lat, stu, cells, true, axes);
@@ -210,33 +210,35 @@ TYPED_TEST(FFDGridBasisTest, RestLatticeIsIdentity)
   using Real = TypeParam;
   ffdtest::Rng rng(402);
   WorstRatio worst("worst_error_over_tolerance");
-  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](const GridLattice& lat) {
-    const std::vector<Real> values = ffdtest::Flatten<Real>(lat.Rest);
-    const double tol = EvaluationTolerance<Real>() * ffdtest::LatticeScale(lat.Rest);
-    std::vector<Vec> params;
-    for (int p = 0; p < 50; ++p)
+  ffdtest::ForEachRandomLattice(rng, 20, 6,
+    [&](const GridLattice& lat)
     {
-      params.push_back(RandomParameters<Real>(rng));
-    }
-    for (int p = 0; p < 50; ++p)
-    {
-      Vec stu;
-      for (int a = 0; a < 3; ++a)
+      const std::vector<Real> values = ffdtest::Flatten<Real>(lat.Rest);
+      const double tol = EvaluationTolerance<Real>() * ffdtest::LatticeScale(lat.Rest);
+      std::vector<Vec> params;
+      for (int p = 0; p < 50; ++p)
       {
-        const int n = lat.Divisions[a];
-        const int i = std::uniform_int_distribution<int>(0, lat.Dims()[a] - 1)(rng);
-        stu[a] = double(Real(std::min(std::max(ffdref::RestParameter(lat.Basis, n, i), 0.0), 1.0)));
+        params.push_back(RandomParameters<Real>(rng));
       }
-      params.push_back(stu);
-    }
-    for (const Vec& stu : params)
-    {
-      const Vec got = Evaluate(lat, values, stu);
-      const Vec want = ffdtest::ToWorld(lat.F, stu);
-      ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst))
-        << lat.Name() << " at (" << stu[0] << "," << stu[1] << "," << stu[2] << ")";
-    }
-  });
+      for (int p = 0; p < 50; ++p)
+      {
+        Vec stu;
+        for (int a = 0; a < 3; ++a)
+        {
+          const int n = lat.Divisions[a];
+          const int i = std::uniform_int_distribution<int>(0, lat.Dims()[a] - 1)(rng);
+          stu[a] = double(Real(std::min(std::max(ffdref::RestParameter(lat.Basis, n, i), 0.0), 1.0)));
+        }
+        params.push_back(stu);
+      }
+      for (const Vec& stu : params)
+      {
+        const Vec got = Evaluate(lat, values, stu);
+        const Vec want = ffdtest::ToWorld(lat.F, stu);
+        ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst))
+          << lat.Name() << " at (" << stu[0] << "," << stu[1] << "," << stu[2] << ")";
+      }
+    });
 }
 
 TYPED_TEST(FFDGridBasisTest, AffineMotionIsReproduced)
@@ -246,23 +248,25 @@ TYPED_TEST(FFDGridBasisTest, AffineMotionIsReproduced)
   using Real = TypeParam;
   ffdtest::Rng rng(403);
   WorstRatio worst("worst_error_over_tolerance");
-  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](const GridLattice& lat) {
-    const ffdtest::Affine map = ffdtest::RandomAffine(rng, 0.5);
-    std::vector<Vec> mapped;
-    for (const Vec& p : lat.Rest)
+  ffdtest::ForEachRandomLattice(rng, 20, 6,
+    [&](const GridLattice& lat)
     {
-      mapped.push_back(map(p));
-    }
-    const std::vector<Real> values = ffdtest::Flatten<Real>(mapped);
-    const double tol = EvaluationTolerance<Real>() * ffdtest::LatticeScale(mapped);
-    for (int p = 0; p < 50; ++p)
-    {
-      const Vec stu = RandomParameters<Real>(rng);
-      const Vec got = Evaluate(lat, values, stu);
-      const Vec want = map(ffdtest::ToWorld(lat.F, stu));
-      ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst)) << lat.Name() << " point " << p;
-    }
-  });
+      const ffdtest::Affine map = ffdtest::RandomAffine(rng, 0.5);
+      std::vector<Vec> mapped;
+      for (const Vec& p : lat.Rest)
+      {
+        mapped.push_back(map(p));
+      }
+      const std::vector<Real> values = ffdtest::Flatten<Real>(mapped);
+      const double tol = EvaluationTolerance<Real>() * ffdtest::LatticeScale(mapped);
+      for (int p = 0; p < 50; ++p)
+      {
+        const Vec stu = RandomParameters<Real>(rng);
+        const Vec got = Evaluate(lat, values, stu);
+        const Vec want = map(ffdtest::ToWorld(lat.F, stu));
+        ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst)) << lat.Name() << " point " << p;
+      }
+    });
 }
 
 TYPED_TEST(FFDGridBasisTest, RandomLatticesMatchReference)
@@ -273,18 +277,20 @@ TYPED_TEST(FFDGridBasisTest, RandomLatticesMatchReference)
   using Real = TypeParam;
   ffdtest::Rng rng(404);
   WorstRatio worst("worst_error_over_tolerance");
-  ffdtest::ForEachRandomLattice(rng, 40, 6, [&](const GridLattice& lat) {
-    const std::vector<Real> values = ffdtest::Flatten<Real>(lat.Points);
-    const std::vector<Vec> seen = ffdtest::RoundLattice<Real>(lat.Points);
-    const double tol = EvaluationTolerance<Real>() * ffdtest::LatticeScale(seen);
-    for (int p = 0; p < 30; ++p)
+  ffdtest::ForEachRandomLattice(rng, 40, 6,
+    [&](const GridLattice& lat)
     {
-      const Vec stu = RandomParameters<Real>(rng);
-      const Vec got = Evaluate(lat, values, stu);
-      const Vec want = ffdref::EvaluateLocal(lat.Basis, lat.Divisions.data(), seen, stu);
-      ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst)) << lat.Name() << " point " << p;
-    }
-  });
+      const std::vector<Real> values = ffdtest::Flatten<Real>(lat.Points);
+      const std::vector<Vec> seen = ffdtest::RoundLattice<Real>(lat.Points);
+      const double tol = EvaluationTolerance<Real>() * ffdtest::LatticeScale(seen);
+      for (int p = 0; p < 30; ++p)
+      {
+        const Vec stu = RandomParameters<Real>(rng);
+        const Vec got = Evaluate(lat, values, stu);
+        const Vec want = ffdref::EvaluateLocal(lat.Basis, lat.Divisions.data(), seen, stu);
+        ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst)) << lat.Name() << " point " << p;
+      }
+    });
 }
 
 TYPED_TEST(FFDGridBasisTest, OneBezierVoxelEqualsGlobalBernstein)
@@ -299,35 +305,37 @@ TYPED_TEST(FFDGridBasisTest, OneBezierVoxelEqualsGlobalBernstein)
   ffdtest::Rng rng(405);
   WorstRatio worst("worst_error_over_tolerance");
   const auto bases = { Basis::Trilinear, Basis::TriquadraticBezier, Basis::TricubicBezier };
-  ffdtest::ForEachRandomLattice(rng, bases, 20, 1, [&](const GridLattice& bezier) {
-    const int d = int(bezier.Basis);
-    GridLattice global = bezier;
-    global.Basis = Basis::Bernstein;
-    global.Divisions = { d, d, d };
-    ASSERT_EQ(bezier.Dims(), global.Dims());
-    ASSERT_EQ(ffdref::RestLattice(Basis::Bernstein, global.F, global.Divisions.data()), bezier.Rest);
-    for (int i = 0; i <= d; ++i)
+  ffdtest::ForEachRandomLattice(rng, bases, 20, 1,
+    [&](const GridLattice& bezier)
     {
-      ASSERT_EQ(
-        ffd::RestParameter(KernelBasis(bezier.Basis), 1, i), ffd::RestParameter(ffd::GridBasis::Bernstein, d, i));
-    }
-    const std::vector<Real> values = ffdtest::Flatten<Real>(bezier.Points);
-    const std::vector<Vec> seen = ffdtest::RoundLattice<Real>(bezier.Points);
-    const double scale = ffdtest::LatticeScale(seen);
-    const double tol = EvaluationTolerance<Real>() * scale;
-    for (int p = 0; p < 50; ++p)
-    {
-      const Vec stu = RandomParameters<Real>(rng);
-      double gb[3][3], gg[3][3];
-      const Vec xb = EvaluateWithGradient(bezier, values, stu, gb);
-      const Vec xg = EvaluateWithGradient(global, values, stu, gg);
-      const Vec want = ffdref::Evaluate(seen, d, d, d, stu);
-      ASSERT_TRUE(ffdtest::MaxDiffWithin(xb, xg, tol, &worst)) << bezier.Name() << " point " << p;
-      ASSERT_TRUE(ffdtest::MaxDiffWithin(xb, want, tol, &worst)) << bezier.Name() << " point " << p;
-      ASSERT_TRUE(ffdtest::MatrixNear(gb, gg, GradientTolerance<Real>() * scale, "dx/dstu"))
-        << bezier.Name() << " point " << p;
-    }
-  });
+      const int d = int(bezier.Basis);
+      GridLattice global = bezier;
+      global.Basis = Basis::Bernstein;
+      global.Divisions = { d, d, d };
+      ASSERT_EQ(bezier.Dims(), global.Dims());
+      ASSERT_EQ(ffdref::RestLattice(Basis::Bernstein, global.F, global.Divisions.data()), bezier.Rest);
+      for (int i = 0; i <= d; ++i)
+      {
+        ASSERT_EQ(
+          ffd::RestParameter(KernelBasis(bezier.Basis), 1, i), ffd::RestParameter(ffd::GridBasis::Bernstein, d, i));
+      }
+      const std::vector<Real> values = ffdtest::Flatten<Real>(bezier.Points);
+      const std::vector<Vec> seen = ffdtest::RoundLattice<Real>(bezier.Points);
+      const double scale = ffdtest::LatticeScale(seen);
+      const double tol = EvaluationTolerance<Real>() * scale;
+      for (int p = 0; p < 50; ++p)
+      {
+        const Vec stu = RandomParameters<Real>(rng);
+        double gb[3][3], gg[3][3];
+        const Vec xb = EvaluateWithGradient(bezier, values, stu, gb);
+        const Vec xg = EvaluateWithGradient(global, values, stu, gg);
+        const Vec want = ffdref::Evaluate(seen, d, d, d, stu);
+        ASSERT_TRUE(ffdtest::MaxDiffWithin(xb, xg, tol, &worst)) << bezier.Name() << " point " << p;
+        ASSERT_TRUE(ffdtest::MaxDiffWithin(xb, want, tol, &worst)) << bezier.Name() << " point " << p;
+        ASSERT_TRUE(ffdtest::MatrixNear(gb, gg, GradientTolerance<Real>() * scale, "dx/dstu"))
+          << bezier.Name() << " point " << p;
+      }
+    });
 }
 
 /// One side of a voxel face or knot along axis `a`: the value, the analytic gradient, and the derivative of the
@@ -346,8 +354,8 @@ struct Side
  * (the other columns), so only rounding remains.
  */
 template <typename Real>
-Side EvaluateSide(const GridLattice& lat, const std::vector<Real>& values, const Vec& stu, const int cells[3],
-  int a, int dir, double h)
+Side EvaluateSide(
+  const GridLattice& lat, const std::vector<Real>& values, const Vec& stu, const int cells[3], int a, int dir, double h)
 {
   constexpr int Nodes = 4;
   Side side;
@@ -596,23 +604,25 @@ TYPED_TEST(FFDGridBasisTest, GradientMatchesCentralDifferences)
   using Real = TypeParam;
   ffdtest::Rng rng(409);
   WorstRatio worst("worst_error_over_tolerance");
-  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](const GridLattice& lat) {
-    const std::vector<Real> values = ffdtest::Flatten<Real>(lat.Points);
-    const std::vector<Vec> seen = ffdtest::RoundLattice<Real>(lat.Points);
-    const double scale = ffdtest::LatticeScale(seen);
-    for (int p = 0; p < 10; ++p)
+  ffdtest::ForEachRandomLattice(rng, 20, 6,
+    [&](const GridLattice& lat)
     {
-      const Vec stu = InteriorParameters<Real>(rng, lat, 0.01);
-      double g[3][3];
-      const Vec got = EvaluateWithGradient(lat, values, stu, g);
-      const Vec want = ffdref::EvaluateLocal(lat.Basis, lat.Divisions.data(), seen, stu);
-      ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, EvaluationTolerance<Real>() * scale)) << lat.Name();
-      const ffdtest::Mat fd = ffdtest::CentralDifferences(
-        stu, 1e-6, [&](const Vec& y) { return ffdref::EvaluateLocal(lat.Basis, lat.Divisions.data(), seen, y); });
-      const auto tol = [&](int r, int c) { return GradientTolerance<Real>() * std::max(scale, std::fabs(fd[r][c])); };
-      ASSERT_TRUE(ffdtest::MatrixNear(g, fd, tol, "dx/dstu", &worst)) << lat.Name() << " point " << p;
-    }
-  });
+      const std::vector<Real> values = ffdtest::Flatten<Real>(lat.Points);
+      const std::vector<Vec> seen = ffdtest::RoundLattice<Real>(lat.Points);
+      const double scale = ffdtest::LatticeScale(seen);
+      for (int p = 0; p < 10; ++p)
+      {
+        const Vec stu = InteriorParameters<Real>(rng, lat, 0.01);
+        double g[3][3];
+        const Vec got = EvaluateWithGradient(lat, values, stu, g);
+        const Vec want = ffdref::EvaluateLocal(lat.Basis, lat.Divisions.data(), seen, stu);
+        ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, EvaluationTolerance<Real>() * scale)) << lat.Name();
+        const ffdtest::Mat fd = ffdtest::CentralDifferences(
+          stu, 1e-6, [&](const Vec& y) { return ffdref::EvaluateLocal(lat.Basis, lat.Divisions.data(), seen, y); });
+        const auto tol = [&](int r, int c) { return GradientTolerance<Real>() * std::max(scale, std::fabs(fd[r][c])); };
+        ASSERT_TRUE(ffdtest::MatrixNear(g, fd, tol, "dx/dstu", &worst)) << lat.Name() << " point " << p;
+      }
+    });
 }
 
 } // namespace

@@ -29,9 +29,9 @@ using ffdtest::EvaluationTolerance;
 using ffdtest::GradientTolerance;
 using ffdtest::GridLattice;
 using ffdtest::MaxAbs;
-using ffdtest::WorstRatio;
 using ffdtest::PositionTolerance;
 using ffdtest::WithKernel;
+using ffdtest::WorstRatio;
 
 /// Cells per axis seen by the binding, from the data contract: the voxels, one cell for the global basis.
 int Cells(const GridLattice& lat, int a)
@@ -90,25 +90,29 @@ TYPED_TEST(FFDGridDeformationTest, DeformMatchesReference)
   using Real = TypeParam;
   ffdtest::Rng rng(501);
   WorstRatio worst("worst_error_over_tolerance");
-  ffdtest::ForEachRandomLattice(rng, 30, 6, [&](const GridLattice& lat) {
-    const double scale = ffdtest::LatticeScale(lat.Points);
-    WithKernel<Real>(lat, [&](const auto& k) {
-      for (int p = 0; p < 30; ++p)
-      {
-        const ffd::Vec3<Real> x = PointAt<Real>(lat, ffdtest::RandomVec(rng, 0.0, 1.0)).first;
-        const Vec xd = ffdtest::ToRef(x);
-        const int cell = k.Bind(x, false);
-        ASSERT_GE(cell, 0) << lat.Name() << " point " << p;
-        ffd::Mat3<Real> j;
-        const Vec got = ffdtest::ToRef(k.D.Deform(x, cell));
-        const Vec gotJ = ffdtest::ToRef(k.D.Deform(x, cell, j));
-        const Vec want = ffdref::DeformLocal(lat.Basis, lat.F, lat.Divisions.data(), lat.Points, xd);
-        const double tol = PositionTolerance(scale, xd, lat.F, j);
-        ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst)) << lat.Name() << " point " << p;
-        ASSERT_TRUE(ffdtest::MaxDiffWithin(gotJ, want, tol)) << lat.Name() << " point " << p << " (with Jacobian)";
-      }
+  ffdtest::ForEachRandomLattice(rng, 30, 6,
+    [&](const GridLattice& lat)
+    {
+      const double scale = ffdtest::LatticeScale(lat.Points);
+      WithKernel<Real>(lat,
+        [&](const auto& k)
+        {
+          for (int p = 0; p < 30; ++p)
+          {
+            const ffd::Vec3<Real> x = PointAt<Real>(lat, ffdtest::RandomVec(rng, 0.0, 1.0)).first;
+            const Vec xd = ffdtest::ToRef(x);
+            const int cell = k.Bind(x, false);
+            ASSERT_GE(cell, 0) << lat.Name() << " point " << p;
+            ffd::Mat3<Real> j;
+            const Vec got = ffdtest::ToRef(k.D.Deform(x, cell));
+            const Vec gotJ = ffdtest::ToRef(k.D.Deform(x, cell, j));
+            const Vec want = ffdref::DeformLocal(lat.Basis, lat.F, lat.Divisions.data(), lat.Points, xd);
+            const double tol = PositionTolerance(scale, xd, lat.F, j);
+            ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst)) << lat.Name() << " point " << p;
+            ASSERT_TRUE(ffdtest::MaxDiffWithin(gotJ, want, tol)) << lat.Name() << " point " << p << " (with Jacobian)";
+          }
+        });
     });
-  });
 }
 
 TYPED_TEST(FFDGridDeformationTest, AffineMotionIsReproduced)
@@ -120,30 +124,34 @@ TYPED_TEST(FFDGridDeformationTest, AffineMotionIsReproduced)
   using Real = TypeParam;
   ffdtest::Rng rng(502);
   WorstRatio worst("worst_error_over_tolerance");
-  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](GridLattice& lat) {
-    const ffdtest::Affine map = ffdtest::RandomAffine(rng, 0.5);
-    const double mmax = ffdtest::MaxAbsEntry(map.A, 1.0);
-    for (size_t i = 0; i < lat.Rest.size(); ++i)
+  ffdtest::ForEachRandomLattice(rng, 20, 6,
+    [&](GridLattice& lat)
     {
-      lat.Points[i] = map(lat.Rest[i]);
-    }
-    const double scale = ffdtest::LatticeScale(lat.Points);
-    WithKernel<Real>(lat, [&](const auto& k) {
-      for (int p = 0; p < 30; ++p)
+      const ffdtest::Affine map = ffdtest::RandomAffine(rng, 0.5);
+      const double mmax = ffdtest::MaxAbsEntry(map.A, 1.0);
+      for (size_t i = 0; i < lat.Rest.size(); ++i)
       {
-        const ffd::Vec3<Real> x = PointAt<Real>(lat, ffdtest::RandomVec(rng, 0.0, 1.0)).first;
-        const Vec xd = ffdtest::ToRef(x);
-        const int cell = k.Bind(x, false);
-        ASSERT_GE(cell, 0);
-        ffd::Mat3<Real> j;
-        const Vec got = ffdtest::ToRef(k.D.Deform(x, cell, j));
-        const double tol = EvaluationTolerance<Real>() * (scale + MaxAbs(xd));
-        ASSERT_TRUE(ffdtest::MaxDiffWithin(got, map(xd), tol, &worst)) << lat.Name() << " point " << p;
-        const double tolJ = 100.0 * EvaluationTolerance<Real>() * mmax;
-        ASSERT_TRUE(ffdtest::MatrixNear(j, map.A, tolJ, "J", &worst)) << lat.Name() << " point " << p;
+        lat.Points[i] = map(lat.Rest[i]);
       }
+      const double scale = ffdtest::LatticeScale(lat.Points);
+      WithKernel<Real>(lat,
+        [&](const auto& k)
+        {
+          for (int p = 0; p < 30; ++p)
+          {
+            const ffd::Vec3<Real> x = PointAt<Real>(lat, ffdtest::RandomVec(rng, 0.0, 1.0)).first;
+            const Vec xd = ffdtest::ToRef(x);
+            const int cell = k.Bind(x, false);
+            ASSERT_GE(cell, 0);
+            ffd::Mat3<Real> j;
+            const Vec got = ffdtest::ToRef(k.D.Deform(x, cell, j));
+            const double tol = EvaluationTolerance<Real>() * (scale + MaxAbs(xd));
+            ASSERT_TRUE(ffdtest::MaxDiffWithin(got, map(xd), tol, &worst)) << lat.Name() << " point " << p;
+            const double tolJ = 100.0 * EvaluationTolerance<Real>() * mmax;
+            ASSERT_TRUE(ffdtest::MatrixNear(j, map.A, tolJ, "J", &worst)) << lat.Name() << " point " << p;
+          }
+        });
     });
-  });
 }
 
 /// Central differences, h = 1e-6, of a map of world points: fd[r][c] = d f_r / d x_c.
@@ -169,21 +177,25 @@ TYPED_TEST(FFDGridDeformationTest, JacobianMatchesCentralDifferences)
   using Real = TypeParam;
   ffdtest::Rng rng(503);
   WorstRatio worst("worst_error_over_tolerance");
-  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](const GridLattice& lat) {
-    WithKernel<Real>(lat, [&](const auto& k) {
-      for (int p = 0; p < 10; ++p)
-      {
-        const ffd::Vec3<Real> x = PointAt<Real>(lat, InteriorParameters(rng, lat, 0.01)).first;
-        const int cell = k.Bind(x, false);
-        ASSERT_GE(cell, 0);
-        ffd::Mat3<Real> j;
-        k.D.Deform(x, cell, j);
-        const ffdtest::Mat fd = ReferenceJacobianAt(lat, ffdtest::ToRef(x));
-        const double tol = GradientTolerance<Real>() * ffdtest::MaxAbsEntry(fd, 1.0);
-        ASSERT_TRUE(ffdtest::MatrixNear(j, fd, tol, "J", &worst)) << lat.Name() << " point " << p;
-      }
+  ffdtest::ForEachRandomLattice(rng, 20, 6,
+    [&](const GridLattice& lat)
+    {
+      WithKernel<Real>(lat,
+        [&](const auto& k)
+        {
+          for (int p = 0; p < 10; ++p)
+          {
+            const ffd::Vec3<Real> x = PointAt<Real>(lat, InteriorParameters(rng, lat, 0.01)).first;
+            const int cell = k.Bind(x, false);
+            ASSERT_GE(cell, 0);
+            ffd::Mat3<Real> j;
+            k.D.Deform(x, cell, j);
+            const ffdtest::Mat fd = ReferenceJacobianAt(lat, ffdtest::ToRef(x));
+            const double tol = GradientTolerance<Real>() * ffdtest::MaxAbsEntry(fd, 1.0);
+            ASSERT_TRUE(ffdtest::MatrixNear(j, fd, tol, "J", &worst)) << lat.Name() << " point " << p;
+          }
+        });
     });
-  });
 }
 
 TYPED_TEST(FFDGridDeformationTest, TransformNormalMatchesDeformedTangents)
@@ -198,39 +210,43 @@ TYPED_TEST(FFDGridDeformationTest, TransformNormalMatchesDeformedTangents)
   ffdtest::Rng rng(508);
   WorstRatio worst("worst_error_over_tolerance");
   int folded = 0;
-  ffdtest::ForEachRandomLattice(rng, 20, 4, [&](const GridLattice& lat) {
-    WithKernel<Real>(lat, [&](const auto& k) {
-      for (int p = 0; p < 10; ++p)
-      {
-        const ffd::Vec3<Real> x = PointAt<Real>(lat, InteriorParameters(rng, lat, 0.01)).first;
-        const int cell = k.Bind(x, false);
-        ASSERT_GE(cell, 0);
-        ffd::Mat3<Real> j;
-        k.D.Deform(x, cell, j);
-        const ffdtest::Mat fd = ReferenceJacobianAt(lat, ffdtest::ToRef(x));
-        const double jmax = ffdtest::MaxAbsEntry(fd, 1.0);
-        const Vec t1 = ffdtest::RandomVec(rng, -1.0, 1.0), t2 = ffdtest::RandomVec(rng, -1.0, 1.0);
-        const Vec n = ffdref::Cross(t1, t2);
-        const double nn = ffdtest::Norm(n);
-        if (nn < 0.1)
+  ffdtest::ForEachRandomLattice(rng, 20, 4,
+    [&](const GridLattice& lat)
+    {
+      WithKernel<Real>(lat,
+        [&](const auto& k)
         {
-          continue;
-        }
-        const Vec m = ffdref::Cross(ffdtest::Product(fd, t1), ffdtest::Product(fd, t2));
-        const double mm = ffdtest::Norm(m);
-        if (mm < 0.1 * nn)
-        {
-          continue;
-        }
-        folded += ffd::Determinant(j) < Real(0) ? 1 : 0;
-        const ffd::Vec3<Real> unit = ffdtest::ToKernel<Real>({ n[0] / nn, n[1] / nn, n[2] / nn });
-        const Vec got = ffdtest::ToRef(ffd::TransformNormal(j, unit));
-        const Vec want = { m[0] / mm, m[1] / mm, m[2] / mm };
-        const double tol = 10.0 * GradientTolerance<Real>() * jmax * jmax * nn / mm;
-        ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst)) << lat.Name() << " point " << p;
-      }
+          for (int p = 0; p < 10; ++p)
+          {
+            const ffd::Vec3<Real> x = PointAt<Real>(lat, InteriorParameters(rng, lat, 0.01)).first;
+            const int cell = k.Bind(x, false);
+            ASSERT_GE(cell, 0);
+            ffd::Mat3<Real> j;
+            k.D.Deform(x, cell, j);
+            const ffdtest::Mat fd = ReferenceJacobianAt(lat, ffdtest::ToRef(x));
+            const double jmax = ffdtest::MaxAbsEntry(fd, 1.0);
+            const Vec t1 = ffdtest::RandomVec(rng, -1.0, 1.0), t2 = ffdtest::RandomVec(rng, -1.0, 1.0);
+            const Vec n = ffdref::Cross(t1, t2);
+            const double nn = ffdtest::Norm(n);
+            if (nn < 0.1)
+            {
+              continue;
+            }
+            const Vec m = ffdref::Cross(ffdtest::Product(fd, t1), ffdtest::Product(fd, t2));
+            const double mm = ffdtest::Norm(m);
+            if (mm < 0.1 * nn)
+            {
+              continue;
+            }
+            folded += ffd::Determinant(j) < Real(0) ? 1 : 0;
+            const ffd::Vec3<Real> unit = ffdtest::ToKernel<Real>({ n[0] / nn, n[1] / nn, n[2] / nn });
+            const Vec got = ffdtest::ToRef(ffd::TransformNormal(j, unit));
+            const Vec want = { m[0] / mm, m[1] / mm, m[2] / mm };
+            const double tol = 10.0 * GradientTolerance<Real>() * jmax * jmax * nn / mm;
+            ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst)) << lat.Name() << " point " << p;
+          }
+        });
     });
-  });
   ::testing::Test::RecordProperty("folded_points", folded);
 }
 
@@ -245,69 +261,73 @@ TYPED_TEST(FFDGridDeformationTest, BindToGridFindsCells)
   //  - interior voxel faces s = c/n: cell c - 1 or c.
   using Real = TypeParam;
   ffdtest::Rng rng(504);
-  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](const GridLattice& lat) {
-    const double scale = ffdtest::LatticeScale(lat.Points);
-    WithKernel<Real>(lat, [&](const auto& k) {
-      for (int p = 0; p < 100; ++p)
-      {
-        const auto [x, stu] = PointAt<Real>(lat, ffdtest::RandomVec(rng, 0.0, 1.0));
-        int c[3];
-        bool nearFace = false;
-        for (int a = 0; a < 3; ++a)
+  ffdtest::ForEachRandomLattice(rng, 20, 6,
+    [&](const GridLattice& lat)
+    {
+      const double scale = ffdtest::LatticeScale(lat.Points);
+      WithKernel<Real>(lat,
+        [&](const auto& k)
         {
-          const double v = stu[a] * Cells(lat, a);
-          c[a] = std::min(int(std::floor(v)), Cells(lat, a) - 1);
-          nearFace = nearFace || std::fabs(v - std::round(v)) < 1e-3;
-        }
-        if (!nearFace)
-        {
-          ASSERT_EQ(k.Bind(x, false), FlatCell(lat, c)) << lat.Name() << " point " << p;
-          ASSERT_EQ(k.Bind(x, true), FlatCell(lat, c)) << lat.Name() << " point " << p;
-        }
-      }
-      for (int combo = 0; combo < 27; ++combo)
-      {
-        const int kind[3] = { combo % 3, (combo / 3) % 3, combo / 9 }; // 0: s = 0, 1: interior, 2: s = 1
-        Vec stu;
-        int c[3];
-        for (int a = 0; a < 3; ++a)
-        {
-          const int cells = Cells(lat, a);
-          const int random = std::uniform_int_distribution<int>(0, cells - 1)(rng);
-          c[a] = kind[a] == 0 ? 0 : (kind[a] == 2 ? cells - 1 : random);
-          stu[a] = kind[a] == 0 ? 0.0 : (kind[a] == 2 ? 1.0 : (c[a] + ffdtest::Uniform(rng, 0.01, 0.99)) / cells);
-        }
-        const ffd::Vec3<Real> x = PointAt<Real>(lat, stu).first;
-        const Vec xd = ffdtest::ToRef(x);
-        const int cell = k.Bind(x, false);
-        ASSERT_EQ(cell, FlatCell(lat, c)) << lat.Name() << " kinds " << kind[0] << kind[1] << kind[2];
-        ASSERT_EQ(k.Bind(x, true), cell) << lat.Name() << " kinds " << kind[0] << kind[1] << kind[2];
-        const Vec want = ffdref::DeformLocal(lat.Basis, lat.F, lat.Divisions.data(), lat.Points, xd);
-        ffd::Mat3<Real> j;
-        const Vec got = ffdtest::ToRef(k.D.Deform(x, cell, j));
-        ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, PositionTolerance(scale, xd, lat.F, j)))
-          << lat.Name() << " kinds " << kind[0] << kind[1] << kind[2];
-      }
-      for (int a = 0; a < 3; ++a)
-      {
-        for (int face = 1; face < Cells(lat, a); ++face)
-        {
-          Vec stu = InteriorParameters(rng, lat, 0.01); // the other axes away from their cells' faces
-          int lo[3], hi[3];
-          for (int q = 0; q < 3; ++q)
+          for (int p = 0; p < 100; ++p)
           {
-            lo[q] = hi[q] = int(std::floor(stu[q] * Cells(lat, q)));
+            const auto [x, stu] = PointAt<Real>(lat, ffdtest::RandomVec(rng, 0.0, 1.0));
+            int c[3];
+            bool nearFace = false;
+            for (int a = 0; a < 3; ++a)
+            {
+              const double v = stu[a] * Cells(lat, a);
+              c[a] = std::min(int(std::floor(v)), Cells(lat, a) - 1);
+              nearFace = nearFace || std::fabs(v - std::round(v)) < 1e-3;
+            }
+            if (!nearFace)
+            {
+              ASSERT_EQ(k.Bind(x, false), FlatCell(lat, c)) << lat.Name() << " point " << p;
+              ASSERT_EQ(k.Bind(x, true), FlatCell(lat, c)) << lat.Name() << " point " << p;
+            }
           }
-          stu[a] = double(face) / Cells(lat, a);
-          lo[a] = face - 1;
-          hi[a] = face;
-          const int cell = k.Bind(PointAt<Real>(lat, stu).first, false);
-          ASSERT_TRUE(cell == FlatCell(lat, lo) || cell == FlatCell(lat, hi))
-            << lat.Name() << " face " << face << " of axis " << a << ": cell " << cell;
-        }
-      }
+          for (int combo = 0; combo < 27; ++combo)
+          {
+            const int kind[3] = { combo % 3, (combo / 3) % 3, combo / 9 }; // 0: s = 0, 1: interior, 2: s = 1
+            Vec stu;
+            int c[3];
+            for (int a = 0; a < 3; ++a)
+            {
+              const int cells = Cells(lat, a);
+              const int random = std::uniform_int_distribution<int>(0, cells - 1)(rng);
+              c[a] = kind[a] == 0 ? 0 : (kind[a] == 2 ? cells - 1 : random);
+              stu[a] = kind[a] == 0 ? 0.0 : (kind[a] == 2 ? 1.0 : (c[a] + ffdtest::Uniform(rng, 0.01, 0.99)) / cells);
+            }
+            const ffd::Vec3<Real> x = PointAt<Real>(lat, stu).first;
+            const Vec xd = ffdtest::ToRef(x);
+            const int cell = k.Bind(x, false);
+            ASSERT_EQ(cell, FlatCell(lat, c)) << lat.Name() << " kinds " << kind[0] << kind[1] << kind[2];
+            ASSERT_EQ(k.Bind(x, true), cell) << lat.Name() << " kinds " << kind[0] << kind[1] << kind[2];
+            const Vec want = ffdref::DeformLocal(lat.Basis, lat.F, lat.Divisions.data(), lat.Points, xd);
+            ffd::Mat3<Real> j;
+            const Vec got = ffdtest::ToRef(k.D.Deform(x, cell, j));
+            ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, PositionTolerance(scale, xd, lat.F, j)))
+              << lat.Name() << " kinds " << kind[0] << kind[1] << kind[2];
+          }
+          for (int a = 0; a < 3; ++a)
+          {
+            for (int face = 1; face < Cells(lat, a); ++face)
+            {
+              Vec stu = InteriorParameters(rng, lat, 0.01); // the other axes away from their cells' faces
+              int lo[3], hi[3];
+              for (int q = 0; q < 3; ++q)
+              {
+                lo[q] = hi[q] = int(std::floor(stu[q] * Cells(lat, q)));
+              }
+              stu[a] = double(face) / Cells(lat, a);
+              lo[a] = face - 1;
+              hi[a] = face;
+              const int cell = k.Bind(PointAt<Real>(lat, stu).first, false);
+              ASSERT_TRUE(cell == FlatCell(lat, lo) || cell == FlatCell(lat, hi))
+                << lat.Name() << " face " << face << " of axis " << a << ": cell " << cell;
+            }
+          }
+        });
     });
-  });
 }
 
 TYPED_TEST(FFDGridDeformationTest, BindToGridOutsideAndNonFinite)
@@ -319,48 +339,52 @@ TYPED_TEST(FFDGridDeformationTest, BindToGridOutsideAndNonFinite)
   using Real = TypeParam;
   ffdtest::Rng rng(505);
   const double band = double(ffd::ParametricTolerance<Real>());
-  ffdtest::ForEachRandomLattice(rng, 10, 6, [&](const GridLattice& lat) {
-    WithKernel<Real>(lat, [&](const auto& k) {
-      for (int p = 0; p < 200; ++p)
-      {
-        const int axis = std::uniform_int_distribution<int>(0, 2)(rng);
-        const bool high = rng() % 2 == 1;
-        const bool far = p % 2 == 0;
-        Vec stu = InteriorParameters(rng, lat, 0.01);
-        const double out = far ? ffdtest::Uniform(rng, 0.01, 2.0) : ffdtest::Uniform(rng, -3.0 * band, 3.0 * band);
-        stu[axis] = high ? 1.0 + out : -out;
-        const auto [x, seen] = PointAt<Real>(lat, stu);
-        const double beyond = high ? seen[axis] - 1.0 : -seen[axis];
-        int c[3];
-        for (int a = 0; a < 3; ++a)
+  ffdtest::ForEachRandomLattice(rng, 10, 6,
+    [&](const GridLattice& lat)
+    {
+      WithKernel<Real>(lat,
+        [&](const auto& k)
         {
-          c[a] = std::min(std::max(int(std::floor(seen[a] * Cells(lat, a))), 0), Cells(lat, a) - 1);
-        }
-        if (beyond <= 0.5 * band)
-        {
-          ASSERT_EQ(k.Bind(x, false), FlatCell(lat, c)) << lat.Name() << " " << beyond << " outside";
-          ASSERT_EQ(k.Bind(x, true), FlatCell(lat, c)) << lat.Name() << " " << beyond << " outside";
-        }
-        else if (beyond >= 2.0 * band)
-        {
-          ASSERT_EQ(k.Bind(x, false), -1) << lat.Name() << " " << beyond << " outside";
-          ASSERT_EQ(k.Bind(x, true), FlatCell(lat, c)) << lat.Name() << " " << beyond << " outside";
-        }
-      }
-      const Real bad[3] = { std::numeric_limits<Real>::quiet_NaN(), std::numeric_limits<Real>::infinity(),
-        -std::numeric_limits<Real>::infinity() };
-      for (int a = 0; a < 3; ++a)
-      {
-        for (Real v : bad)
-        {
-          ffd::Vec3<Real> x = PointAt<Real>(lat, { 0.5, 0.5, 0.5 }).first;
-          (a == 0 ? x.x : (a == 1 ? x.y : x.z)) = v;
-          ASSERT_EQ(k.Bind(x, false), -1) << lat.Name() << " coordinate " << a << " = " << v;
-          ASSERT_EQ(k.Bind(x, true), -1) << lat.Name() << " coordinate " << a << " = " << v;
-        }
-      }
+          for (int p = 0; p < 200; ++p)
+          {
+            const int axis = std::uniform_int_distribution<int>(0, 2)(rng);
+            const bool high = rng() % 2 == 1;
+            const bool far = p % 2 == 0;
+            Vec stu = InteriorParameters(rng, lat, 0.01);
+            const double out = far ? ffdtest::Uniform(rng, 0.01, 2.0) : ffdtest::Uniform(rng, -3.0 * band, 3.0 * band);
+            stu[axis] = high ? 1.0 + out : -out;
+            const auto [x, seen] = PointAt<Real>(lat, stu);
+            const double beyond = high ? seen[axis] - 1.0 : -seen[axis];
+            int c[3];
+            for (int a = 0; a < 3; ++a)
+            {
+              c[a] = std::min(std::max(int(std::floor(seen[a] * Cells(lat, a))), 0), Cells(lat, a) - 1);
+            }
+            if (beyond <= 0.5 * band)
+            {
+              ASSERT_EQ(k.Bind(x, false), FlatCell(lat, c)) << lat.Name() << " " << beyond << " outside";
+              ASSERT_EQ(k.Bind(x, true), FlatCell(lat, c)) << lat.Name() << " " << beyond << " outside";
+            }
+            else if (beyond >= 2.0 * band)
+            {
+              ASSERT_EQ(k.Bind(x, false), -1) << lat.Name() << " " << beyond << " outside";
+              ASSERT_EQ(k.Bind(x, true), FlatCell(lat, c)) << lat.Name() << " " << beyond << " outside";
+            }
+          }
+          const Real bad[3] = { std::numeric_limits<Real>::quiet_NaN(), std::numeric_limits<Real>::infinity(),
+            -std::numeric_limits<Real>::infinity() };
+          for (int a = 0; a < 3; ++a)
+          {
+            for (Real v : bad)
+            {
+              ffd::Vec3<Real> x = PointAt<Real>(lat, { 0.5, 0.5, 0.5 }).first;
+              (a == 0 ? x.x : (a == 1 ? x.y : x.z)) = v;
+              ASSERT_EQ(k.Bind(x, false), -1) << lat.Name() << " coordinate " << a << " = " << v;
+              ASSERT_EQ(k.Bind(x, true), -1) << lat.Name() << " coordinate " << a << " = " << v;
+            }
+          }
+        });
     });
-  });
 }
 
 TYPED_TEST(FFDGridDeformationTest, ClampingGivesEdgeDisplacement)
@@ -375,58 +399,62 @@ TYPED_TEST(FFDGridDeformationTest, ClampingGivesEdgeDisplacement)
   using Real = TypeParam;
   ffdtest::Rng rng(506);
   WorstRatio worst("worst_error_over_tolerance");
-  ffdtest::ForEachRandomLattice(rng, 20, 6, [&](const GridLattice& lat) {
-    const double scale = ffdtest::LatticeScale(lat.Points);
-    const Vec edges[3] = { lat.F.S, lat.F.T, lat.F.U };
-    WithKernel<Real>(lat, [&](const auto& k) {
-      for (int p = 0; p < 20; ++p)
-      {
-        Vec stu = InteriorParameters(rng, lat, 0.01);
-        bool clamped[3] = { false, false, false };
-        for (int a = 0; a < 3; ++a)
+  ffdtest::ForEachRandomLattice(rng, 20, 6,
+    [&](const GridLattice& lat)
+    {
+      const double scale = ffdtest::LatticeScale(lat.Points);
+      const Vec edges[3] = { lat.F.S, lat.F.T, lat.F.U };
+      WithKernel<Real>(lat,
+        [&](const auto& k)
         {
-          if (rng() % 2 == 0 || (a == 2 && !clamped[0] && !clamped[1]))
+          for (int p = 0; p < 20; ++p)
           {
-            clamped[a] = true;
-            const double out = ffdtest::Uniform(rng, 0.01, 0.5);
-            stu[a] = rng() % 2 == 0 ? -out : 1.0 + out;
-          }
-        }
-        const ffd::Vec3<Real> x = PointAt<Real>(lat, stu).first;
-        const Vec xd = ffdtest::ToRef(x);
-        ASSERT_EQ(k.Bind(x, false), -1) << lat.Name();
-        const int cell = k.Bind(x, true);
-        ASSERT_GE(cell, 0) << lat.Name();
-        ffd::Mat3<Real> j;
-        const Vec got = ffdtest::ToRef(k.D.Deform(x, cell, j));
-        const Vec gotPlain = ffdtest::ToRef(k.D.Deform(x, cell));
-        const Vec want = ClampedReference(lat, xd);
-        const double tol = PositionTolerance(scale, xd, lat.F, j);
-        ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst)) << lat.Name() << " point " << p;
-        ASSERT_TRUE(ffdtest::MaxDiffWithin(gotPlain, want, tol)) << lat.Name() << " point " << p;
+            Vec stu = InteriorParameters(rng, lat, 0.01);
+            bool clamped[3] = { false, false, false };
+            for (int a = 0; a < 3; ++a)
+            {
+              if (rng() % 2 == 0 || (a == 2 && !clamped[0] && !clamped[1]))
+              {
+                clamped[a] = true;
+                const double out = ffdtest::Uniform(rng, 0.01, 0.5);
+                stu[a] = rng() % 2 == 0 ? -out : 1.0 + out;
+              }
+            }
+            const ffd::Vec3<Real> x = PointAt<Real>(lat, stu).first;
+            const Vec xd = ffdtest::ToRef(x);
+            ASSERT_EQ(k.Bind(x, false), -1) << lat.Name();
+            const int cell = k.Bind(x, true);
+            ASSERT_GE(cell, 0) << lat.Name();
+            ffd::Mat3<Real> j;
+            const Vec got = ffdtest::ToRef(k.D.Deform(x, cell, j));
+            const Vec gotPlain = ffdtest::ToRef(k.D.Deform(x, cell));
+            const Vec want = ClampedReference(lat, xd);
+            const double tol = PositionTolerance(scale, xd, lat.F, j);
+            ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst)) << lat.Name() << " point " << p;
+            ASSERT_TRUE(ffdtest::MaxDiffWithin(gotPlain, want, tol)) << lat.Name() << " point " << p;
 
-        const ffdtest::Mat fd = CentralDifferences(xd, [&](const Vec& y) { return ClampedReference(lat, y); });
-        const double jmax = std::max(ffdtest::MaxAbsEntry(fd, 1.0), ffdtest::MaxAbsEntry(j, 1.0));
-        const double tolJ = GradientTolerance<Real>() * jmax;
-        ASSERT_TRUE(ffdtest::MatrixNear(j, fd, tolJ, "J", &worst)) << lat.Name() << " point " << p;
-        for (int a = 0; a < 3; ++a)
-        {
-          if (!clamped[a])
-          {
-            continue;
+            const ffdtest::Mat fd = CentralDifferences(xd, [&](const Vec& y) { return ClampedReference(lat, y); });
+            const double jmax = std::max(ffdtest::MaxAbsEntry(fd, 1.0), ffdtest::MaxAbsEntry(j, 1.0));
+            const double tolJ = GradientTolerance<Real>() * jmax;
+            ASSERT_TRUE(ffdtest::MatrixNear(j, fd, tolJ, "J", &worst)) << lat.Name() << " point " << p;
+            for (int a = 0; a < 3; ++a)
+            {
+              if (!clamped[a])
+              {
+                continue;
+              }
+              const Vec& e = edges[a];
+              Vec je;
+              for (int r = 0; r < 3; ++r)
+              {
+                je[r] = double(j.M[r][0]) * e[0] + double(j.M[r][1]) * e[1] + double(j.M[r][2]) * e[2];
+              }
+              ASSERT_TRUE(ffdtest::VectorNear(je, e, 100.0 * Eps<Real>() * jmax * ffdtest::Norm(e)))
+                << lat.Name() << " (J - I) E along clamped axis " << a;
+            }
           }
-          const Vec& e = edges[a];
-          Vec je;
-          for (int r = 0; r < 3; ++r)
-          {
-            je[r] = double(j.M[r][0]) * e[0] + double(j.M[r][1]) * e[1] + double(j.M[r][2]) * e[2];
-          }
-          ASSERT_TRUE(ffdtest::VectorNear(je, e, 100.0 * Eps<Real>() * jmax * ffdtest::Norm(e)))
-            << lat.Name() << " (J - I) E along clamped axis " << a;
-        }
-      }
+        });
     });
-  });
 }
 
 /**
@@ -491,56 +519,60 @@ TYPED_TEST(FFDGridDeformationTest, MovingOneControlPointIsLocal)
       const double scale = std::max(ffdtest::LatticeScale(lat.Points), ffdtest::LatticeScale(after.Points));
 
       int inside = 0, outside = 0;
-      WithKernel<Real>(lat, [&](const auto& k0) {
-        WithKernel<Real>(after, [&](const auto& k1) {
-          if ((k0.D.CellTable == nullptr) != (k1.D.CellTable == nullptr))
-          {
-            return; // compare like with like: a cell table rounds differently
-          }
-          for (int q = 0; q < 200; ++q)
-          {
-            Vec drawn = ffdtest::RandomVec(rng, 0.0, 1.0);
-            for (int a = 0; a < 3 && q % 2 == 0; ++a)
+      WithKernel<Real>(lat,
+        [&](const auto& k0)
+        {
+          WithKernel<Real>(after,
+            [&](const auto& k1)
             {
-              const std::pair<int, int> support = SupportVoxels(b, lat.Divisions[a], moved[a]);
-              const int c = std::uniform_int_distribution<int>(support.first, support.second)(rng);
-              drawn[a] = (c + ffdtest::Uniform(rng, 0.0, 1.0)) / lat.Divisions[a];
-            }
-            const auto [x, stu] = PointAt<Real>(lat, drawn);
-            const Vec xd = ffdtest::ToRef(x);
-            bool inSupport = true, nearFace = false;
-            for (int a = 0; a < 3; ++a)
-            {
-              const double v = stu[a] * lat.Divisions[a];
-              const int c = std::min(int(std::floor(v)), lat.Divisions[a] - 1);
-              const std::pair<int, int> support = SupportVoxels(b, lat.Divisions[a], moved[a]);
-              inSupport = inSupport && c >= support.first && c <= support.second;
-              nearFace = nearFace || std::fabs(v - std::round(v)) < 1e-3;
-            }
-            if (nearFace) // Real's rounding may bind it to the neighbouring voxel
-            {
-              continue;
-            }
-            const int cell = k0.Bind(x, false);
-            ASSERT_GE(cell, 0);
-            ffd::Mat3<Real> j0, j1;
-            const ffd::Vec3<Real> y0 = k0.D.Deform(x, cell, j0);
-            const ffd::Vec3<Real> y1 = k1.D.Deform(x, cell, j1);
-            if (!inSupport)
-            {
-              ++outside;
-              ASSERT_TRUE(y0.x == y1.x && y0.y == y1.y && y0.z == y1.z) << lat.Name() << " point " << q;
-              continue;
-            }
-            ++inside;
-            const Vec want = ffdref::Sub(ffdref::DeformLocal(b, after.F, after.Divisions.data(), after.Points, xd),
-              ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, xd));
-            const Vec got = ffdref::Sub(ffdtest::ToRef(y1), ffdtest::ToRef(y0));
-            const double tol = PositionTolerance(scale, xd, lat.F, j0) + PositionTolerance(scale, xd, lat.F, j1);
-            ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst)) << lat.Name() << " point " << q;
-          }
+              if ((k0.D.CellTable == nullptr) != (k1.D.CellTable == nullptr))
+              {
+                return; // compare like with like: a cell table rounds differently
+              }
+              for (int q = 0; q < 200; ++q)
+              {
+                Vec drawn = ffdtest::RandomVec(rng, 0.0, 1.0);
+                for (int a = 0; a < 3 && q % 2 == 0; ++a)
+                {
+                  const std::pair<int, int> support = SupportVoxels(b, lat.Divisions[a], moved[a]);
+                  const int c = std::uniform_int_distribution<int>(support.first, support.second)(rng);
+                  drawn[a] = (c + ffdtest::Uniform(rng, 0.0, 1.0)) / lat.Divisions[a];
+                }
+                const auto [x, stu] = PointAt<Real>(lat, drawn);
+                const Vec xd = ffdtest::ToRef(x);
+                bool inSupport = true, nearFace = false;
+                for (int a = 0; a < 3; ++a)
+                {
+                  const double v = stu[a] * lat.Divisions[a];
+                  const int c = std::min(int(std::floor(v)), lat.Divisions[a] - 1);
+                  const std::pair<int, int> support = SupportVoxels(b, lat.Divisions[a], moved[a]);
+                  inSupport = inSupport && c >= support.first && c <= support.second;
+                  nearFace = nearFace || std::fabs(v - std::round(v)) < 1e-3;
+                }
+                if (nearFace) // Real's rounding may bind it to the neighbouring voxel
+                {
+                  continue;
+                }
+                const int cell = k0.Bind(x, false);
+                ASSERT_GE(cell, 0);
+                ffd::Mat3<Real> j0, j1;
+                const ffd::Vec3<Real> y0 = k0.D.Deform(x, cell, j0);
+                const ffd::Vec3<Real> y1 = k1.D.Deform(x, cell, j1);
+                if (!inSupport)
+                {
+                  ++outside;
+                  ASSERT_TRUE(y0.x == y1.x && y0.y == y1.y && y0.z == y1.z) << lat.Name() << " point " << q;
+                  continue;
+                }
+                ++inside;
+                const Vec want = ffdref::Sub(ffdref::DeformLocal(b, after.F, after.Divisions.data(), after.Points, xd),
+                  ffdref::DeformLocal(b, lat.F, lat.Divisions.data(), lat.Points, xd));
+                const Vec got = ffdref::Sub(ffdtest::ToRef(y1), ffdtest::ToRef(y0));
+                const double tol = PositionTolerance(scale, xd, lat.F, j0) + PositionTolerance(scale, xd, lat.F, j1);
+                ASSERT_TRUE(ffdtest::MaxDiffWithin(got, want, tol, &worst)) << lat.Name() << " point " << q;
+              }
+            });
         });
-      });
       ASSERT_GT(inside, 0) << lat.Name();
       if (b != Basis::Bernstein)
       {

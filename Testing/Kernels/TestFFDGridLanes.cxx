@@ -11,9 +11,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <memory>
-#include <cstdlib>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -59,7 +59,8 @@ template <typename Real, typename K>
 PointSet<Real> MeshLikePoints(ffdtest::Rng& rng, const GridLattice& lat, const K& k, int count)
 {
   PointSet<Real> set;
-  auto add = [&](const Vec& stu) {
+  auto add = [&](const Vec& stu)
+  {
     const ffd::Vec3<Real> x = ffdtest::ToKernel<Real>(ffdtest::ToWorld(lat.F, stu));
     set.Values.insert(set.Values.end(), { x.x, x.y, x.z });
     set.Cells.push_back(k.Bind(x, false));
@@ -200,39 +201,43 @@ TYPED_TEST(FFDGridLanesTest, EveryLevelMatchesReference)
     levels += (levels.empty() ? "" : " ") + LevelName(level);
   }
   ::testing::Test::RecordProperty("simd_levels", levels);
-  ffdtest::ForEachRandomLattice(rng, 6, 5, [&](const GridLattice& lat) {
-    const double scale = ffdtest::LatticeScale(lat.Points);
-    ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
-      const PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 1001);
-      for (int maxCells : MaxCellsToTry())
-      {
-        const ffd::GatheredPoints gathered =
-          ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells, TestTile);
-        for (ffd::SimdLevel level : Levels())
+  ffdtest::ForEachRandomLattice(rng, 6, 5,
+    [&](const GridLattice& lat)
+    {
+      const double scale = ffdtest::LatticeScale(lat.Points);
+      ffdtest::WithKernel<Real>(lat,
+        [&](const auto& k)
         {
-          const std::vector<Real> out = DeformAll(level, k.D, set, gathered, maxCells);
-          for (std::int64_t i = 0; i < set.Size(); ++i)
+          const PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 1001);
+          for (int maxCells : MaxCellsToTry())
           {
-            const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&set.Values[3 * i]);
-            const ffd::Vec3<Real> y = ffd::Vec3<Real>::From(&out[3 * i]);
-            const std::string where = lat.Name() + " level " + LevelName(level) + " in place up to " +
-              std::to_string(maxCells) + " cells, point " + std::to_string(i);
-            if (set.Cells[i] < 0)
+            const ffd::GatheredPoints gathered =
+              ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells, TestTile);
+            for (ffd::SimdLevel level : Levels())
             {
-              ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
-              continue;
+              const std::vector<Real> out = DeformAll(level, k.D, set, gathered, maxCells);
+              for (std::int64_t i = 0; i < set.Size(); ++i)
+              {
+                const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&set.Values[3 * i]);
+                const ffd::Vec3<Real> y = ffd::Vec3<Real>::From(&out[3 * i]);
+                const std::string where = lat.Name() + " level " + LevelName(level) + " in place up to " +
+                  std::to_string(maxCells) + " cells, point " + std::to_string(i);
+                if (set.Cells[i] < 0)
+                {
+                  ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
+                  continue;
+                }
+                ffd::Mat3<Real> j;
+                k.D.Deform(x, set.Cells[i], j);
+                const Vec xd = ffdtest::ToRef(x);
+                const Vec want = ClampedReference(lat.Basis, lat, xd);
+                const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
+                ASSERT_TRUE(ffdtest::MaxDiffWithin(ffdtest::ToRef(y), want, tol, &worst)) << where;
+              }
             }
-            ffd::Mat3<Real> j;
-            k.D.Deform(x, set.Cells[i], j);
-            const Vec xd = ffdtest::ToRef(x);
-            const Vec want = ClampedReference(lat.Basis, lat, xd);
-            const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
-            ASSERT_TRUE(ffdtest::MaxDiffWithin(ffdtest::ToRef(y), want, tol, &worst)) << where;
           }
-        }
-      }
+        });
     });
-  });
 }
 
 TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
@@ -250,78 +255,81 @@ TYPED_TEST(FFDGridLanesTest, ResultDependsOnlyOnThePoint)
     {
       lat = ffdtest::RandomGridLattice(rng, b, 5);
     } while (b != Basis::Bernstein && CellCount(lat) < 16);
-    ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
-      const PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 2003);
-      std::vector<std::int64_t> order;
-      const PointSet<Real> shuffled = Shuffled(set, rng, order);
+    ffdtest::WithKernel<Real>(lat,
+      [&](const auto& k)
+      {
+        const PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 2003);
+        std::vector<std::int64_t> order;
+        const PointSet<Real> shuffled = Shuffled(set, rng, order);
 
-      auto cuts = [&](std::int64_t n) {
-        std::vector<std::int64_t> c;
-        for (int m = 0; m < 7; ++m)
+        auto cuts = [&](std::int64_t n)
         {
-          c.push_back(std::uniform_int_distribution<std::int64_t>(0, n)(rng));
-        }
-        std::sort(c.begin(), c.end());
-        return c;
-      };
-      // The lists and the random cuts of each cell limit, drawn once for every level.
-      struct Lists
-      {
-        ffd::GatheredPoints Gathered, ShuffledGathered, OneTile;
-        std::vector<std::int64_t> BlockCuts, TileCuts;
-      };
-      std::vector<Lists> lists;
-      for (int maxCells : MaxCellsToTry())
-      {
-        Lists l;
-        l.Gathered = ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells, TestTile);
-        l.ShuffledGathered =
-          ffd::ListGatheredPoints(shuffled.Cells.data(), shuffled.Size(), CellCount(lat), maxCells, TestTile);
-        l.OneTile = ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells);
-        if (b != Basis::Bernstein && maxCells > 0 && maxCells < ffd::BlockSize) // in one cell, or outside
-        {
-          ASSERT_GT(l.ShuffledGathered.Order.size(), l.Gathered.Order.size()) << lat.Name();
-        }
-        l.BlockCuts = cuts((set.Size() + ffd::BlockSize - 1) / ffd::BlockSize);
-        l.TileCuts = cuts(l.Gathered.TileCount());
-        lists.push_back(std::move(l));
-      }
-      for (ffd::SimdLevel level : Levels())
-      {
-        std::vector<Real> first; // the result of the first cell limit, which the others must give
-        for (std::size_t m = 0; m < lists.size(); ++m)
-        {
-          const int maxCells = MaxCellsToTry()[m];
-          const ffd::GatheredPoints& gathered = lists[m].Gathered;
-          const ffd::GatheredPoints& shuffledGathered = lists[m].ShuffledGathered;
-          const ffd::GatheredPoints& oneTile = lists[m].OneTile;
-          const std::vector<Real> whole = DeformAll(level, k.D, set, gathered, maxCells);
-          const std::vector<Real> split =
-            DeformAll(level, k.D, set, gathered, maxCells, lists[m].BlockCuts, lists[m].TileCuts);
-          const std::vector<Real> tiled = DeformAll(level, k.D, set, oneTile, maxCells);
-          const std::vector<Real> reordered = DeformAll(level, k.D, shuffled, shuffledGathered, maxCells);
-          const std::vector<Real> streamed = DeformAll(level, k.D, set, gathered, maxCells, {}, {}, true);
-          if (first.empty())
+          std::vector<std::int64_t> c;
+          for (int m = 0; m < 7; ++m)
           {
-            first = whole;
+            c.push_back(std::uniform_int_distribution<std::int64_t>(0, n)(rng));
           }
-          for (std::size_t p = 0; p < order.size(); ++p)
+          std::sort(c.begin(), c.end());
+          return c;
+        };
+        // The lists and the random cuts of each cell limit, drawn once for every level.
+        struct Lists
+        {
+          ffd::GatheredPoints Gathered, ShuffledGathered, OneTile;
+          std::vector<std::int64_t> BlockCuts, TileCuts;
+        };
+        std::vector<Lists> lists;
+        for (int maxCells : MaxCellsToTry())
+        {
+          Lists l;
+          l.Gathered = ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells, TestTile);
+          l.ShuffledGathered =
+            ffd::ListGatheredPoints(shuffled.Cells.data(), shuffled.Size(), CellCount(lat), maxCells, TestTile);
+          l.OneTile = ffd::ListGatheredPoints(set.Cells.data(), set.Size(), CellCount(lat), maxCells);
+          if (b != Basis::Bernstein && maxCells > 0 && maxCells < ffd::BlockSize) // in one cell, or outside
           {
-            const std::size_t i = std::size_t(order[p]);
-            const std::string where = lat.Name() + " " + LevelName(level) + " in place up to " +
-              std::to_string(maxCells) + " cells, point " + std::to_string(i);
-            for (int c = 0; c < 3; ++c)
+            ASSERT_GT(l.ShuffledGathered.Order.size(), l.Gathered.Order.size()) << lat.Name();
+          }
+          l.BlockCuts = cuts((set.Size() + ffd::BlockSize - 1) / ffd::BlockSize);
+          l.TileCuts = cuts(l.Gathered.TileCount());
+          lists.push_back(std::move(l));
+        }
+        for (ffd::SimdLevel level : Levels())
+        {
+          std::vector<Real> first; // the result of the first cell limit, which the others must give
+          for (std::size_t m = 0; m < lists.size(); ++m)
+          {
+            const int maxCells = MaxCellsToTry()[m];
+            const ffd::GatheredPoints& gathered = lists[m].Gathered;
+            const ffd::GatheredPoints& shuffledGathered = lists[m].ShuffledGathered;
+            const ffd::GatheredPoints& oneTile = lists[m].OneTile;
+            const std::vector<Real> whole = DeformAll(level, k.D, set, gathered, maxCells);
+            const std::vector<Real> split =
+              DeformAll(level, k.D, set, gathered, maxCells, lists[m].BlockCuts, lists[m].TileCuts);
+            const std::vector<Real> tiled = DeformAll(level, k.D, set, oneTile, maxCells);
+            const std::vector<Real> reordered = DeformAll(level, k.D, shuffled, shuffledGathered, maxCells);
+            const std::vector<Real> streamed = DeformAll(level, k.D, set, gathered, maxCells, {}, {}, true);
+            if (first.empty())
             {
-              ASSERT_EQ(whole[3 * i + c], first[3 * i + c]) << where;
-              ASSERT_EQ(split[3 * i + c], whole[3 * i + c]) << where;
-              ASSERT_EQ(tiled[3 * i + c], whole[3 * i + c]) << where << " (one tile of " << ffd::GatherTile << ")";
-              ASSERT_EQ(streamed[3 * i + c], whole[3 * i + c]) << where << " (non-temporal stores)";
-              ASSERT_EQ(reordered[3 * p + c], whole[3 * i + c]) << where;
+              first = whole;
+            }
+            for (std::size_t p = 0; p < order.size(); ++p)
+            {
+              const std::size_t i = std::size_t(order[p]);
+              const std::string where = lat.Name() + " " + LevelName(level) + " in place up to " +
+                std::to_string(maxCells) + " cells, point " + std::to_string(i);
+              for (int c = 0; c < 3; ++c)
+              {
+                ASSERT_EQ(whole[3 * i + c], first[3 * i + c]) << where;
+                ASSERT_EQ(split[3 * i + c], whole[3 * i + c]) << where;
+                ASSERT_EQ(tiled[3 * i + c], whole[3 * i + c]) << where << " (one tile of " << ffd::GatherTile << ")";
+                ASSERT_EQ(streamed[3 * i + c], whole[3 * i + c]) << where << " (non-temporal stores)";
+                ASSERT_EQ(reordered[3 * p + c], whole[3 * i + c]) << where;
+              }
             }
           }
         }
-      }
-    });
+      });
   }
 }
 
@@ -341,90 +349,95 @@ TYPED_TEST(FFDGridLanesTest, JacobianAtEveryLevelMatchesReference)
   ffdtest::WorstRatio worstPosition("worst_position_error_over_tolerance");
   ffdtest::WorstRatio worstDeterminant("worst_determinant_error_over_bound");
   ffdtest::WorstRatio worstNormal("worst_normal_error_over_bound");
-  ffdtest::ForEachRandomLattice(rng, 4, 5, [&](const GridLattice& lat, int trial) {
-    const double scale = ffdtest::LatticeScale(lat.Points);
-    const std::vector<Vec> displacements = ffdtest::RoundLattice<Real>(lat.Displacements()); // as the kernel
-    ffdtest::WithKernel<Real>(lat, [&](const auto& k) {
-      PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 1001);
-      const bool clamp = trial >= 2; // the points outside lose the Jacobian's columns they are clamped along
-      if (clamp)
-      {
-        for (std::int64_t i = 0; i < set.Size(); ++i)
+  ffdtest::ForEachRandomLattice(rng, 4, 5,
+    [&](const GridLattice& lat, int trial)
+    {
+      const double scale = ffdtest::LatticeScale(lat.Points);
+      const std::vector<Vec> displacements = ffdtest::RoundLattice<Real>(lat.Displacements()); // as the kernel
+      ffdtest::WithKernel<Real>(lat,
+        [&](const auto& k)
         {
-          set.Cells[i] = k.Bind(ffd::Vec3<Real>::From(&set.Values[3 * i]), true);
-        }
-      }
-      if (trial % 2 == 1)
-      {
-        std::vector<std::int64_t> order;
-        set = Shuffled(set, rng, order);
-      }
-      std::vector<Real> normals;
-      for (std::int64_t i = 0; i < set.Size(); ++i)
-      {
-        const Vec n = ffdtest::RandomVec(rng, -1.0, 1.0);
-        const double length = std::max(ffdtest::Norm(n), 1e-3);
-        normals.insert(normals.end(), { Real(n[0] / length), Real(n[1] / length), Real(n[2] / length) });
-      }
-      std::vector<std::int64_t> cuts = { 0, set.Size() };
-      for (int c = 0; c < 4; ++c)
-      {
-        cuts.push_back(
-          ffd::BlockSize * std::uniform_int_distribution<std::int64_t>(0, set.Size() / ffd::BlockSize)(rng));
-      }
-      std::sort(cuts.begin(), cuts.end());
-      const ffd::BlockCells listed = ffd::ListBlockCells(set.Cells.data(), set.Size(), ffd::BlockSize);
-      for (ffd::SimdLevel level : Levels())
-      {
-        const Real nan = std::numeric_limits<Real>::quiet_NaN(); // poisoned outputs
-        std::vector<Real> out(set.Values.size(), nan), outNormals(normals.size(), nan),
-          determinants(std::size_t(set.Size()), nan);
-        for (std::size_t c = 0; c + 1 < cuts.size(); ++c)
-        {
-          ffd::DeformWithJacobian(level, k.D, set.Values.data(), set.Cells.data(), listed, normals.data(),
-            out.data(), outNormals.data(), determinants.data(), cuts[c], cuts[c + 1]);
-        }
-        for (std::int64_t i = 0; i < set.Size(); ++i)
-        {
-          const std::string where = lat.Name() + (clamp ? " clamped" : "") + " level " + LevelName(level) +
-            " point " + std::to_string(i);
-          const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&set.Values[3 * i]);
-          const ffd::Vec3<Real> y = ffd::Vec3<Real>::From(&out[3 * i]);
-          const Vec xd = ffdtest::ToRef(x);
-          const Vec n = ffdtest::ToRef(ffd::Vec3<Real>::From(&normals[3 * i]));
-          const Vec gotNormal = ffdtest::ToRef(ffd::Vec3<Real>::From(&outNormals[3 * i]));
-          if (set.Cells[i] < 0)
+          PointSet<Real> set = MeshLikePoints<Real>(rng, lat, k, 1001);
+          const bool clamp = trial >= 2; // the points outside lose the Jacobian's columns they are clamped along
+          if (clamp)
           {
-            ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
-            ASSERT_EQ(determinants[i], Real(1)) << where;
-            ASSERT_TRUE(ffdtest::MaxDiffWithin(gotNormal, n, 4.0 * ffdtest::Eps<Real>())) << where; // n renormalised
-            continue;
+            for (std::int64_t i = 0; i < set.Size(); ++i)
+            {
+              set.Cells[i] = k.Bind(ffd::Vec3<Real>::From(&set.Values[3 * i]), true);
+            }
           }
-          const ffdtest::ReferenceJacobian ref =
-            ffdtest::JacobianOfPoint<Real>(lat, displacements, xd, set.Cells[i]);
-          const ffdtest::Mat bound =
-            ffdtest::JacobianErrorBound<Real>(lat, displacements, xd, ref, k.D.CellTable != nullptr);
-          ffd::Mat3<Real> j; // only for PositionTolerance()'s |J - I|
-          k.D.Deform(x, set.Cells[i], j);
-          const Vec want = ClampedReference(lat.Basis, lat, xd);
-          const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
-          ASSERT_TRUE(ffdtest::MaxDiffWithin(ffdtest::ToRef(y), want, tol, &worstPosition)) << where;
+          if (trial % 2 == 1)
+          {
+            std::vector<std::int64_t> order;
+            set = Shuffled(set, rng, order);
+          }
+          std::vector<Real> normals;
+          for (std::int64_t i = 0; i < set.Size(); ++i)
+          {
+            const Vec n = ffdtest::RandomVec(rng, -1.0, 1.0);
+            const double length = std::max(ffdtest::Norm(n), 1e-3);
+            normals.insert(normals.end(), { Real(n[0] / length), Real(n[1] / length), Real(n[2] / length) });
+          }
+          std::vector<std::int64_t> cuts = { 0, set.Size() };
+          for (int c = 0; c < 4; ++c)
+          {
+            cuts.push_back(
+              ffd::BlockSize * std::uniform_int_distribution<std::int64_t>(0, set.Size() / ffd::BlockSize)(rng));
+          }
+          std::sort(cuts.begin(), cuts.end());
+          const ffd::BlockCells listed = ffd::ListBlockCells(set.Cells.data(), set.Size(), ffd::BlockSize);
+          for (ffd::SimdLevel level : Levels())
+          {
+            const Real nan = std::numeric_limits<Real>::quiet_NaN(); // poisoned outputs
+            std::vector<Real> out(set.Values.size(), nan), outNormals(normals.size(), nan),
+              determinants(std::size_t(set.Size()), nan);
+            for (std::size_t c = 0; c + 1 < cuts.size(); ++c)
+            {
+              ffd::DeformWithJacobian(level, k.D, set.Values.data(), set.Cells.data(), listed, normals.data(),
+                out.data(), outNormals.data(), determinants.data(), cuts[c], cuts[c + 1]);
+            }
+            for (std::int64_t i = 0; i < set.Size(); ++i)
+            {
+              const std::string where =
+                lat.Name() + (clamp ? " clamped" : "") + " level " + LevelName(level) + " point " + std::to_string(i);
+              const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&set.Values[3 * i]);
+              const ffd::Vec3<Real> y = ffd::Vec3<Real>::From(&out[3 * i]);
+              const Vec xd = ffdtest::ToRef(x);
+              const Vec n = ffdtest::ToRef(ffd::Vec3<Real>::From(&normals[3 * i]));
+              const Vec gotNormal = ffdtest::ToRef(ffd::Vec3<Real>::From(&outNormals[3 * i]));
+              if (set.Cells[i] < 0)
+              {
+                ASSERT_TRUE(y.x == x.x && y.y == x.y && y.z == x.z) << where;
+                ASSERT_EQ(determinants[i], Real(1)) << where;
+                ASSERT_TRUE(ffdtest::MaxDiffWithin(gotNormal, n, 4.0 * ffdtest::Eps<Real>()))
+                  << where; // n renormalised
+                continue;
+              }
+              const ffdtest::ReferenceJacobian ref =
+                ffdtest::JacobianOfPoint<Real>(lat, displacements, xd, set.Cells[i]);
+              const ffdtest::Mat bound =
+                ffdtest::JacobianErrorBound<Real>(lat, displacements, xd, ref, k.D.CellTable != nullptr);
+              ffd::Mat3<Real> j; // only for PositionTolerance()'s |J - I|
+              k.D.Deform(x, set.Cells[i], j);
+              const Vec want = ClampedReference(lat.Basis, lat, xd);
+              const double tol = ffdtest::PositionTolerance(scale, xd, lat.F, j);
+              ASSERT_TRUE(ffdtest::MaxDiffWithin(ffdtest::ToRef(y), want, tol, &worstPosition)) << where;
 
-          const double detBound = ffdtest::DeterminantErrorBound<Real>(ref.J, bound);
-          const double detError = std::fabs(double(determinants[i]) - ffdtest::Determinant(ref.J));
-          worstDeterminant.Add(detError, detBound);
-          ASSERT_LE(detError, detBound) << where;
-          const Vec m = ffdtest::Product(ffdtest::Cofactor(ref.J), n);
-          if (ffdtest::Norm(m) >= 0.1)
-          {
-            const Vec wantNormal = ffdtest::Scaled(m, 1.0 / ffdtest::Norm(m));
-            const double normalBound = ffdtest::NormalErrorBound<Real>(ref.J, bound, n);
-            ASSERT_TRUE(ffdtest::MaxDiffWithin(gotNormal, wantNormal, normalBound, &worstNormal)) << where;
+              const double detBound = ffdtest::DeterminantErrorBound<Real>(ref.J, bound);
+              const double detError = std::fabs(double(determinants[i]) - ffdtest::Determinant(ref.J));
+              worstDeterminant.Add(detError, detBound);
+              ASSERT_LE(detError, detBound) << where;
+              const Vec m = ffdtest::Product(ffdtest::Cofactor(ref.J), n);
+              if (ffdtest::Norm(m) >= 0.1)
+              {
+                const Vec wantNormal = ffdtest::Scaled(m, 1.0 / ffdtest::Norm(m));
+                const double normalBound = ffdtest::NormalErrorBound<Real>(ref.J, bound, n);
+                ASSERT_TRUE(ffdtest::MaxDiffWithin(gotNormal, wantNormal, normalBound, &worstNormal)) << where;
+              }
+            }
           }
-        }
-      }
+        });
     });
-  });
 }
 
 TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
@@ -470,8 +483,8 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
   EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 3, maxCells));
   EXPECT_FALSE(ffd::BlockInPlace(cells.data(), n, 1, 9));
   EXPECT_TRUE(ffd::BlockInPlace(cells.data(), n, 1, 10));
-  EXPECT_EQ(ffd::GatherByCell(cells.data(), n, cellCount, ffd::GatheredBlocks(cells.data(), n, ffd::BlockSize)),
-    expectedTail);
+  EXPECT_EQ(
+    ffd::GatherByCell(cells.data(), n, cellCount, ffd::GatheredBlocks(cells.data(), n, ffd::BlockSize)), expectedTail);
 
   // What the gathered pass reads: that list, its last point repeated up to whole blocks, and their cells.
   const ffd::GatheredPoints gathered = ffd::ListGatheredPoints(cells.data(), n, cellCount, maxCells);
@@ -498,8 +511,7 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
   }
 
   // In tiles of 2 blocks: block 1 in the first, sorted by cell; the tail in the second, padded by its last point.
-  const ffd::GatheredPoints tiled =
-    ffd::ListGatheredPoints(cells.data(), n, cellCount, maxCells, 2 * ffd::BlockSize);
+  const ffd::GatheredPoints tiled = ffd::ListGatheredPoints(cells.data(), n, cellCount, maxCells, 2 * ffd::BlockSize);
   EXPECT_EQ(tiled.TileCount(), 2);
   EXPECT_EQ(tiled.TileBlocks, (std::vector<std::int64_t>{ 0, 1, 2 }));
   EXPECT_EQ(tiled.TileSources, (std::vector<std::int64_t>{ 0, 1, 2 }));
@@ -511,8 +523,8 @@ TEST(FFDGridLanes, GatherByCellListsTheBlocksNotDeformedInPlace)
   for (int g = 0; g < ffd::BlockSize; ++g)
   {
     EXPECT_EQ(tiled.Order[std::size_t(g)], firstTile[std::size_t(g)]) << g;
-    EXPECT_EQ(tiled.Order[std::size_t(ffd::BlockSize + g)],
-      secondTile[std::min(std::size_t(g), secondTile.size() - 1)]) << g;
+    EXPECT_EQ(tiled.Order[std::size_t(ffd::BlockSize + g)], secondTile[std::min(std::size_t(g), secondTile.size() - 1)])
+      << g;
   }
   for (int l = 0; l < 5; ++l) // ranks are places within the tile's run
   {

@@ -101,8 +101,7 @@ TYPED_TEST(FFDTetrahedraTest, MapIsTheWeightedSumOfNodes)
     for (int n = 0; n < 4; ++n)
     {
       const Vec displacement = ffdtest::RandomVec(rng, -0.5, 0.5);
-      moved[n] = { t.Nodes[n][0] + displacement[0], t.Nodes[n][1] + displacement[1],
-        t.Nodes[n][2] + displacement[2] };
+      moved[n] = { t.Nodes[n][0] + displacement[0], t.Nodes[n][1] + displacement[1], t.Nodes[n][2] + displacement[2] };
       d[n] = ffdtest::ToKernel<double>(displacement);
       largest = std::max(largest, MaxAbs(displacement));
     }
@@ -193,9 +192,8 @@ TEST(FFDTetrahedra, ClosestPointGradientProjectsOntoTheFeature)
   {
     const Tetrahedron t = RandomTetrahedron(rng);
     const ffd::Frame<double> frame = KernelFrame(t);
-    const auto apply = [](const ffd::Mat3<double>& p, const Vec& v) {
-      return ffdtest::ToRef(p * ffdtest::ToKernel<double>(v));
-    };
+    const auto apply = [](const ffd::Mat3<double>& p, const Vec& v)
+    { return ffdtest::ToRef(p * ffdtest::ToKernel<double>(v)); };
     const double tol = 1e-12 * (1.0 + DualNorm(t.Frame));
     // A point on face BCD (weight of A zero): tangents BC, BD are kept, the face normal is removed.
     const double s = ffdtest::Uniform(rng, 0.1, 0.5), u = ffdtest::Uniform(rng, 0.1, 0.4);

@@ -55,7 +55,7 @@ int main()
     out->GetPoint(id, b);
     moved += (a[0] != b[0]) ? 1 : 0;
   }
-  std::printf("%lld of %lld points moved\n", static_cast<long long>(moved),
-    static_cast<long long>(in->GetNumberOfPoints()));
+  std::printf(
+    "%lld of %lld points moved\n", static_cast<long long>(moved), static_cast<long long>(in->GetNumberOfPoints()));
   return moved > 0 ? 0 : 1;
 }

@@ -25,8 +25,14 @@ namespace ffdref
 {
 using Vec = std::array<double, 3>;
 
-inline Vec Sub(const Vec& a, const Vec& b) { return { a[0] - b[0], a[1] - b[1], a[2] - b[2] }; }
-inline double Dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline Vec Sub(const Vec& a, const Vec& b)
+{
+  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
+}
+inline double Dot(const Vec& a, const Vec& b)
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
 inline Vec Cross(const Vec& a, const Vec& b)
 {
   return { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
@@ -55,8 +61,8 @@ inline std::vector<Vec> RestLattice(const Frame& f, int l, int m, int n)
       for (int i = 0; i <= l; ++i)
       {
         const double a = double(i) / l, b = double(j) / m, c = double(k) / n;
-        p.push_back({ f.X0[0] + a * f.S[0] + b * f.T[0] + c * f.U[0],
-          f.X0[1] + a * f.S[1] + b * f.T[1] + c * f.U[1], f.X0[2] + a * f.S[2] + b * f.T[2] + c * f.U[2] });
+        p.push_back({ f.X0[0] + a * f.S[0] + b * f.T[0] + c * f.U[0], f.X0[1] + a * f.S[1] + b * f.T[1] + c * f.U[1],
+          f.X0[2] + a * f.S[2] + b * f.T[2] + c * f.U[2] });
       }
   return p;
 }
@@ -187,7 +193,8 @@ inline double UniformBSplineDerivative(int i, int p, double x, int order, bool a
  * Bezier bases take the polynomial of voxel `voxel` (-1: the voxel holding s), so that a derivative is that of
  * the voxel a point was bound to even where rounding puts s a hair into the next one (the derivative jumps there).
  */
-inline std::vector<double> AxisWeightDerivatives(Basis b, int n, double s, int order, int voxel = -1, bool absolute = false)
+inline std::vector<double> AxisWeightDerivatives(
+  Basis b, int n, double s, int order, int voxel = -1, bool absolute = false)
 {
   const int count = PointsAlongAxis(b, n);
   std::vector<double> w(count, 0.0);
@@ -278,7 +285,8 @@ inline Vec EvaluateLocal(Basis b, const int divisions[3], const std::vector<Vec>
   return EvaluateLocalDerivative(b, divisions, p, stu, { 0, 0, 0 }, { -1, -1, -1 });
 }
 
-/// The rows of d(s, t, u)/dX (equation 2's dual vectors): (T x U)/(S . T x U), (S x U)/(T . S x U), (S x T)/(U . S x T).
+/// The rows of d(s, t, u)/dX (equation 2's dual vectors): (T x U)/(S . T x U), (S x U)/(T . S x U), (S x T)/(U . S x
+/// T).
 inline std::array<Vec, 3> DualVectors(const Frame& f)
 {
   const Vec tu = Cross(f.T, f.U), su = Cross(f.S, f.U), st = Cross(f.S, f.T);
@@ -318,8 +326,7 @@ inline std::array<Vec, 3> JacobianLocal(Basis b, const Frame& f, const int divis
 
 /// The deformed position of a world point inside the frame: equation 2, then EvaluateLocal. Parameters a
 /// rounding error outside [0, 1] (points on a face) are clamped to it.
-inline Vec DeformLocal(
-  Basis b, const Frame& f, const int divisions[3], const std::vector<Vec>& p, const Vec& x)
+inline Vec DeformLocal(Basis b, const Frame& f, const int divisions[3], const std::vector<Vec>& p, const Vec& x)
 {
   Vec stu = Parameters(f, x);
   for (double& v : stu)

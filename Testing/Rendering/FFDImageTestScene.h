@@ -43,7 +43,7 @@ struct FFDTestLattice
 {
   vtkSmartPointer<vtkStructuredGrid> Grid;
   vtkSmartPointer<vtkStructuredGrid> VoxelGrid; ///< vtkFFDVoxelize's output: inactive voxels hidden
-  double Frame[12]; ///< X0, S, T, U
+  double Frame[12];                             ///< X0, S, T, U
   int Divisions[3];
   int Dims[3]; ///< control points per axis
   vtkIdType ActiveVoxels = 0;
@@ -90,10 +90,9 @@ inline bool BuildTestLattice(
   if (!vtkFFDDataContract::GetFrame(lattice.Grid, lattice.Frame) || lattice.Dims[0] != expectedDims[0] ||
     lattice.Dims[1] != expectedDims[1] || lattice.Dims[2] != expectedDims[2])
   {
-    std::cerr << "Expected a " << vtkFFDBuildLattice::GetBasisAsString(basis) << " lattice of "
-              << expectedDims[0] << " x " << expectedDims[1] << " x " << expectedDims[2]
-              << " control points with an FFDFrame, got " << lattice.Dims[0] << " x " << lattice.Dims[1] << " x "
-              << lattice.Dims[2] << "\n";
+    std::cerr << "Expected a " << vtkFFDBuildLattice::GetBasisAsString(basis) << " lattice of " << expectedDims[0]
+              << " x " << expectedDims[1] << " x " << expectedDims[2] << " control points with an FFDFrame, got "
+              << lattice.Dims[0] << " x " << lattice.Dims[1] << " x " << lattice.Dims[2] << "\n";
     return false;
   }
   return true;
@@ -101,8 +100,8 @@ inline bool BuildTestLattice(
 
 /// ReadTestMeshOrReport(name) into `mesh`, then BuildTestLattice() over it: false (and why on stderr) when
 /// either fails.
-inline bool ReadMeshAndBuildTestLattice(const char* name, const int divisions[3], int basis,
-  const int expectedDims[3], vtkSmartPointer<vtkPolyData>& mesh, FFDTestLattice& lattice)
+inline bool ReadMeshAndBuildTestLattice(const char* name, const int divisions[3], int basis, const int expectedDims[3],
+  vtkSmartPointer<vtkPolyData>& mesh, FFDTestLattice& lattice)
 {
   mesh = ReadTestMeshOrReport(name);
   return mesh && BuildTestLattice(mesh, divisions, basis, expectedDims, lattice);
@@ -129,8 +128,8 @@ inline vtkSmartPointer<vtkPolyData> DeformWithDisplacement(vtkPolyData* mesh, vt
     double x[3], y[3];
     mesh->GetPoint(p, x);
     deformed->GetPoint(p, y);
-    distance->SetValue(p, float(std::sqrt((y[0] - x[0]) * (y[0] - x[0]) + (y[1] - x[1]) * (y[1] - x[1]) +
-                            (y[2] - x[2]) * (y[2] - x[2]))));
+    distance->SetValue(p,
+      float(std::sqrt((y[0] - x[0]) * (y[0] - x[0]) + (y[1] - x[1]) * (y[1] - x[1]) + (y[2] - x[2]) * (y[2] - x[2]))));
   }
   deformed->GetPointData()->SetScalars(distance);
   return deformed;
@@ -154,13 +153,13 @@ inline vtkIdType CountMovedPoints(vtkPolyData* deformed, double tolerance)
  * with small spheres (`pointRadius` in world units, 0 for vtkFFDLatticeActor's automatic size) and thin,
  * light edges, so that the mesh stays visible through it. Returns the lattice's actor, for more settings.
  */
-inline vtkFFDLatticeActor* AddDeformedScene(vtkRenderer* renderer, vtkPolyData* deformed, vtkPointSet* lattice,
-  double maxDisplacement, double pointRadius = 0.0)
+inline vtkFFDLatticeActor* AddDeformedScene(
+  vtkRenderer* renderer, vtkPolyData* deformed, vtkPointSet* lattice, double maxDisplacement, double pointRadius = 0.0)
 {
   vtkNew<vtkLookupTable> colours;
   colours->SetTableRange(0.0, maxDisplacement);
-  colours->SetHueRange(0.12, 0.0);        // ivory-yellow to red
-  colours->SetSaturationRange(0.1, 0.9);  // points that stay are nearly white
+  colours->SetHueRange(0.12, 0.0);       // ivory-yellow to red
+  colours->SetSaturationRange(0.1, 0.9); // points that stay are nearly white
   colours->SetValueRange(0.95, 0.7);
   colours->Build();
   vtkNew<vtkPolyDataMapper> mapper;

@@ -47,8 +47,8 @@ int TestFFDBearLocalRegionsImage(int argc, char* argv[])
   double centre[3];
   for (int c = 0; c < 3; ++c)
   {
-    centre[c] = lattice.Frame[c] + 0.95 * lattice.Frame[3 + c] + 0.85 * lattice.Frame[6 + c] +
-      0.5 * lattice.Frame[9 + c];
+    centre[c] =
+      lattice.Frame[c] + 0.95 * lattice.Frame[3 + c] + 0.85 * lattice.Frame[6 + c] + 0.5 * lattice.Frame[9 + c];
   }
   const double reach = 0.75;
   const double pull = 0.6;
@@ -118,13 +118,13 @@ int TestFFDBearLocalRegionsImage(int argc, char* argv[])
     movedPoints += pointMoved ? 1 : 0;
     if (pointMoved && !hasMovedCorner)
     {
-      std::cerr << "Point " << p << " moved although no corner of its voxel (" << v[0] << ", " << v[1] << ", "
-                << v[2] << ") did\n";
+      std::cerr << "Point " << p << " moved although no corner of its voxel (" << v[0] << ", " << v[1] << ", " << v[2]
+                << ") did\n";
       return EXIT_FAILURE;
     }
   }
-  std::cout << "mesh points: " << movedPoints << " moved, " << inMovedVoxels
-            << " in voxels with a moved corner, " << skipped << " on voxel faces (not checked)\n";
+  std::cout << "mesh points: " << movedPoints << " moved, " << inMovedVoxels << " in voxels with a moved corner, "
+            << skipped << " on voxel faces (not checked)\n";
   if (movedPoints == 0 || movedPoints > bear->GetNumberOfPoints() / 2)
   {
     std::cerr << "Expected the magnet to move some of the bear, not most of it\n";

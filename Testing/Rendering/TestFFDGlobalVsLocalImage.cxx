@@ -5,8 +5,8 @@
 // (4, 2, 2) on the frame's +S face at the height of the bear's left arm (the viewer's right), is moved by the
 // same vector in both. Each mesh is coloured by how far its points moved, up to its own largest displacement:
 // the global lattice moves the whole bear, a little, the trilinear one moves the arm and the side next to it,
-// strongly, and leaves the rest still. Compared with Testing/Data/Baseline/TestFFDGlobalVsLocalImage.png; the numbers of moved
-// points are checked as well, so that the claim does not rest on the picture alone.
+// strongly, and leaves the rest still. Compared with Testing/Data/Baseline/TestFFDGlobalVsLocalImage.png; the numbers
+// of moved points are checked as well, so that the claim does not rest on the picture alone.
 #include "FFDImageTestScene.h"
 #include "FFDTestMeshes.h"
 
@@ -44,8 +44,7 @@ int TestFFDGlobalVsLocalImage(int argc, char* argv[])
     deformed[b] = DeformWithDisplacement(bear, lattices[b].Grid);
     if (!deformed[b])
     {
-      std::cerr << "vtkFFDDeform failed with the " << vtkFFDBuildLattice::GetBasisAsString(bases[b])
-                << " lattice\n";
+      std::cerr << "vtkFFDDeform failed with the " << vtkFFDBuildLattice::GetBasisAsString(bases[b]) << " lattice\n";
       return EXIT_FAILURE;
     }
   }
@@ -72,8 +71,7 @@ int TestFFDGlobalVsLocalImage(int argc, char* argv[])
     renderer->SetViewport(0.5 * b, 0.0, 0.5 * (b + 1), 1.0);
     // Each mesh coloured up to its own largest displacement: the colours show where a control point has
     // influence, everywhere for the global basis, however small.
-    AddDeformedScene(
-      renderer, deformed[b], lattices[b].Grid, deformed[b]->GetPointData()->GetScalars()->GetRange()[1]);
+    AddDeformedScene(renderer, deformed[b], lattices[b].Grid, deformed[b]->GetPointData()->GetScalars()->GetRange()[1]);
     renderer->SetActiveCamera(camera);
     window->AddRenderer(renderer);
   }

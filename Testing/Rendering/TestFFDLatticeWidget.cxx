@@ -105,8 +105,8 @@ bool CheckLattice(vtkStructuredGrid* lattice, vtkStructuredGrid* expected, doubl
 }
 
 /// The mesh as the widget's pipeline left it against a fresh vtkFFDDeform of `expected`.
-bool CheckMesh(vtkFFDDeform* deform, vtkPolyData* mesh, vtkStructuredGrid* expected, double diagonal,
-  const char* step, double* largestMotion = nullptr)
+bool CheckMesh(vtkFFDDeform* deform, vtkPolyData* mesh, vtkStructuredGrid* expected, double diagonal, const char* step,
+  double* largestMotion = nullptr)
 {
   deform->Update();
   vtkNew<vtkFFDDeform> fresh;
@@ -234,8 +234,7 @@ int TestFFDLatticeWidget(int argc, char* argv[])
   Translate(expected, lower, motion);
   vtkNew<vtkIdList> selected;
   rep->GetSelectedControlPoints(selected);
-  if (selected->GetNumberOfIds() != 2 || !rep->IsControlPointSelected(upper) ||
-    !rep->IsControlPointSelected(lower))
+  if (selected->GetNumberOfIds() != 2 || !rep->IsControlPointSelected(upper) || !rep->IsControlPointSelected(lower))
   {
     std::cerr << "Expected control points " << upper << " and " << lower << " selected, got "
               << selected->GetNumberOfIds() << " points\n";

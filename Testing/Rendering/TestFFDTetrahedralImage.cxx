@@ -37,8 +37,8 @@ int TestFFDTetrahedralImage(int argc, char* argv[])
   vtkNew<vtkUnstructuredGrid> lattice;
   lattice->DeepCopy(build->GetOutput());
   std::cout << "cow: " << cow->GetNumberOfPoints() << " points; control mesh: " << build->GetNumberOfHullFaces()
-            << " hull triangles, " << lattice->GetNumberOfCells() << " tetrahedra, "
-            << lattice->GetNumberOfPoints() << " nodes, " << build->GetNumberOfActiveNodes() << " active\n";
+            << " hull triangles, " << lattice->GetNumberOfCells() << " tetrahedra, " << lattice->GetNumberOfPoints()
+            << " nodes, " << build->GetNumberOfActiveNodes() << " active\n";
 
   // The head: CGAL's cow looks along +X. Nodes in the front 15 % of its length move forward and up, the more
   // the further forward.
