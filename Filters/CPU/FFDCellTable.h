@@ -3,8 +3,9 @@
  * @file FFDCellTable.h
  * @brief A local basis's cells in power form, for GridDeformation's WithCellTable evaluation (host only).
  *
- * The CPU builds the table at every update where ffd::WorthCellTable() says it pays; GridDeformation
- * (Filters/Kernels/FFDGridDeformation.h) evaluates it by Horner's rule (PowerForm()).
+ * The CPU builds the table at every update where ffd::WorthCellTable() says it pays (FillCellTable());
+ * GridDeformation (Filters/Kernels/FFDGridDeformation.h) WithCellTable evaluates it by Horner's rule
+ * (PowerForm(), declared there and defined here: the CUDA backend never instantiates it).
  */
 #ifndef FFDCellTable_h
 #define FFDCellTable_h
@@ -182,6 +183,95 @@ inline void FillCellTable(GridBasis basis, const Real* displacements, const int 
       return detail::FillCellTableOf<GridBasis::CubicBSpline>(displacements, voxels, dims, table, cellBegin, cellEnd);
     case GridBasis::Bernstein: // one cell: no table
       break;
+  }
+}
+
+/**
+ * D of FillCellTable() (a basis of degree Degree) at local coordinates r[g] of the cell whose entry is `entry`, for
+ * G lane groups g at once, by Horner's rule, into d[g], and, where dDdr is not null, its derivatives into dDdr[g]:
+ * column a is dD/dr[a]. Each coefficient is read (broadcast to the lanes) once for all G groups: the broadcasts
+ * are a large part of a cell's cost.
+ */
+template <int Degree, int G, typename Lane, typename Real>
+FFD_INLINE void PowerForm(const Real* entry, const Lane (*r)[3], Vec3<Lane>* d, Mat3<Lane>* dDdr)
+{
+  constexpr int N = Degree + 1;
+  const Real* c = entry + 8;
+  Lane out[G][3];
+  FFD_UNROLL
+  for (int k = 0; k < 3; ++k)
+  {
+    // Along z, of polynomials along y, of polynomials along x; each with its derivative where asked.
+    Lane z[G], zx[G], zy[G], zz[G];
+    FFD_UNROLL
+    for (int iz = Degree; iz >= 0; --iz)
+    {
+      Lane y[G], yx[G], yy[G];
+      FFD_UNROLL
+      for (int iy = Degree; iy >= 0; --iy)
+      {
+        const Real* row = c + 3 * N * (iy + N * iz) + k;
+        Lane x[G], xx[G];
+        const Lane top = Lane(row[3 * Degree]);
+        FFD_UNROLL
+        for (int g = 0; g < G; ++g)
+        {
+          x[g] = top;
+          xx[g] = Lane(0);
+        }
+        FFD_UNROLL
+        for (int ix = Degree - 1; ix >= 0; --ix)
+        {
+          const Lane coefficient = Lane(row[3 * ix]);
+          FFD_UNROLL
+          for (int g = 0; g < G; ++g)
+          {
+            if (dDdr)
+            {
+              xx[g] = x[g] + r[g][0] * xx[g];
+            }
+            x[g] = coefficient + r[g][0] * x[g];
+          }
+        }
+        FFD_UNROLL
+        for (int g = 0; g < G; ++g)
+        {
+          if (dDdr)
+          {
+            yy[g] = iy == Degree ? Lane(0) : y[g] + r[g][1] * yy[g];
+            yx[g] = iy == Degree ? xx[g] : xx[g] + r[g][1] * yx[g];
+          }
+          y[g] = iy == Degree ? x[g] : x[g] + r[g][1] * y[g];
+        }
+      }
+      FFD_UNROLL
+      for (int g = 0; g < G; ++g)
+      {
+        if (dDdr)
+        {
+          zz[g] = iz == Degree ? Lane(0) : z[g] + r[g][2] * zz[g];
+          zx[g] = iz == Degree ? yx[g] : yx[g] + r[g][2] * zx[g];
+          zy[g] = iz == Degree ? yy[g] : yy[g] + r[g][2] * zy[g];
+        }
+        z[g] = iz == Degree ? y[g] : y[g] + r[g][2] * z[g];
+      }
+    }
+    FFD_UNROLL
+    for (int g = 0; g < G; ++g)
+    {
+      out[g][k] = z[g];
+      if (dDdr)
+      {
+        dDdr[g].M[k][0] = zx[g];
+        dDdr[g].M[k][1] = zy[g];
+        dDdr[g].M[k][2] = zz[g];
+      }
+    }
+  }
+  FFD_UNROLL
+  for (int g = 0; g < G; ++g)
+  {
+    d[g] = { out[g][0], out[g][1], out[g][2] };
   }
 }
 

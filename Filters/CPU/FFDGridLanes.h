@@ -9,7 +9,7 @@
  * - In place (DeformBlocksInPlace()), reading and writing memory in order. A lane group in one cell reads each
  *   control point once for all lanes. A group in several cells (listed at binding, ListBlockCells()) computes
  *   each lane's weights once, then each cell's sum in all lanes, kept in that cell's lanes
- *   (GridDeformation::DeformInLaneCells()).
+ *   (DeformInLaneCells(), FFDLaneCells.h).
  * - Gathered (DeformGathered()): the points of the blocks in more than MaxCellsInPlace() cells are listed once,
  *   at binding, tile by tile, each tile's sorted by cell (ListGatheredPoints()); the caller keeps a copy of
  *   their coordinates in that order (CopyGatheredPoints()). The pass deforms a tile's list in order into a
@@ -30,8 +30,10 @@
 #ifndef FFDGridLanes_h
 #define FFDGridLanes_h
 
+#include "FFDCellTable.h"
 #include "FFDDeformPoint.h"
 #include "FFDGridDeformation.h"
+#include "FFDLaneCells.h"
 #include "FFDPointBlocks.h"
 
 #include <algorithm>
@@ -182,7 +184,7 @@ inline typename Lane::IndexVector MaskOfBits(unsigned bits, std::index_sequence<
 
 /**
  * The cells of lane group `group` (of the BlockSize / W of a block) of a local basis, from the block's entry in
- * BlockCells::List, for GridDeformation::DeformInLaneCells(). Lanes bound to no cell take the first cell's
+ * BlockCells::List, for DeformInLaneCells(). Lanes bound to no cell take the first cell's
  * indices (and keep their position).
  */
 template <typename Lane>
@@ -248,7 +250,7 @@ inline void DeformInSeveralCells(const Deformation& deformation, const Wide& wid
       Vec3<Lane> y = x;
       if (cells.Count > 0)
       {
-        const Vec3<Lane> yc = wide.DeformInLaneCells(x, cells);
+        const Vec3<Lane> yc = DeformInLaneCells(wide, x, cells);
         y = { Select(cells.Bound, yc.x, x.x), Select(cells.Bound, yc.y, x.y), Select(cells.Bound, yc.z, x.z) };
       }
       Lane::template Interleave3<Streaming>(y.x, y.y, y.z, out + 3 * (i - outFirst));
@@ -388,7 +390,7 @@ inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, 
       bound = group.Bound;
       if (group.Count > 0)
       {
-        yc = wide.DeformInLaneCells(x, group, jc);
+        yc = DeformInLaneCells(wide, x, group, jc);
       }
     }
     // Lanes of cell -1 keep their position, their Jacobian is the identity.

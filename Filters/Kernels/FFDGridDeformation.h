@@ -94,127 +94,10 @@ FFD_INLINE constexpr int CellTableStride(int degree)
   return (8 + 3 * (degree + 1) * (degree + 1) * (degree + 1) + 7) / 8 * 8;
 }
 
-/**
- * D of FillCellTable() (a basis of degree Degree) at local coordinates r[g] of the cell whose entry is `entry`, for
- * G lane groups g at once, by Horner's rule, into d[g], and, where dDdr is not null, its derivatives into dDdr[g]:
- * column a is dD/dr[a]. Each coefficient is read (broadcast to the lanes) once for all G groups: the broadcasts
- * are a large part of a cell's cost.
- */
+/// D of a cell table's entry at local coordinates r[g] of G lane groups, by Horner's rule, with its derivatives
+/// where dDdr is not null: defined with the table (Filters/CPU/FFDCellTable.h), which only the CPU builds.
 template <int Degree, int G, typename Lane, typename Real>
-FFD_INLINE void PowerForm(const Real* entry, const Lane (*r)[3], Vec3<Lane>* d, Mat3<Lane>* dDdr)
-{
-  constexpr int N = Degree + 1;
-  const Real* c = entry + 8;
-  Lane out[G][3];
-  FFD_UNROLL
-  for (int k = 0; k < 3; ++k)
-  {
-    // Along z, of polynomials along y, of polynomials along x; each with its derivative where asked.
-    Lane z[G], zx[G], zy[G], zz[G];
-    FFD_UNROLL
-    for (int iz = Degree; iz >= 0; --iz)
-    {
-      Lane y[G], yx[G], yy[G];
-      FFD_UNROLL
-      for (int iy = Degree; iy >= 0; --iy)
-      {
-        const Real* row = c + 3 * N * (iy + N * iz) + k;
-        Lane x[G], xx[G];
-        const Lane top = Lane(row[3 * Degree]);
-        FFD_UNROLL
-        for (int g = 0; g < G; ++g)
-        {
-          x[g] = top;
-          xx[g] = Lane(0);
-        }
-        FFD_UNROLL
-        for (int ix = Degree - 1; ix >= 0; --ix)
-        {
-          const Lane coefficient = Lane(row[3 * ix]);
-          FFD_UNROLL
-          for (int g = 0; g < G; ++g)
-          {
-            if (dDdr)
-            {
-              xx[g] = x[g] + r[g][0] * xx[g];
-            }
-            x[g] = coefficient + r[g][0] * x[g];
-          }
-        }
-        FFD_UNROLL
-        for (int g = 0; g < G; ++g)
-        {
-          if (dDdr)
-          {
-            yy[g] = iy == Degree ? Lane(0) : y[g] + r[g][1] * yy[g];
-            yx[g] = iy == Degree ? xx[g] : xx[g] + r[g][1] * yx[g];
-          }
-          y[g] = iy == Degree ? x[g] : x[g] + r[g][1] * y[g];
-        }
-      }
-      FFD_UNROLL
-      for (int g = 0; g < G; ++g)
-      {
-        if (dDdr)
-        {
-          zz[g] = iz == Degree ? Lane(0) : z[g] + r[g][2] * zz[g];
-          zx[g] = iz == Degree ? yx[g] : yx[g] + r[g][2] * zx[g];
-          zy[g] = iz == Degree ? yy[g] : yy[g] + r[g][2] * zy[g];
-        }
-        z[g] = iz == Degree ? y[g] : y[g] + r[g][2] * z[g];
-      }
-    }
-    FFD_UNROLL
-    for (int g = 0; g < G; ++g)
-    {
-      out[g][k] = z[g];
-      if (dDdr)
-      {
-        dDdr[g].M[k][0] = zx[g];
-        dDdr[g].M[k][1] = zy[g];
-        dDdr[g].M[k][2] = zz[g];
-      }
-    }
-  }
-  FFD_UNROLL
-  for (int g = 0; g < G; ++g)
-  {
-    d[g] = { out[g][0], out[g][1], out[g][2] };
-  }
-}
-
-namespace detail
-{
-/// The control points of a lane group's cells (GridDeformation::DeformInLaneCells()), each lane reading its own
-/// cell's: for one sum with its gradient over all lanes, which costs less than one per cell (host only).
-template <typename Real, typename Group>
-struct GroupValues
-{
-  const Real* Displacements;
-  const Group* Cells;
-};
-} // namespace detail
-
-/// Control point `index` (relative to its cell's first one) of each lane's cell: a broadcast and a select per
-/// cell of the group.
-template <typename Real, typename Group>
-struct LatticeValues<detail::GroupValues<Real, Group>>
-{
-  template <typename Lane>
-  static Vec3<Lane> Get(const detail::GroupValues<Real, Group>* values, int index)
-  {
-    const Group& group = *values->Cells;
-    const Real* v = values->Displacements + 3 * (group.Firsts[0] + index);
-    Vec3<Lane> value = { Lane(v[0]), Lane(v[1]), Lane(v[2]) };
-    for (int k = 1; k < group.Count; ++k)
-    {
-      v = values->Displacements + 3 * (group.Firsts[k] + index);
-      value = { Select(group.Lanes[k], Lane(v[0]), value.x), Select(group.Lanes[k], Lane(v[1]), value.y),
-        Select(group.Lanes[k], Lane(v[2]), value.z) };
-    }
-    return value;
-  }
-};
+FFD_INLINE void PowerForm(const Real* entry, const Lane (*r)[3], Vec3<Lane>* d, Mat3<Lane>* dDdr);
 
 /**
  * A grid lattice's deformation, as plain data that host and device code evaluate alike. MaxCount bounds the
@@ -223,7 +106,8 @@ struct LatticeValues<detail::GroupValues<Real, Group>>
  * StaticBasis, when not -1, is the basis known at compile time (it must equal Basis): the compiler then drops
  * the other bases' branches and unrolls the fixed-size sums (WithStaticBasis() instantiates one per basis).
  * Real is the displacements' type; Lane, the arithmetic's, is Real too, or on the host a Lanes type
- * (FFDLanes.h) that deforms several points of one cell at once through these same functions (WithLanes()).
+ * (Filters/CPU/FFDLanes.h) that deforms several points of one cell at once through these same functions
+ * (WithLanes()); Filters/CPU/FFDLaneCells.h deforms lanes in several cells from the same building blocks.
  * A deformation of a local basis WithCellTable evaluates each cell in power form from CellTable (FillCellTable()
  * of its displacements): the same function, rounded differently. That is a compile-time choice, so that no
  * code path holds both evaluations, whose common subexpressions the compiler would otherwise share and round
@@ -307,21 +191,6 @@ struct GridDeformation
     return x + SumTensorProduct(this->Displacements, this->Dims, axes);
   }
 
-  /**
-   * Deform() for lanes bound to different cells of a local basis (host only, Lane a Lanes type). `group` has the
-   * Count cells of the lanes: the k-th is Cells[k] (BindToGrid()'s flat index), its lanes Lanes[k], and, read
-   * without a CellTable, its index along each axis Indices[k] and its first control point Firsts[k]
-   * (i + Dims[0] (j + Dims[1] k)) (GroupCells in FFDGridLanes.h). Each cell's sum is computed for all lanes and
-   * kept in that cell's lanes, from the same weights (or local coordinates) as Deform(), so a lane's result is
-   * bit for bit the one it gets when all lanes share its cell.
-   */
-  template <typename Group>
-  Vec3<Lane> DeformInLaneCells(const Vec3<Lane>& x, const Group& group) const
-  {
-    Mat3<Lane>* noGradient = nullptr;
-    return x + this->SumInLaneCells(this->Frame.ToParametric(x), group, noGradient);
-  }
-
   /// The index along each axis of a bound cell: BindToGrid()'s flat index ci + cx (cj + cy ck) taken apart.
   FFD_INLINE void CellIndices(int cell, int c[3]) const
   {
@@ -361,19 +230,8 @@ struct GridDeformation
     return x + d;
   }
 
-  /// DeformInLaneCells() and the Jacobian dX_ffd/dX there.
-  template <typename Group>
-  Vec3<Lane> DeformInLaneCells(const Vec3<Lane>& x, const Group& group, Mat3<Lane>& jacobian) const
-  {
-    const Vec3<Lane> stu = this->Frame.ToParametric(x);
-    Mat3<Lane> gradient;
-    Mat3<Lane>* withGradient = &gradient;
-    const Vec3<Lane> d = this->SumInLaneCells(stu, group, withGradient);
-    jacobian = this->JacobianAt(stu, gradient);
-    return x + d;
-  }
+  // The building blocks of Deform(), public for the CPU's lanes in several cells (Filters/CPU/FFDLaneCells.h).
 
-private:
   /// The CellTable entry of a bound cell.
   FFD_INLINE const Real* CellEntry(int cell) const
   {
@@ -393,96 +251,6 @@ private:
       default:
         return PowerForm<3, G>(entry, r, d, dDdr);
     }
-  }
-
-  /**
-   * The displacement (and, where `gradient` is not null, dD/d(s, t, u)) at parameters stu of lanes in the cells
-   * of `group` (DeformInLaneCells()): each lane's weights (or local coordinates) from its own cell's indices,
-   * then each cell's sum in all lanes, kept in that cell's lanes.
-   */
-  template <typename Group>
-  Vec3<Lane> SumInLaneCells(const Vec3<Lane>& stu, const Group& group, Mat3<Lane>* gradient) const
-  {
-    Vec3<Lane> index;
-    for (int k = 0; k < group.Count; ++k)
-    {
-      Vec3<Lane> ck;
-      if constexpr (WithCellTable)
-      {
-        const Real* entry = this->CellEntry(group.Cells[k]);
-        ck = { Lane(entry[0]), Lane(entry[1]), Lane(entry[2]) };
-      }
-      else
-      {
-        ck = { Lane(group.Indices[k][0]), Lane(group.Indices[k][1]), Lane(group.Indices[k][2]) };
-      }
-      const auto& lanes = group.Lanes[k];
-      index = k == 0
-        ? ck
-        : Vec3<Lane>{ Select(lanes, ck.x, index.x), Select(lanes, ck.y, index.y), Select(lanes, ck.z, index.z) };
-    }
-    Lane r[3];
-    AxisWeights<MaxCount, Lane> axes[3];
-    if constexpr (WithCellTable)
-    {
-      this->TableCoordinates(stu, index, r);
-    }
-    else
-    {
-      this->LaneCellWeights(stu, index, gradient != nullptr, axes);
-    }
-    if constexpr (!WithCellTable)
-    {
-      if (gradient && group.Count > 1)
-      {
-        // One sum with its gradient over values read per lane: a cell's sum with its gradient (12 multiply-adds
-        // a control point) costs more than reading its control points into its lanes (6 operations).
-        const detail::GroupValues<Real, Group> values{ this->Displacements, &group };
-        return SumTensorProductWithGradient(&values, this->Dims, axes, *gradient);
-      }
-    }
-    Vec3<Lane> d;
-    for (int k = 0; k < group.Count; ++k)
-    {
-      Mat3<Lane> gk;
-      Vec3<Lane> dk;
-      if constexpr (WithCellTable)
-      {
-        this->CellPowerForm<1>(this->CellEntry(group.Cells[k]), &r, &dk, gradient ? &gk : nullptr);
-        if (gradient)
-        {
-          gk = this->TableGradient(gk);
-        }
-      }
-      else
-      {
-        const Real* values = this->Displacements + 3 * group.Firsts[k];
-        dk = gradient ? SumTensorProductWithGradient(values, this->Dims, axes, gk)
-                      : SumTensorProduct(values, this->Dims, axes);
-      }
-      if (k == 0)
-      {
-        d = dk;
-        if (gradient)
-        {
-          *gradient = gk;
-        }
-        continue;
-      }
-      const auto& lanes = group.Lanes[k];
-      d = { Select(lanes, dk.x, d.x), Select(lanes, dk.y, d.y), Select(lanes, dk.z, d.z) };
-      if (gradient)
-      {
-        for (int row = 0; row < 3; ++row)
-        {
-          for (int column = 0; column < 3; ++column)
-          {
-            gradient->M[row][column] = Select(lanes, gk.M[row][column], gradient->M[row][column]);
-          }
-        }
-      }
-    }
-    return d;
   }
 
   /// The local coordinates in the cells of indices `cell` (as numbers) of points at parameters stu, as
@@ -529,21 +297,7 @@ private:
     return DeformationJacobian(gradient, this->Frame);
   }
 
-  /// The weights along each axis at parameters stu of lanes in the cells of indices `cell` (DeformInLaneCells()),
-  /// as ComputeAxisWeights() computes them for one cell.
-  void LaneCellWeights(
-    const Vec3<Lane>& stu, const Vec3<Lane>& cell, bool withDerivative, AxisWeights<MaxCount, Lane>* axes) const
-  {
-    const Lane p[3] = { stu.x, stu.y, stu.z };
-    const Lane c[3] = { cell.x, cell.y, cell.z };
-    for (int a = 0; a < 3; ++a)
-    {
-      const Lane n = Lane(this->Voxels[a]);
-      axes[a].First = 0;
-      ComputeLocalAxisWeights(this->BasisOf(), n, Clamp01(p[a] * n - c[a]), withDerivative, axes[a]);
-    }
-  }
-
+private:
   /// The weights along each axis at parameters stu (ComputeAxisWeights() clamps them to the frame) of a point
   /// in cell (ci, cj, ck).
   FFD_INLINE void Weights(

@@ -1,0 +1,190 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file FFDLaneCells.h
+ * @brief GridDeformation for lanes bound to different cells of a local basis (host only).
+ *
+ * A lane group of the in-place pass whose points lie in several cells (FFDGridLanes.h) computes each lane's
+ * weights (or local coordinates) once from its own cell's indices, then each cell's sum in all lanes, kept in
+ * that cell's lanes: from GridDeformation's own building blocks, so that a lane's result is bit for bit the one
+ * it gets when all lanes share its cell.
+ */
+#ifndef FFDLaneCells_h
+#define FFDLaneCells_h
+
+#include "FFDGridDeformation.h"
+
+namespace ffd
+{
+
+namespace detail
+{
+/// The control points of a lane group's cells (DeformInLaneCells()), each lane reading its own
+/// cell's: for one sum with its gradient over all lanes, which costs less than one per cell.
+template <typename Real, typename Group>
+struct GroupValues
+{
+  const Real* Displacements;
+  const Group* Cells;
+};
+} // namespace detail
+
+/// Control point `index` (relative to its cell's first one) of each lane's cell: a broadcast and a select per
+/// cell of the group.
+template <typename Real, typename Group>
+struct LatticeValues<detail::GroupValues<Real, Group>>
+{
+  template <typename Lane>
+  static Vec3<Lane> Get(const detail::GroupValues<Real, Group>* values, int index)
+  {
+    const Group& group = *values->Cells;
+    const Real* v = values->Displacements + 3 * (group.Firsts[0] + index);
+    Vec3<Lane> value = { Lane(v[0]), Lane(v[1]), Lane(v[2]) };
+    for (int k = 1; k < group.Count; ++k)
+    {
+      v = values->Displacements + 3 * (group.Firsts[k] + index);
+      value = { Select(group.Lanes[k], Lane(v[0]), value.x), Select(group.Lanes[k], Lane(v[1]), value.y),
+        Select(group.Lanes[k], Lane(v[2]), value.z) };
+    }
+    return value;
+  }
+};
+
+/// The weights along each axis at parameters stu of lanes in the cells of indices `cell` (DeformInLaneCells()),
+/// as ComputeAxisWeights() computes them for one cell.
+template <int MaxCount, typename Real, int StaticBasis, typename Lane, bool WithCellTable>
+inline void LaneCellWeights(const GridDeformation<MaxCount, Real, StaticBasis, Lane, WithCellTable>& deformation,
+  const Vec3<Lane>& stu, const Vec3<Lane>& cell, bool withDerivative, AxisWeights<MaxCount, Lane>* axes)
+{
+  const Lane p[3] = { stu.x, stu.y, stu.z };
+  const Lane c[3] = { cell.x, cell.y, cell.z };
+  for (int a = 0; a < 3; ++a)
+  {
+    const Lane n = Lane(deformation.Voxels[a]);
+    axes[a].First = 0;
+    ComputeLocalAxisWeights(deformation.BasisOf(), n, Clamp01(p[a] * n - c[a]), withDerivative, axes[a]);
+  }
+}
+
+/**
+ * The displacement (and, where `gradient` is not null, dD/d(s, t, u)) at parameters stu of lanes in the cells
+ * of `group` (DeformInLaneCells()): each lane's weights (or local coordinates) from its own cell's indices,
+ * then each cell's sum in all lanes, kept in that cell's lanes.
+ */
+template <int MaxCount, typename Real, int StaticBasis, typename Lane, bool WithCellTable, typename Group>
+inline Vec3<Lane> SumInLaneCells(const GridDeformation<MaxCount, Real, StaticBasis, Lane, WithCellTable>& deformation,
+  const Vec3<Lane>& stu, const Group& group, Mat3<Lane>* gradient)
+{
+  Vec3<Lane> index;
+  for (int k = 0; k < group.Count; ++k)
+  {
+    Vec3<Lane> ck;
+    if constexpr (WithCellTable)
+    {
+      const Real* entry = deformation.CellEntry(group.Cells[k]);
+      ck = { Lane(entry[0]), Lane(entry[1]), Lane(entry[2]) };
+    }
+    else
+    {
+      ck = { Lane(group.Indices[k][0]), Lane(group.Indices[k][1]), Lane(group.Indices[k][2]) };
+    }
+    const auto& lanes = group.Lanes[k];
+    index = k == 0
+      ? ck
+      : Vec3<Lane>{ Select(lanes, ck.x, index.x), Select(lanes, ck.y, index.y), Select(lanes, ck.z, index.z) };
+  }
+  Lane r[3];
+  AxisWeights<MaxCount, Lane> axes[3];
+  if constexpr (WithCellTable)
+  {
+    deformation.TableCoordinates(stu, index, r);
+  }
+  else
+  {
+    LaneCellWeights(deformation, stu, index, gradient != nullptr, axes);
+  }
+  if constexpr (!WithCellTable)
+  {
+    if (gradient && group.Count > 1)
+    {
+      // One sum with its gradient over values read per lane: a cell's sum with its gradient (12 multiply-adds
+      // a control point) costs more than reading its control points into its lanes (6 operations).
+      const detail::GroupValues<Real, Group> values{ deformation.Displacements, &group };
+      return SumTensorProductWithGradient(&values, deformation.Dims, axes, *gradient);
+    }
+  }
+  Vec3<Lane> d;
+  for (int k = 0; k < group.Count; ++k)
+  {
+    Mat3<Lane> gk;
+    Vec3<Lane> dk;
+    if constexpr (WithCellTable)
+    {
+      deformation.template CellPowerForm<1>(deformation.CellEntry(group.Cells[k]), &r, &dk, gradient ? &gk : nullptr);
+      if (gradient)
+      {
+        gk = deformation.TableGradient(gk);
+      }
+    }
+    else
+    {
+      const Real* values = deformation.Displacements + 3 * group.Firsts[k];
+      dk = gradient ? SumTensorProductWithGradient(values, deformation.Dims, axes, gk)
+                    : SumTensorProduct(values, deformation.Dims, axes);
+    }
+    if (k == 0)
+    {
+      d = dk;
+      if (gradient)
+      {
+        *gradient = gk;
+      }
+      continue;
+    }
+    const auto& lanes = group.Lanes[k];
+    d = { Select(lanes, dk.x, d.x), Select(lanes, dk.y, d.y), Select(lanes, dk.z, d.z) };
+    if (gradient)
+    {
+      for (int row = 0; row < 3; ++row)
+      {
+        for (int column = 0; column < 3; ++column)
+        {
+          gradient->M[row][column] = Select(lanes, gk.M[row][column], gradient->M[row][column]);
+        }
+      }
+    }
+  }
+  return d;
+}
+
+/**
+ * Deform() for lanes bound to different cells of a local basis (Lane a Lanes type). `group` has the Count cells
+ * of the lanes: the k-th is Cells[k] (BindToGrid()'s flat index), its lanes Lanes[k], and, read without a
+ * CellTable, its index along each axis Indices[k] and its first control point Firsts[k]
+ * (i + Dims[0] (j + Dims[1] k)) (GroupCells in FFDGridLanes.h).
+ */
+template <int MaxCount, typename Real, int StaticBasis, typename Lane, bool WithCellTable, typename Group>
+inline Vec3<Lane> DeformInLaneCells(
+  const GridDeformation<MaxCount, Real, StaticBasis, Lane, WithCellTable>& deformation, const Vec3<Lane>& x,
+  const Group& group)
+{
+  Mat3<Lane>* noGradient = nullptr;
+  return x + SumInLaneCells(deformation, deformation.Frame.ToParametric(x), group, noGradient);
+}
+
+/// DeformInLaneCells() and the Jacobian dX_ffd/dX there.
+template <int MaxCount, typename Real, int StaticBasis, typename Lane, bool WithCellTable, typename Group>
+inline Vec3<Lane> DeformInLaneCells(
+  const GridDeformation<MaxCount, Real, StaticBasis, Lane, WithCellTable>& deformation, const Vec3<Lane>& x,
+  const Group& group, Mat3<Lane>& jacobian)
+{
+  const Vec3<Lane> stu = deformation.Frame.ToParametric(x);
+  Mat3<Lane> gradient;
+  Mat3<Lane>* withGradient = &gradient;
+  const Vec3<Lane> d = SumInLaneCells(deformation, stu, group, withGradient);
+  jacobian = deformation.JacobianAt(stu, gradient);
+  return x + d;
+}
+
+} // namespace ffd
+
+#endif
