@@ -5,7 +5,8 @@
  *
  * Every constant and threshold that the CPU passes (FFDGridLanes.h, FFDPointBlocks.h) were tuned by is here, with
  * the reason for it; BENCHMARKS.md has the measurements. None of them changes a result: a point is deformed the
- * same whichever pass takes it.
+ * same whichever pass takes it. How many points a vtkSMPTools task takes is the VTK side's: vtkFFDGrain()
+ * (Filters/vtkFFDForInChunks.h).
  */
 #ifndef FFDCpuTuning_h
 #define FFDCpuTuning_h
@@ -23,6 +24,10 @@ constexpr int BlockSize = 16;
 
 /// Blocks ahead whose points the in-place pass prefetches.
 constexpr int PrefetchBlocks = 8;
+
+/// Blocks over which the in-place pass defers the blocks in several cells to the end, while their points are
+/// still in cache.
+constexpr int InPlaceWindow = 64;
 
 /**
  * Consecutive points among which the gathered pass sorts by cell (a multiple of BlockSize, at most 2^16: see

@@ -273,12 +273,11 @@ inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in,
   blockEnd = std::min(blockEnd, std::int64_t(blocks.Entry.size())); // the last, partial block is gathered
   // Blocks in several cells are deformed after the others of a window of blocks, still in cache: kept out of the
   // loop over the window, their code leaves that loop's registers to the common case.
-  constexpr int Window = 64;
-  std::int64_t several[Window];
-  for (std::int64_t window = blockBegin; window < blockEnd; window += Window)
+  std::int64_t several[InPlaceWindow];
+  for (std::int64_t window = blockBegin; window < blockEnd; window += InPlaceWindow)
   {
     int severalCount = 0;
-    for (std::int64_t b = window; b < blockEnd && b < window + Window; ++b)
+    for (std::int64_t b = window; b < blockEnd && b < window + InPlaceWindow; ++b)
     {
       if (!blocks.InPlace(b))
       {
