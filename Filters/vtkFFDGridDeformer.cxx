@@ -32,14 +32,8 @@ namespace
 using PointArrays = vtkArrayDispatch::Reals;
 
 //------------------------------------------------------------------------------------------------------------
-static_assert(int(ffd::GridBasis::Bernstein) == vtkFFDBuildLattice::BERNSTEIN &&
-    int(ffd::GridBasis::Trilinear) == vtkFFDBuildLattice::TRILINEAR &&
-    int(ffd::GridBasis::TriquadraticBezier) == vtkFFDBuildLattice::TRIQUADRATIC_BEZIER &&
-    int(ffd::GridBasis::TricubicBezier) == vtkFFDBuildLattice::TRICUBIC_BEZIER &&
-    int(ffd::GridBasis::CubicBSpline) == vtkFFDBuildLattice::CUBIC_BSPLINE,
-  "the kernels' basis values are the FFDBasis values");
-
-// Reads a lattice per the data contract; returns an empty string or what is wrong with it.
+// Reads a lattice per the data contract; returns an empty string or what is wrong with it. Its FFDBasis holds
+// vtkFFDBuildLattice's values, which vtkFFDBuildLattice.cxx asserts are ffd::GridBasis's.
 std::string ReadLattice(vtkPointSet* lattice, vtkFFDGridLattice& view)
 {
   const std::string fix = " Build the lattice with vtkFFDBuildLattice, or keep its data contract "
@@ -195,14 +189,14 @@ namespace
 // Evaluation of the points alone (no normals, no determinants) from points of the output's precision, W at a
 // time in SIMD lanes (FFDGridLanes.h): first the blocks deformed in place, then the points of the other blocks,
 // gathered by cell at binding, tile by tile.
-template <typename Deformer, typename Real>
+template <typename DeformationT, typename Real>
 struct LanesFunctor
 {
   const Real* InPoints;
   Real* OutPoints;
   vtkFFDGridBinding& Binding;
   const Real* Listed; // vtkFFDGridBinding::Listed()
-  Deformer Deformation;
+  DeformationT Deformation;
   bool Stream;       // non-temporal stores in the in-place pass (ffd::StreamOutput())
   bool GatheredPass; // false: over the blocks of points, true: over the tiles of Binding.Gathered
 
@@ -225,7 +219,7 @@ struct LanesFunctor
 // Evaluation with the Jacobian (normals to transform, determinants), W points at a time in SIMD lanes
 // (ffd::DeformWithJacobian), over blocks of ffd::BlockSize points: the last points, fewer than a lane group, are
 // deformed one at a time, whatever the split among threads.
-template <typename Deformer, typename Real>
+template <typename DeformationT, typename Real>
 struct JacobianFunctor
 {
   const Real* InPoints;
@@ -235,7 +229,7 @@ struct JacobianFunctor
   const Real* InNormals; // nullptr: no normals to transform
   Real* OutNormals;
   Real* Determinants; // nullptr: not asked for
-  Deformer Deformation;
+  DeformationT Deformation;
 
   void operator()(vtkIdType begin, vtkIdType end)
   {
