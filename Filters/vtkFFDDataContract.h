@@ -12,6 +12,11 @@
  * | `FFDBasis`     | field data, 1 int     | basis (vtkFFDBuildLattice::Basis), lattices only             |
  * | `RestPosition` | point data, 3 doubles | control point position before any deformation                |
  * | `Active`       | point data, uint8     | 1 where the control point influences some input point        |
+ * | `VoxelIndex`   | cell data, 3 ints     | (i, j, k) of a sparse voxel grid's or lattice's voxel        |
+ * | `LatticeIndex` | point data, 3 ints    | (i, j, k) of a sparse lattice's control point                |
+ *
+ * Voxel grids are vtkUnstructuredGrids of the active voxels; lattices are dense (vtkStructuredGrid) or sparse
+ * (vtkUnstructuredGrid of the active control points and one cell per active voxel): README, "Data contract".
  *
  * This class gathers those names and the checked reads and writes of the field arrays, so that every filter
  * (and a Python script) reads them the same way. The Get methods return false, leaving the output untouched,
@@ -41,6 +46,8 @@ public:
   static const char* BasisArrayName() { return "FFDBasis"; }
   static const char* RestPositionArrayName() { return "RestPosition"; }
   static const char* ActiveArrayName() { return "Active"; }
+  static const char* VoxelIndexArrayName() { return "VoxelIndex"; }
+  static const char* LatticeIndexArrayName() { return "LatticeIndex"; }
   ///@}
 
   ///@{
