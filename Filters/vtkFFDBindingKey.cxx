@@ -18,13 +18,14 @@ vtkFFDBindingKey vtkFFDBindingKey::Of(vtkPoints* points, int outsidePolicy)
 }
 
 //------------------------------------------------------------------------------------------------------------
-vtkFFDBindingKey vtkFFDBindingKey::OfGrid(
-  vtkPoints* points, int outsidePolicy, const double frame[12], const int divisions[3], int basis)
+vtkFFDBindingKey vtkFFDBindingKey::OfGrid(vtkPoints* points, int outsidePolicy, const double frame[12],
+  const int divisions[3], int basis, std::uint64_t sparseCells)
 {
   vtkFFDBindingKey key = Of(points, outsidePolicy);
   std::copy(frame, frame + 12, key.Frame.begin());
   std::copy(divisions, divisions + 3, key.Divisions.begin());
   key.Basis = basis;
+  key.SparseCells = sparseCells;
   return key;
 }
 
@@ -39,5 +40,6 @@ bool vtkFFDBindingKey::operator==(const vtkFFDBindingKey& other) const
 {
   return this->Points == other.Points && this->PointsMTime == other.PointsMTime &&
     this->NumberOfPoints == other.NumberOfPoints && this->OutsidePolicy == other.OutsidePolicy &&
-    this->Frame == other.Frame && this->Divisions == other.Divisions && this->Basis == other.Basis;
+    this->Frame == other.Frame && this->Divisions == other.Divisions && this->Basis == other.Basis &&
+    this->SparseCells == other.SparseCells;
 }

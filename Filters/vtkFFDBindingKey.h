@@ -14,6 +14,7 @@
 #include "vtkType.h"
 
 #include <array>
+#include <cstdint>
 
 class vtkPoints;
 
@@ -27,12 +28,13 @@ struct vtkFFDBindingKey
   std::array<double, 12> Frame{};
   std::array<int, 3> Divisions{};
   int Basis = -1;
+  std::uint64_t SparseCells = 0; // a sparse lattice's vtkFFDSparseCells::GetFingerprint(), 0 for a dense one
 
   /// The key of a binding of `points` under `outsidePolicy` (a tetrahedral lattice's).
   static vtkFFDBindingKey Of(vtkPoints* points, int outsidePolicy);
   /// The key of a binding of `points` to a grid lattice of that rest frame, divisions and basis.
-  static vtkFFDBindingKey OfGrid(
-    vtkPoints* points, int outsidePolicy, const double frame[12], const int divisions[3], int basis);
+  static vtkFFDBindingKey OfGrid(vtkPoints* points, int outsidePolicy, const double frame[12], const int divisions[3],
+    int basis, std::uint64_t sparseCells);
 
   /// Whether points outside the lattice are clamped to it (vtkFFDDeform::CLAMP_TO_EDGE).
   bool ClampsOutside() const;

@@ -17,6 +17,7 @@
 #include "vtkPoints.h"
 #include "vtkSMPThreadLocal.h"
 #include "vtkSMPTools.h"
+#include "vtkUnstructuredGrid.h"
 
 #include "FFDCellTable.h"
 #include "FFDGridLanes.h"
@@ -34,7 +35,7 @@ using PointArrays = vtkArrayDispatch::Reals;
 //------------------------------------------------------------------------------------------------------------
 // Reads a lattice per the data contract; returns an empty string or what is wrong with it. Its FFDBasis holds
 // vtkFFDBuildLattice's values, which vtkFFDBuildLattice.cxx asserts are ffd::GridBasis's.
-std::string ReadLattice(vtkPointSet* lattice, vtkFFDGridLattice& view)
+std::string ReadLattice(vtkPointSet* lattice, vtkFFDGridLattice& view, vtkFFDSparseCells& sparseCells)
 {
   const std::string fix = " Build the lattice with vtkFFDBuildLattice, or keep its data contract "
                           "(see vtkFFDDataContract).";
@@ -64,15 +65,43 @@ std::string ReadLattice(vtkPointSet* lattice, vtkFFDGridLattice& view)
     return "The lattice's FFDBasis " + std::to_string(basis) + " is not a known basis." + fix;
   }
   view.Basis = static_cast<ffd::GridBasis>(basis);
+  // A sparse lattice holds the control points of its cells: its own count, not the whole lattice's.
+  view.Sparse = lattice->GetPointData()->GetAbstractArray(vtkFFDDataContract::LatticeIndexArrayName()) != nullptr;
+  vtkUnstructuredGrid* sparse = vtkUnstructuredGrid::SafeDownCast(lattice);
+  if (view.Sparse && (!sparse || view.Basis == ffd::GridBasis::Bernstein))
+  {
+    return "The lattice has a LatticeIndex point array, so it is sparse, but it is not a vtkUnstructuredGrid of a "
+           "local basis: a global Bernstein lattice is dense." +
+      fix;
+  }
   std::string why;
-  if (!vtkFFDBuildLattice::GetControlPointsPerAxis(basis, view.Divisions, view.ControlPointsPerAxis, why))
+  if (view.Sparse)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      if (view.Divisions[a] > (VTK_INT_MAX - 1) / 3)
+      {
+        return "The lattice's FFDDivisions are too large: more control points along an axis than an int counts.";
+      }
+      view.ControlPointsPerAxis[a] = ffd::ControlPointsAlongAxis(view.Basis, view.Divisions[a]);
+    }
+  }
+  else if (!vtkFFDBuildLattice::GetControlPointsPerAxis(basis, view.Divisions, view.ControlPointsPerAxis, why))
   {
     return "The lattice's FFDDivisions do not fit its FFDBasis: " + why;
   }
   const vtkIdType expected =
     vtkIdType(view.ControlPointsPerAxis[0]) * view.ControlPointsPerAxis[1] * view.ControlPointsPerAxis[2];
   const vtkIdType count = lattice->GetNumberOfPoints();
-  if (count != expected)
+  if (view.Sparse)
+  {
+    why = sparseCells.Read(sparse, view.Basis, view.Divisions);
+    if (!why.empty())
+    {
+      return why;
+    }
+  }
+  else if (count != expected)
   {
     std::ostringstream msg;
     msg << "The lattice has " << count << " points but its divisions " << view.Divisions[0] << "x" << view.Divisions[1]
@@ -101,6 +130,7 @@ struct BindSettings
   ffd::GridBasis Basis;
   int Voxels[3];
   bool ClampOutside;
+  const vtkFFDSparseCells* SparseCells; // null for a dense lattice
 };
 
 template <typename PointArrayT>
@@ -114,10 +144,20 @@ struct BindFunctor
   {
     const auto points = vtk::DataArrayTupleRange<3>(this->Points, begin, end);
     int* cell = this->CellOfPoint + begin;
+    const BindSettings& s = this->Settings;
     for (const auto x : points)
     {
-      *cell++ = ffd::BindToGrid(this->Settings.Frame, this->Settings.Basis, this->Settings.Voxels,
-        { double(x[0]), double(x[1]), double(x[2]) }, this->Settings.ClampOutside);
+      const ffd::Vec3<double> p{ double(x[0]), double(x[1]), double(x[2]) };
+      if (!s.SparseCells)
+      {
+        *cell++ = ffd::BindToGrid(s.Frame, s.Basis, s.Voxels, p, s.ClampOutside);
+        continue;
+      }
+      // A sparse lattice's cell of the point's voxel, -1 where it has none.
+      int v[3];
+      *cell++ = ffd::BindToCells(s.Frame, s.Voxels, p, s.ClampOutside, v)
+        ? s.SparseCells->Find(v[0] + std::int64_t(s.Voxels[0]) * (v[1] + std::int64_t(s.Voxels[1]) * v[2]))
+        : -1;
     }
   }
 };
@@ -243,22 +283,27 @@ struct JacobianFunctor
 template <typename Real>
 struct EvaluateWorker
 {
+  const vtkFFDSparseCells* Sparse; // null for a dense lattice
+
   template <typename PointArrayT>
   void operator()(PointArrayT* inPoints, const vtkFFDGridLattice& lattice, vtkFFDGridBinding& binding,
     vtkDataArray* inNormals, vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outPoints,
     vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self, double progressBegin, double progressEnd,
     bool& completed)
   {
+    const vtkFFDSparseCells* sparse = this->Sparse;
     const std::vector<Real> displacements(lattice.Displacements.begin(), lattice.Displacements.end());
     std::vector<Real> cellTable;
     if (binding.CellTable)
     {
-      const int cells = lattice.Divisions[0] * lattice.Divisions[1] * lattice.Divisions[2];
+      const int cells =
+        sparse ? sparse->GetNumberOfCells() : lattice.Divisions[0] * lattice.Divisions[1] * lattice.Divisions[2];
       cellTable.resize(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(lattice.Basis)));
       vtkSMPTools::For(0, cells, 256,
         [&](int begin, int end)
         {
           ffd::FillCellTable(lattice.Basis, displacements.data(), lattice.Divisions, lattice.ControlPointsPerAxis,
+            sparse ? sparse->GetVoxels().data() : nullptr, sparse ? sparse->GetSupports().data() : nullptr,
             cellTable.data(), begin, end);
         });
     }
@@ -293,9 +338,11 @@ struct EvaluateWorker
     double progressBegin, double progressEnd, bool& completed)
   {
     using Deformation = ffd::GridDeformation<MaxCount, Real, StaticBasis, Real, WithCellTable>;
+    const vtkFFDSparseCells* sparse = this->Sparse;
     const Deformation deformation{ lattice.Basis, { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] },
       { lattice.ControlPointsPerAxis[0], lattice.ControlPointsPerAxis[1], lattice.ControlPointsPerAxis[2] },
-      displacements, ffd::Frame<Real>::FromArray(lattice.Frame), cellTable };
+      displacements, ffd::Frame<Real>::FromArray(lattice.Frame), cellTable,
+      sparse ? sparse->GetVoxels().data() : nullptr, sparse ? sparse->GetSupports().data() : nullptr };
     const vtkIdType n = inPoints->GetNumberOfTuples();
     // The work of a point: the control points it reads, and 16 for its parameters and output.
     double reads = 1.0;
@@ -354,14 +401,15 @@ vtkFFDGridDeformer::~vtkFFDGridDeformer() = default;
 //------------------------------------------------------------------------------------------------------------
 std::string vtkFFDGridDeformer::SetLattice(vtkPointSet* lattice)
 {
-  return ReadLattice(lattice, this->Lattice);
+  return ReadLattice(lattice, this->Lattice, this->SparseCells);
 }
 
 //------------------------------------------------------------------------------------------------------------
 vtkFFDBindingKey vtkFFDGridDeformer::KeyOf(vtkPoints* points, int outsidePolicy) const
 {
-  return vtkFFDBindingKey::OfGrid(
-    points, outsidePolicy, this->Lattice.Frame, this->Lattice.Divisions, static_cast<int>(this->Lattice.Basis));
+  const vtkFFDSparseCells* sparse = this->GetSparseCells();
+  return vtkFFDBindingKey::OfGrid(points, outsidePolicy, this->Lattice.Frame, this->Lattice.Divisions,
+    static_cast<int>(this->Lattice.Basis), sparse ? sparse->GetFingerprint() : 0);
 }
 
 //------------------------------------------------------------------------------------------------------------
@@ -379,8 +427,9 @@ bool vtkFFDGridDeformer::Bind(
   vtkFFDGridBinding& binding = *this->Binding;
   const vtkIdType n = points->GetNumberOfPoints();
   binding.CellOfPoint.resize(n);
+  const vtkFFDSparseCells* sparse = this->GetSparseCells();
   const BindSettings settings{ ffd::Frame<double>::FromArray(lattice.Frame), lattice.Basis,
-    { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] }, key.ClampsOutside() };
+    { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] }, key.ClampsOutside(), sparse };
   bool completed = false;
   BindWorker bind;
   if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(
@@ -392,13 +441,16 @@ bool vtkFFDGridDeformer::Bind(
   {
     return false;
   }
-  int cellCount = 1;
+  // A sparse lattice decides on the cell table as the dense lattice would, so that both evaluate alike; its point
+  // lists are sorted by its own cells, which are in the dense lattice's order.
+  std::int64_t denseCells = 1;
   for (int a = 0; a < 3; ++a)
   {
-    cellCount *= ffd::BindingCells(lattice.Basis, lattice.Divisions[a]);
+    denseCells *= ffd::BindingCells(lattice.Basis, lattice.Divisions[a]);
   }
+  const int cellCount = sparse ? sparse->GetNumberOfCells() : static_cast<int>(denseCells);
   const int* cells = binding.CellOfPoint.data();
-  binding.CellTable = ffd::WorthCellTable(lattice.Basis, cellCount, n);
+  binding.CellTable = ffd::WorthCellTable(lattice.Basis, denseCells, n);
   const int maxCellsInPlace = ffd::MaxCellsInPlace(lattice.Basis, ffd::MeanCellsPerBlock(cells, n), binding.CellTable);
   binding.Blocks = ffd::ListBlockCells(cells, n, maxCellsInPlace);
   binding.Gathered = ffd::ListGatheredPoints(cells, n, cellCount, maxCellsInPlace);
@@ -418,7 +470,7 @@ bool vtkFFDGridDeformer::Evaluate(vtkPoints* points, vtkDataArray* normals, vtkD
   {
     using RealArray = std::remove_pointer_t<decltype(out)>;
     using Real = typename RealArray::ValueType;
-    EvaluateWorker<Real> worker;
+    EvaluateWorker<Real> worker{ this->GetSparseCells() };
     auto* determinants = static_cast<RealArray*>(outDeterminants);
     if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(points->GetData(), worker, this->Lattice,
           *this->Binding, normals, outNormals, out, determinants, self, progressBegin, progressEnd, completed))
@@ -436,4 +488,10 @@ bool vtkFFDGridDeformer::Evaluate(vtkPoints* points, vtkDataArray* normals, vtkD
     evaluate(vtkAOSDataArrayTemplate<float>::FastDownCast(outPoints));
   }
   return completed;
+}
+
+//------------------------------------------------------------------------------------------------------------
+const std::vector<int>& vtkFFDGridDeformer::GetCellOfPoint() const
+{
+  return this->Binding->CellOfPoint;
 }

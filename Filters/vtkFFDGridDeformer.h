@@ -8,11 +8,14 @@
  * points' displacements; Bind() finds every point's cell (ffd::BindToGrid) and lists the blocks of points
  * for the SIMD passes, unless the binding is already for these points, the same rest frame, divisions, basis and
  * policy; Evaluate() deforms the bound points on vtkSMPTools threads. Filters/README.md says how the passes work.
+ * A lattice is dense (a control point per lattice index) or sparse (vtkFFDSparseCells): both bind and evaluate
+ * through the same passes, a sparse lattice's cells numbered in the dense lattice's order.
  */
 #ifndef vtkFFDGridDeformer_h
 #define vtkFFDGridDeformer_h
 
 #include "vtkFFDBindingKey.h"
+#include "vtkFFDSparseCells.h"
 #include "vtkType.h"
 
 #include "FFDGridBasis.h"
@@ -35,6 +38,7 @@ struct vtkFFDGridLattice
   ffd::GridBasis Basis;
   int ControlPointsPerAxis[3];
   std::vector<double> Displacements; // 3 per control point: point minus RestPosition
+  bool Sparse = false;               // the control points and cells of vtkFFDGridDeformer::GetSparseCells() only
 };
 
 class vtkFFDGridDeformer
@@ -53,6 +57,12 @@ public:
 
   /// The lattice of the last SetLattice().
   const vtkFFDGridLattice& GetLattice() const { return this->Lattice; }
+
+  /// The cells of the last SetLattice()'s lattice where it is sparse, else null.
+  const vtkFFDSparseCells* GetSparseCells() const { return this->Lattice.Sparse ? &this->SparseCells : nullptr; }
+
+  /// The cell of each point of the last Bind() (-1: it keeps its position).
+  const std::vector<int>& GetCellOfPoint() const;
 
   /// What a binding of `points` to the lattice of SetLattice() under `outsidePolicy` is for.
   vtkFFDBindingKey KeyOf(vtkPoints* points, int outsidePolicy) const;
@@ -75,6 +85,7 @@ public:
 
 private:
   vtkFFDGridLattice Lattice;
+  vtkFFDSparseCells SparseCells;
   std::unique_ptr<vtkFFDGridBinding> Binding;
   vtkFFDBindingKey Bound; // what Binding is for
 };

@@ -12,6 +12,8 @@
 
 #include "FFDGridDeformation.h"
 
+#include <algorithm>
+
 namespace ffd
 {
 
@@ -23,7 +25,9 @@ namespace ffd
  * multiply-adds a component, against about 1.3 times that and the weights for the weighted sum of the control
  * points (a half, and 14 against 7, for the trilinear basis). The rest lattice's coefficients are all 0, so it stays
  * exactly the identity. `displacements` as GridDeformation::Displacements on a grid of `dims`; `table` holds
- * CellTableStride(CellDegree(basis)) Reals per cell.
+ * CellTableStride(CellDegree(basis)) Reals per cell. For a sparse lattice, `cellVoxels` and `cellSupports` are
+ * GridDeformation's (null for a dense one): its cells' entries are read through them, the same values in the same
+ * order, so that its table is the dense lattice's, cell for cell.
  */
 namespace detail
 {
@@ -107,8 +111,8 @@ inline void ToMonomialsAlong(const double (&m)[4][4], double (&v)[N * N * N][3])
 
 /// FillCellTable() for one local basis.
 template <GridBasis Basis, typename Real>
-inline void FillCellTableOf(
-  const Real* displacements, const int voxels[3], const int dims[3], Real* table, int cellBegin, int cellEnd)
+inline void FillCellTableOf(const Real* displacements, const int voxels[3], const int dims[3], const int* cellVoxels,
+  const int* cellSupports, Real* table, int cellBegin, int cellEnd)
 {
   static constexpr ToMonomials<Basis> toMonomials;
   constexpr int N = ToMonomials<Basis>::N;
@@ -116,6 +120,10 @@ inline void FillCellTableOf(
   int c[3] = { cellBegin % voxels[0], cellBegin / voxels[0] % voxels[1], cellBegin / (voxels[0] * voxels[1]) };
   for (int cell = cellBegin; cell < cellEnd; ++cell)
   {
+    if (cellVoxels)
+    {
+      std::copy(cellVoxels + 3 * std::size_t(cell), cellVoxels + 3 * std::size_t(cell) + 3, c);
+    }
     int first[3], count;
     for (int a = 0; a < 3; ++a)
     {
@@ -128,6 +136,7 @@ inline void FillCellTableOf(
     }
     // The control points (x fastest), changed to monomials along x, then y, then z.
     const Real* corner = displacements + 3 * (first[0] + dims[0] * (first[1] + dims[1] * first[2]));
+    const int* support = cellSupports ? cellSupports + std::size_t(cell) * (N * N * N) : nullptr;
     double v[N * N * N][3];
     for (int z = 0; z < N; ++z)
     {
@@ -135,9 +144,12 @@ inline void FillCellTableOf(
       {
         for (int x = 0; x < N; ++x)
         {
+          const int local = x + N * (y + N * z);
+          const Real* value =
+            support ? displacements + 3 * std::size_t(support[local]) : corner + 3 * (x + dims[0] * (y + dims[1] * z));
           for (int k = 0; k < 3; ++k)
           {
-            v[x + N * (y + N * z)][k] = double(corner[3 * (x + dims[0] * (y + dims[1] * z)) + k]);
+            v[local][k] = double(value[k]);
           }
         }
       }
@@ -168,19 +180,22 @@ inline void FillCellTableOf(
 
 template <typename Real>
 inline void FillCellTable(GridBasis basis, const Real* displacements, const int voxels[3], const int dims[3],
-  Real* table, int cellBegin, int cellEnd)
+  const int* cellVoxels, const int* cellSupports, Real* table, int cellBegin, int cellEnd)
 {
   switch (basis)
   {
     case GridBasis::Trilinear:
-      return detail::FillCellTableOf<GridBasis::Trilinear>(displacements, voxels, dims, table, cellBegin, cellEnd);
+      return detail::FillCellTableOf<GridBasis::Trilinear>(
+        displacements, voxels, dims, cellVoxels, cellSupports, table, cellBegin, cellEnd);
     case GridBasis::TriquadraticBezier:
       return detail::FillCellTableOf<GridBasis::TriquadraticBezier>(
-        displacements, voxels, dims, table, cellBegin, cellEnd);
+        displacements, voxels, dims, cellVoxels, cellSupports, table, cellBegin, cellEnd);
     case GridBasis::TricubicBezier:
-      return detail::FillCellTableOf<GridBasis::TricubicBezier>(displacements, voxels, dims, table, cellBegin, cellEnd);
+      return detail::FillCellTableOf<GridBasis::TricubicBezier>(
+        displacements, voxels, dims, cellVoxels, cellSupports, table, cellBegin, cellEnd);
     case GridBasis::CubicBSpline:
-      return detail::FillCellTableOf<GridBasis::CubicBSpline>(displacements, voxels, dims, table, cellBegin, cellEnd);
+      return detail::FillCellTableOf<GridBasis::CubicBSpline>(
+        displacements, voxels, dims, cellVoxels, cellSupports, table, cellBegin, cellEnd);
     case GridBasis::Bernstein: // one cell: no table
       break;
   }

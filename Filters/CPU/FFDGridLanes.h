@@ -158,13 +158,18 @@ inline void DeformOnePointWithJacobian(const Deformation& deformation, const Rea
 
 namespace detail
 {
-/// The flat index of the first control point of a cell (not -1) of a local basis, and the cell's index along
-/// each axis.
+/// The flat index of the first control point of a cell (not -1) of a local basis, or a sparse lattice's cell's
+/// first entry in CellSupports, and the cell's index along each axis.
 template <typename Deformation>
 inline int FirstOfCell(const Deformation& deformation, const CellSplit& split, int cell, int index[3])
 {
+  deformation.CellIndices(split, cell, index);
+  if (deformation.IsSparse())
+  {
+    const int n = deformation.SupportCount();
+    return cell * n * n * n;
+  }
   int first[3], count;
-  split.Split(cell, index);
   for (int a = 0; a < 3; ++a)
   {
     VoxelSupport(deformation.BasisOf(), deformation.Voxels[a], index[a], first[a], count);
@@ -301,7 +306,7 @@ inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in,
       int c[3];
       if constexpr (!Deformation::UsesCellTable())
       {
-        split.Split(first < 0 ? 0 : first, c);
+        deformation.CellIndices(split, first < 0 ? 0 : first, c);
       }
       constexpr int Groups = BlockSize / W;
       const std::int64_t begin = b * BlockSize;
@@ -333,7 +338,7 @@ inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in,
         {
           for (int g = 0; g < Groups; ++g)
           {
-            y[g] = wide.DeformInCell(x[g], c);
+            y[g] = wide.DeformInCell(x[g], first, c);
           }
         }
       }
@@ -343,6 +348,41 @@ inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in,
       }
     }
     DeformInSeveralCells<Lane, Streaming>(deformation, wide, split, blocks, in, out, outFirst, several, severalCount);
+  }
+}
+
+/**
+ * Point i deformed with its Jacobian (DeformOnePointWithJacobian()) in every lane of a group of its own: by the
+ * lane code, not by scalar code, which the compiler may contract into multiply-adds differently in each of its
+ * instantiations (that of a dense lattice and that of a sparse one would then differ in the last bit).
+ */
+template <typename Lane, typename Wide, typename Real>
+inline void OnePointInLanes(const Wide& wide, const Real* in, const int* cells, const Real* inNormals, Real* out,
+  Real* outNormals, Real* determinants, std::int64_t i)
+{
+  auto first = [](const Lane& lane)
+  {
+    Real v;
+    std::memcpy(&v, &lane.V, sizeof(Real));
+    return v;
+  };
+  const Vec3<Lane> x = { Lane(in[3 * i]), Lane(in[3 * i + 1]), Lane(in[3 * i + 2]) };
+  Mat3<Lane> jacobian = Mat3<Lane>::Identity(); // cell -1 keeps its position
+  const Vec3<Lane> y = cells[i] < 0 ? x : wide.Deform(x, cells[i], jacobian);
+  out[3 * i] = first(y.x);
+  out[3 * i + 1] = first(y.y);
+  out[3 * i + 2] = first(y.z);
+  if (outNormals)
+  {
+    const Vec3<Lane> n = { Lane(inNormals[3 * i]), Lane(inNormals[3 * i + 1]), Lane(inNormals[3 * i + 2]) };
+    const Vec3<Lane> m = TransformNormal(jacobian, n);
+    outNormals[3 * i] = first(m.x);
+    outNormals[3 * i + 1] = first(m.y);
+    outNormals[3 * i + 2] = first(m.z);
+  }
+  if (determinants)
+  {
+    determinants[i] = first(Determinant(jacobian));
   }
 }
 
@@ -357,7 +397,7 @@ inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, 
   const bool global = deformation.BasisOf() == GridBasis::Bernstein;
   const CellSplit split = CellSplit::For(deformation.BasisOf(), deformation.Voxels);
   const Mat3<Lane> identity = Mat3<Lane>::Identity();
-  // Whole blocks in lanes (begin is a block's first point), the last points one at a time.
+  // Whole blocks in lanes (begin is a block's first point), the last points one at a time (OnePointInLanes()).
   const std::int64_t whole = std::min(end, std::int64_t(blocks.Entry.size()) * BlockSize);
   std::int64_t i = begin;
   for (; i < whole; i += W)
@@ -418,7 +458,7 @@ inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, 
   }
   for (; i < end; ++i) // the points of the last, partial block
   {
-    DeformOnePointWithJacobian(deformation, in, cells, inNormals, out, outNormals, determinants, i);
+    OnePointInLanes<Lane>(wide, in, cells, inNormals, out, outNormals, determinants, i);
   }
 }
 

@@ -19,12 +19,21 @@ namespace ffd
 namespace detail
 {
 /// The control points of a lane group's cells (DeformInLaneCells()), each lane reading its own
-/// cell's: for one sum with its gradient over all lanes, which costs less than one per cell.
+/// cell's: for one sum with its gradient over all lanes, which costs less than one per cell. Supports is a sparse
+/// lattice's GridDeformation::CellSupports, null for a dense one.
 template <typename Real, typename Group>
 struct GroupValues
 {
   const Real* Displacements;
+  const int* Supports;
   const Group* Cells;
+
+  /// Control point `index` (relative to the cell's first one) of the group's k-th cell.
+  const Real* Of(int k, int index) const
+  {
+    const int at = this->Cells->Firsts[k] + index;
+    return this->Displacements + 3 * std::size_t(this->Supports ? this->Supports[at] : at);
+  }
 };
 } // namespace detail
 
@@ -37,11 +46,11 @@ struct LatticeValues<detail::GroupValues<Real, Group>>
   static Vec3<Lane> Get(const detail::GroupValues<Real, Group>* values, int index)
   {
     const Group& group = *values->Cells;
-    const Real* v = values->Displacements + 3 * (group.Firsts[0] + index);
+    const Real* v = values->Of(0, index);
     Vec3<Lane> value = { Lane(v[0]), Lane(v[1]), Lane(v[2]) };
     for (int k = 1; k < group.Count; ++k)
     {
-      v = values->Displacements + 3 * (group.Firsts[k] + index);
+      v = values->Of(k, index);
       value = { Select(group.Lanes[k], Lane(v[0]), value.x), Select(group.Lanes[k], Lane(v[1]), value.y),
         Select(group.Lanes[k], Lane(v[2]), value.z) };
     }
@@ -102,14 +111,17 @@ inline Vec3<Lane> SumInLaneCells(const GridDeformation<MaxCount, Real, StaticBas
   {
     LaneCellWeights(deformation, stu, index, gradient != nullptr, axes);
   }
+  // A cell's control points: on the lattice's grid from its first (dense), or on its support (sparse).
+  const auto cellDims = deformation.CellDims();
+  const int* dims = deformation.IsSparse() ? cellDims.D : deformation.Dims;
   if constexpr (!WithCellTable)
   {
     if (gradient && group.Count > 1)
     {
       // One sum with its gradient over values read per lane: a cell's sum with its gradient (12 multiply-adds
       // a control point) costs more than reading its control points into its lanes (6 operations).
-      const detail::GroupValues<Real, Group> values{ deformation.Displacements, &group };
-      return SumTensorProductWithGradient(&values, deformation.Dims, axes, *gradient);
+      const detail::GroupValues<Real, Group> values{ deformation.Displacements, deformation.CellSupports, &group };
+      return SumTensorProductWithGradient(&values, dims, axes, *gradient);
     }
   }
   Vec3<Lane> d;
@@ -127,9 +139,16 @@ inline Vec3<Lane> SumInLaneCells(const GridDeformation<MaxCount, Real, StaticBas
     }
     else
     {
-      const Real* values = deformation.Displacements + 3 * group.Firsts[k];
-      dk = gradient ? SumTensorProductWithGradient(values, deformation.Dims, axes, gk)
-                    : SumTensorProduct(values, deformation.Dims, axes);
+      if (deformation.IsSparse())
+      {
+        const SupportValues<Real> values{ deformation.Displacements, deformation.CellSupports + group.Firsts[k] };
+        dk = gradient ? SumTensorProductWithGradient(&values, dims, axes, gk) : SumTensorProduct(&values, dims, axes);
+      }
+      else
+      {
+        const Real* values = deformation.Displacements + 3 * group.Firsts[k];
+        dk = gradient ? SumTensorProductWithGradient(values, dims, axes, gk) : SumTensorProduct(values, dims, axes);
+      }
     }
     if (k == 0)
     {
@@ -160,7 +179,8 @@ inline Vec3<Lane> SumInLaneCells(const GridDeformation<MaxCount, Real, StaticBas
  * Deform() for lanes bound to different cells of a local basis (Lane a Lanes type). `group` has the Count cells
  * of the lanes: the k-th is Cells[k] (BindToGrid()'s flat index), its lanes Lanes[k], and, read without a
  * CellTable, its index along each axis Indices[k] and its first control point Firsts[k]
- * (i + Dims[0] (j + Dims[1] k)) (GroupCells in FFDGridLanes.h).
+ * (i + Dims[0] (j + Dims[1] k), or, for a sparse lattice, its first entry in CellSupports) (GroupCells in
+ * FFDGridLanes.h).
  */
 template <int MaxCount, typename Real, int StaticBasis, typename Lane, bool WithCellTable, typename Group>
 inline Vec3<Lane> DeformInLaneCells(

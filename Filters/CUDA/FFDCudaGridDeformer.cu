@@ -41,8 +41,8 @@ struct SplitCellDeformation
   __device__ __forceinline__ ffd::Vec3<float> Deform(const ffd::Vec3<float>& x, int cell) const
   {
     int c[3];
-    this->Split.Split(cell, c);
-    return this->Grid.DeformInCell(x, c);
+    this->Grid.CellIndices(this->Split, cell, c);
+    return this->Grid.DeformInCell(x, cell, c);
   }
 };
 

@@ -8,6 +8,11 @@
  * evaluation recomputes them from the point, which it reads anyway for the displacement form, in the point's
  * own precision, so the binding costs 4 bytes per point and loses no digit of a double-precision point.
  *
+ * A sparse lattice (README, "Data contract") binds the same way, then numbers its cells from 0 in increasing
+ * order of that flat index (a point in a voxel without a cell keeps its position): the order of the cells, and
+ * so every grouping of points by cell, is the dense lattice's, and a sparse lattice deforms its points bit for
+ * bit as the dense one does.
+ *
  * Outside policy: a point outside the frame keeps its position, or, with clamping, takes the displacement of
  * the frame point of its parameters clamped to [0, 1] (the nearest point of a box frame), and the Jacobian
  * loses the columns of the clamped directions.
@@ -43,27 +48,37 @@ FFD_INLINE bool IsFinite(Real v)
 } // namespace detail
 
 /**
- * The cell a point is bound to, or -1 when it keeps its position: non-finite points, and points outside the
- * frame (beyond ParametricTolerance()) unless clampOutside. `voxels` are the lattice's divisions.
+ * The cell of a point along each axis of a grid of `cells` cells per axis, or false where it keeps its position:
+ * non-finite points, and points outside the frame (beyond ParametricTolerance()) unless clampOutside.
  */
 template <typename Real>
-FFD_INLINE int BindToGrid(
-  const Frame<Real>& frame, GridBasis basis, const int voxels[3], const Vec3<Real>& x, bool clampOutside)
+FFD_INLINE bool BindToCells(
+  const Frame<Real>& frame, const int cells[3], const Vec3<Real>& x, bool clampOutside, int c[3])
 {
   const Vec3<Real> stu = frame.ToParametric(x);
   const Real p[3] = { stu.x, stu.y, stu.z };
   const Real lo = -ParametricTolerance<Real>(), hi = Real(1) + ParametricTolerance<Real>();
-  int cell = 0;
-  for (int a = 2; a >= 0; --a)
+  for (int a = 0; a < 3; ++a)
   {
     if (!detail::IsFinite(p[a]) || (!clampOutside && !(p[a] >= lo && p[a] <= hi)))
     {
-      return -1;
+      return false;
     }
-    const int cells = BindingCells(basis, voxels[a]);
-    cell = cell * cells + CellOf(p[a] < Real(0) ? Real(0) : (p[a] > Real(1) ? Real(1) : p[a]), cells);
+    c[a] = CellOf(p[a] < Real(0) ? Real(0) : (p[a] > Real(1) ? Real(1) : p[a]), cells[a]);
   }
-  return cell;
+  return true;
+}
+
+/// The cell a point is bound to (BindToCells()) as the flat index ci + cx (cj + cy ck), or -1 when it keeps its
+/// position. `voxels` are the lattice's divisions.
+template <typename Real>
+FFD_INLINE int BindToGrid(
+  const Frame<Real>& frame, GridBasis basis, const int voxels[3], const Vec3<Real>& x, bool clampOutside)
+{
+  const int cells[3] = { BindingCells(basis, voxels[0]), BindingCells(basis, voxels[1]),
+    BindingCells(basis, voxels[2]) };
+  int c[3];
+  return BindToCells(frame, cells, x, clampOutside, c) ? c[0] + cells[0] * (c[1] + cells[1] * c[2]) : -1;
 }
 
 /**
@@ -99,6 +114,25 @@ FFD_INLINE constexpr int CellTableStride(int degree)
 template <int Degree, int G, typename Lane, typename Real>
 FFD_INLINE void PowerForm(const Real* entry, const Lane (*r)[3], Vec3<Lane>* d, Mat3<Lane>* dDdr);
 
+/// The control points of a sparse lattice's cell, for SumTensorProduct(): its support's indices into the
+/// lattice's values, i fastest.
+template <typename Value>
+struct SupportValues
+{
+  const Value* Values;
+  const int* Support;
+};
+
+template <typename Value>
+struct LatticeValues<SupportValues<Value>>
+{
+  template <typename Real>
+  FFD_INLINE static Vec3<Real> Get(const SupportValues<Value>* values, int index)
+  {
+    return LatticeValues<Value>::template Get<Real>(values->Values, values->Support[index]);
+  }
+};
+
 /**
  * A grid lattice's deformation, as plain data that host and device code evaluate alike. MaxCount bounds the
  * control points per axis that influence a point: 4 covers every local basis (and global ones up to degree 3),
@@ -112,6 +146,9 @@ FFD_INLINE void PowerForm(const Real* entry, const Lane (*r)[3], Vec3<Lane>* d, 
  * of its displacements): the same function, rounded differently. That is a compile-time choice, so that no
  * code path holds both evaluations, whose common subexpressions the compiler would otherwise share and round
  * differently (a multiply no longer fused into its add) from one caller to another.
+ * A sparse lattice (CellSupports not null, a local basis) holds only its cells' control points: Displacements
+ * then has one entry per control point of the sparse lattice, and cells are numbered as the binding of a sparse
+ * lattice numbers them (CellVoxels, CellSupports).
  */
 template <int MaxCount, typename Real, int StaticBasis = -1, typename Lane = Real, bool WithCellTable = false>
 struct GridDeformation
@@ -126,6 +163,10 @@ struct GridDeformation
   const Real* Displacements; ///< 3 per control point, VTK order: the lattice's points minus RestPosition
   ffd::Frame<Lane> Frame;
   const Real* CellTable = nullptr; ///< WithCellTable: FillCellTable() of Displacements
+  /// Sparse lattices only (null for dense ones): per cell, its voxel's index along each axis (3 ints), and the
+  /// index in Displacements of each control point of its support (SupportCount()^3 ints, i fastest).
+  const int* CellVoxels = nullptr;
+  const int* CellSupports = nullptr;
 
   /// This deformation evaluated in lanes of type OtherLane (its frame converted once, host only).
   template <typename OtherLane>
@@ -133,11 +174,24 @@ struct GridDeformation
   {
     return { this->Basis, { this->Voxels[0], this->Voxels[1], this->Voxels[2] },
       { this->Dims[0], this->Dims[1], this->Dims[2] }, this->Displacements, this->Frame.template As<OtherLane>(),
-      this->CellTable };
+      this->CellTable, this->CellVoxels, this->CellSupports };
   }
 
   /// True where cells are evaluated from CellTable (a compile-time constant).
   static constexpr bool UsesCellTable() { return WithCellTable; }
+
+  /// True for a sparse lattice (never for the global basis).
+  FFD_INLINE bool IsSparse() const
+  {
+    if constexpr (StaticBasis == int(GridBasis::Bernstein))
+    {
+      return false;
+    }
+    return this->CellSupports != nullptr;
+  }
+
+  /// Control points along each axis of a cell's support (a local basis).
+  FFD_INLINE int SupportCount() const { return CellDegree(this->BasisOf()) + 1; }
 
   /// The basis: StaticBasis where it is known at compile time (constant-folded), else Basis.
   FFD_INLINE GridBasis BasisOf() const { return StaticBasis >= 0 ? static_cast<GridBasis>(StaticBasis) : this->Basis; }
@@ -178,22 +232,33 @@ struct GridDeformation
     FFD_UNROLL
     for (int g = 0; g < G; ++g)
     {
-      y[g] = this->DeformInCell(x[g], c);
+      y[g] = this->DeformInCell(x[g], cell, c);
     }
   }
 
-  /// Deform() for a cell given by its index along each axis (CellIndices()), for callers that take the flat
+  /// Deform() for a cell given also by its index along each axis (CellIndices()), for callers that take the flat
   /// index apart faster themselves (the CUDA backend multiplies by reciprocals instead of dividing).
-  FFD_INLINE Vec3<Lane> DeformInCell(const Vec3<Lane>& x, const int cell[3]) const
+  FFD_INLINE Vec3<Lane> DeformInCell(const Vec3<Lane>& x, int cell, const int indices[3]) const
   {
     AxisWeights<MaxCount, Lane> axes[3];
-    this->Weights(this->Frame.ToParametric(x), cell, false, axes);
+    this->Weights(this->Frame.ToParametric(x), indices, false, axes);
+    if (this->IsSparse())
+    {
+      const SupportValues<Real> values = this->CellValues(cell, axes);
+      return x + SumTensorProduct(&values, this->CellDims().D, axes);
+    }
     return x + SumTensorProduct(this->Displacements, this->Dims, axes);
   }
 
-  /// The index along each axis of a bound cell: BindToGrid()'s flat index ci + cx (cj + cy ck) taken apart.
+  /// The index along each axis of a bound cell: BindToGrid()'s flat index ci + cx (cj + cy ck) taken apart, or
+  /// a sparse lattice's CellVoxels.
   FFD_INLINE void CellIndices(int cell, int c[3]) const
   {
+    if (this->IsSparse())
+    {
+      this->SparseCellIndices(cell, c);
+      return;
+    }
     const GridBasis basis = this->BasisOf();
     FFD_UNROLL
     for (int a = 0; a < 2; ++a)
@@ -203,6 +268,17 @@ struct GridDeformation
       cell /= cells;
     }
     c[2] = cell; // the last axis takes what is left: no division
+  }
+
+  /// CellIndices() with the flat index taken apart by `split` (CellSplit::For() of this deformation).
+  FFD_INLINE void CellIndices(const CellSplit& split, int cell, int c[3]) const
+  {
+    if (this->IsSparse())
+    {
+      this->SparseCellIndices(cell, c);
+      return;
+    }
+    split.Split(cell, c);
   }
 
   /// Deform() and the Jacobian dX_ffd/dX there.
@@ -225,12 +301,44 @@ struct GridDeformation
     AxisWeights<MaxCount, Lane> axes[3];
     this->Weights(stu, c, true, axes);
     Mat3<Lane> gradient;
-    const Vec3<Lane> d = SumTensorProductWithGradient(this->Displacements, this->Dims, axes, gradient);
+    Vec3<Lane> d;
+    if (this->IsSparse())
+    {
+      const SupportValues<Real> values = this->CellValues(cell, axes);
+      d = SumTensorProductWithGradient(&values, this->CellDims().D, axes, gradient);
+    }
+    else
+    {
+      d = SumTensorProductWithGradient(this->Displacements, this->Dims, axes, gradient);
+    }
     jacobian = this->JacobianAt(stu, gradient);
     return x + d;
   }
 
   // The building blocks of Deform(), public for the CPU's lanes in several cells (Filters/CPU/FFDLaneCells.h).
+
+  /// The grid on which SumTensorProduct() finds a sparse lattice's cell's control points: its support's.
+  struct Extent
+  {
+    int D[3];
+  };
+  FFD_INLINE Extent CellDims() const
+  {
+    const int n = this->SupportCount();
+    return { { n, n, n } };
+  }
+
+  /// A sparse lattice's cell's control points, with `axes` (of that cell) made relative to its support.
+  FFD_INLINE SupportValues<Real> CellValues(int cell, AxisWeights<MaxCount, Lane>* axes) const
+  {
+    const int n = this->SupportCount();
+    FFD_UNROLL
+    for (int a = 0; a < 3; ++a)
+    {
+      axes[a].First = 0;
+    }
+    return { this->Displacements, this->CellSupports + std::size_t(cell) * std::size_t(n * n * n) };
+  }
 
   /// The CellTable entry of a bound cell.
   FFD_INLINE const Real* CellEntry(int cell) const
@@ -298,6 +406,14 @@ struct GridDeformation
   }
 
 private:
+  FFD_INLINE void SparseCellIndices(int cell, int c[3]) const
+  {
+    const int* voxel = this->CellVoxels + 3 * std::size_t(cell);
+    c[0] = voxel[0];
+    c[1] = voxel[1];
+    c[2] = voxel[2];
+  }
+
   /// The weights along each axis at parameters stu (ComputeAxisWeights() clamps them to the frame) of a point
   /// in cell (ci, cj, ck).
   FFD_INLINE void Weights(

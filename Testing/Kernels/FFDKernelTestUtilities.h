@@ -357,8 +357,8 @@ public:
     {
       const int cells = lat.Divisions[0] * lat.Divisions[1] * lat.Divisions[2];
       this->Table.resize(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(this->D.Basis)));
-      ffd::FillCellTable(
-        this->D.Basis, this->Values.data(), this->D.Voxels, this->D.Dims, this->Table.data(), 0, cells);
+      ffd::FillCellTable(this->D.Basis, this->Values.data(), this->D.Voxels, this->D.Dims, nullptr, nullptr,
+        this->Table.data(), 0, cells);
       this->D.CellTable = this->Table.data();
     }
   }

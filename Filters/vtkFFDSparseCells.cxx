@@ -1,0 +1,241 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkFFDSparseCells.h"
+
+#include "vtkCellArray.h"
+#include "vtkCellData.h"
+#include "vtkFFDDataContract.h"
+#include "vtkIdList.h"
+#include "vtkIntArray.h"
+#include "vtkPointData.h"
+#include "vtkSMPThreadLocalObject.h"
+#include "vtkSMPTools.h"
+#include "vtkUnstructuredGrid.h"
+
+#include <algorithm>
+#include <atomic>
+#include <sstream>
+#include <utility>
+
+namespace
+{
+/// The 3-component int array `name` of `data` with `count` tuples, or null.
+vtkIntArray* IndexArray(vtkFieldData* data, const char* name, vtkIdType count)
+{
+  vtkIntArray* array = vtkIntArray::SafeDownCast(data->GetAbstractArray(name));
+  return array && array->GetNumberOfComponents() == 3 && array->GetNumberOfTuples() == count ? array : nullptr;
+}
+
+/// What Read() needs to check and place one cell's points.
+struct CellReader
+{
+  vtkCellArray* Cells;
+  const int* VoxelIndices;   // 3 per cell
+  const int* LatticeIndices; // 3 per point
+  ffd::GridBasis Basis;
+  const int* Divisions;
+  int N; // control points per axis of a support
+
+  /// Places the points of cell `cell`, whose voxel is `voxel`, into support (N^3 slots, -1 where empty); false,
+  /// with the reason in `why` when not null, where they are not exactly the voxel's support.
+  bool Place(vtkIdType cell, const int voxel[3], vtkIdList* ids, int* support, std::string* why) const
+  {
+    this->Cells->GetCellAtId(cell, ids); // into a list of the caller's thread: thread-safe for any storage
+    const vtkIdType size = ids->GetNumberOfIds();
+    const vtkIdType* points = ids->GetPointer(0);
+    const int n3 = this->N * this->N * this->N;
+    std::fill(support, support + n3, -1);
+    int first[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      int count;
+      ffd::VoxelSupport(this->Basis, this->Divisions[a], voxel[a], first[a], count);
+    }
+    auto fail = [&](const std::string& what)
+    {
+      if (why)
+      {
+        std::ostringstream msg;
+        msg << "Cell " << cell << " (voxel " << voxel[0] << ", " << voxel[1] << ", " << voxel[2] << ") " << what;
+        *why = msg.str();
+      }
+      return false;
+    };
+    if (size != n3)
+    {
+      return fail("has " + std::to_string(size) + " points; its support has " + std::to_string(n3) + ".");
+    }
+    for (vtkIdType p = 0; p < size; ++p)
+    {
+      const int* index = this->LatticeIndices + 3 * points[p];
+      int slot = 0;
+      for (int a = 2; a >= 0; --a)
+      {
+        const int local = index[a] - first[a];
+        if (local < 0 || local >= this->N)
+        {
+          return fail(
+            "lists point " + std::to_string(points[p]) + ", whose LatticeIndex is outside the voxel's support.");
+        }
+        slot = slot * this->N + local;
+      }
+      if (support[slot] >= 0)
+      {
+        return fail("lists two points of the same LatticeIndex.");
+      }
+      support[slot] = static_cast<int>(points[p]);
+    }
+    return true;
+  }
+};
+} // namespace
+
+//------------------------------------------------------------------------------------------------------------
+std::string vtkFFDSparseCells::Read(vtkUnstructuredGrid* lattice, ffd::GridBasis basis, const int divisions[3])
+{
+  const vtkIdType numPoints = lattice->GetNumberOfPoints();
+  const vtkIdType numCells = lattice->GetNumberOfCells();
+  vtkCellArray* cells = lattice->GetCells();
+  vtkIntArray* latticeIndex =
+    IndexArray(lattice->GetPointData(), vtkFFDDataContract::LatticeIndexArrayName(), numPoints);
+  vtkIntArray* voxelIndex = IndexArray(lattice->GetCellData(), vtkFFDDataContract::VoxelIndexArrayName(), numCells);
+  const std::string fix = " Build the lattice with vtkFFDBuildLattice, or keep its data contract (README, \"Data "
+                          "contract\").";
+  if (!latticeIndex)
+  {
+    return "The sparse lattice has no LatticeIndex point array (3 ints per point)." + fix;
+  }
+  if (!voxelIndex)
+  {
+    return "The sparse lattice has no VoxelIndex cell array (3 ints per cell)." + fix;
+  }
+  if (numCells == 0 || numCells > VTK_INT_MAX || numPoints > VTK_INT_MAX)
+  {
+    return "The sparse lattice has " + std::to_string(numCells) + " cells and " + std::to_string(numPoints) +
+      " points: it needs at least one cell, and at most 2^31 - 1 of each." + fix;
+  }
+  const void* source[3] = { cells, latticeIndex, voxelIndex };
+  const vtkMTimeType sourceTime[3] = { cells->GetMTime(), latticeIndex->GetMTime(), voxelIndex->GetMTime() };
+  if (std::equal(source, source + 3, this->Source) && std::equal(sourceTime, sourceTime + 3, this->SourceTime) &&
+    numPoints == this->SourcePoints && basis == this->SourceBasis &&
+    std::equal(divisions, divisions + 3, this->SourceDivisions))
+  {
+    return std::string();
+  }
+  this->SourcePoints = -1; // valid again once read
+
+  // The indices, checked against the lattice's shape.
+  int pointsPerAxis[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    pointsPerAxis[a] = ffd::ControlPointsAlongAxis(basis, divisions[a]);
+  }
+  auto outside = [](const int* index, const int* limits, vtkIdType count)
+  {
+    std::atomic<vtkIdType> first(count);
+    vtkSMPTools::For(0, count,
+      [&](vtkIdType begin, vtkIdType end)
+      {
+        for (vtkIdType t = begin; t < end && t < first; ++t)
+        {
+          for (int a = 0; a < 3; ++a)
+          {
+            if (index[3 * t + a] < 0 || index[3 * t + a] >= limits[a])
+            {
+              vtkIdType seen = first.load();
+              while (t < seen && !first.compare_exchange_weak(seen, t))
+              {
+              }
+            }
+          }
+        }
+      });
+    return first == count ? vtkIdType(-1) : first.load();
+  };
+  const int* voxels = voxelIndex->GetPointer(0);
+  const int* indices = latticeIndex->GetPointer(0);
+  if (const vtkIdType bad = outside(voxels, divisions, numCells); bad >= 0)
+  {
+    return "The VoxelIndex of cell " + std::to_string(bad) + " is outside the lattice's FFDDivisions." + fix;
+  }
+  if (const vtkIdType bad = outside(indices, pointsPerAxis, numPoints); bad >= 0)
+  {
+    return "The LatticeIndex of point " + std::to_string(bad) + " is outside the lattice's control points per axis." +
+      fix;
+  }
+
+  // The cells in the order of their voxels' flat indices, each voxel once.
+  std::vector<std::pair<std::int64_t, int>> order(static_cast<size_t>(numCells));
+  vtkSMPTools::For(0, numCells,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType c = begin; c < end; ++c)
+      {
+        const int* v = voxels + 3 * c;
+        order[c] = { v[0] + std::int64_t(divisions[0]) * (v[1] + std::int64_t(divisions[1]) * v[2]), int(c) };
+      }
+    });
+  vtkSMPTools::Sort(order.begin(), order.end());
+  const auto twice = std::adjacent_find(order.begin(), order.end(),
+    [](const std::pair<std::int64_t, int>& a, const std::pair<std::int64_t, int>& b) { return a.first == b.first; });
+  if (twice != order.end())
+  {
+    return "Cells " + std::to_string(twice->second) + " and " + std::to_string((twice + 1)->second) +
+      " have the same VoxelIndex: a sparse lattice has one cell per voxel." + fix;
+  }
+
+  // Each cell's support, its points placed by their LatticeIndex.
+  const CellReader reader{ cells, voxels, indices, basis, divisions, ffd::SupportSize(basis, divisions[0]) };
+  const int n3 = reader.N * reader.N * reader.N;
+  this->Keys.resize(order.size());
+  this->Voxels.resize(3 * order.size());
+  this->Supports.resize(size_t(n3) * order.size());
+  std::atomic<vtkIdType> firstBad(numCells);
+  vtkSMPThreadLocalObject<vtkIdList> ids;
+  vtkSMPTools::For(0, numCells,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType r = begin; r < end; ++r)
+      {
+        const int cell = order[r].second;
+        this->Keys[r] = order[r].first;
+        std::copy(voxels + 3 * cell, voxels + 3 * cell + 3, this->Voxels.data() + 3 * r);
+        if (!reader.Place(cell, voxels + 3 * cell, ids.Local(), this->Supports.data() + size_t(n3) * r, nullptr))
+        {
+          vtkIdType seen = firstBad.load();
+          while (r < seen && !firstBad.compare_exchange_weak(seen, r))
+          {
+          }
+        }
+      }
+    });
+  if (firstBad < numCells)
+  {
+    std::string why;
+    vtkNew<vtkIdList> idList;
+    const int cell = order[firstBad].second;
+    std::vector<int> support(n3);
+    reader.Place(cell, voxels + 3 * cell, idList, support.data(), &why);
+    return why + fix;
+  }
+
+  // FNV-1a over the cells' voxels: the binding depends on them alone.
+  std::uint64_t hash = 14695981039346656037ull;
+  for (const std::int64_t key : this->Keys)
+  {
+    hash = (hash ^ std::uint64_t(key)) * 1099511628211ull;
+  }
+  this->Fingerprint = hash;
+  std::copy(source, source + 3, this->Source);
+  std::copy(sourceTime, sourceTime + 3, this->SourceTime);
+  std::copy(divisions, divisions + 3, this->SourceDivisions);
+  this->SourceBasis = basis;
+  this->SourcePoints = numPoints;
+  return std::string();
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDSparseCells::Find(std::int64_t key) const
+{
+  const auto at = std::lower_bound(this->Keys.begin(), this->Keys.end(), key);
+  return at != this->Keys.end() && *at == key ? static_cast<int>(at - this->Keys.begin()) : -1;
+}

@@ -1,0 +1,60 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkFFDSparseCells
+ * @brief   a sparse lattice's cells, read and checked: each one's voxel and support, and the cell of a voxel
+ *
+ * Private to the Filters module (not wrapped). A sparse lattice (README, "Data contract") is a
+ * vtkUnstructuredGrid of control points with their `LatticeIndex` and a cell per active voxel with its
+ * `VoxelIndex`. Read() turns its cells into what ffd::GridDeformation evaluates: the cells ordered by their
+ * voxel's flat index i + nx (j + ny k) (the order of the dense lattice's cells, so that both deform bit for bit
+ * alike), each with its voxel's indices and the point ids of its support in support order (i fastest), each point
+ * placed by its `LatticeIndex`, whatever its place in the cell. The cells are read again only when the lattice's
+ * cells or indices change, not when its points move.
+ */
+#ifndef vtkFFDSparseCells_h
+#define vtkFFDSparseCells_h
+
+#include "vtkType.h"
+
+#include "FFDGridBasis.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+class vtkUnstructuredGrid;
+
+class vtkFFDSparseCells
+{
+public:
+  /**
+   * Reads the cells of `lattice`, a sparse lattice of a local `basis` over `divisions` voxels, unless they are
+   * those of the last Read(). Returns an empty string, or what is wrong with the lattice.
+   */
+  std::string Read(vtkUnstructuredGrid* lattice, ffd::GridBasis basis, const int divisions[3]);
+
+  /// The cells: their number, each one's voxel (3 ints) and support (SupportCount()^3 point ids).
+  int GetNumberOfCells() const { return static_cast<int>(this->Keys.size()); }
+  const std::vector<int>& GetVoxels() const { return this->Voxels; }
+  const std::vector<int>& GetSupports() const { return this->Supports; }
+
+  /// The cell of the voxel whose flat index is `key` (i + nx (j + ny k)), or -1 where the lattice has none.
+  int Find(std::int64_t key) const;
+
+  /// A hash of the cells: equal for lattices of the same cells and points (the binding's key).
+  std::uint64_t GetFingerprint() const { return this->Fingerprint; }
+
+private:
+  std::vector<std::int64_t> Keys; // each cell's voxel's flat index, increasing
+  std::vector<int> Voxels;
+  std::vector<int> Supports;
+  std::uint64_t Fingerprint = 0;
+  // What the cells were read from: the lattice's cells, indices and points, by identity and time.
+  const void* Source[3] = { nullptr, nullptr, nullptr };
+  vtkMTimeType SourceTime[3] = { 0, 0, 0 };
+  vtkIdType SourcePoints = -1;
+  ffd::GridBasis SourceBasis = ffd::GridBasis::Bernstein;
+  int SourceDivisions[3] = { 0, 0, 0 };
+};
+
+#endif

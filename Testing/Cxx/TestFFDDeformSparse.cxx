@@ -1,0 +1,380 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// vtkFFDDeform with sparse lattices (README, "Data contract"): built here by hand from a dense lattice and the
+// voxels of the mesh's points, with cells and points in random order, so that these tests depend neither on
+// vtkFFDVoxelize nor on vtkFFDBuildLattice. A sparse lattice deforms a mesh bit for bit as the dense lattice
+// does (positions, normals, det J, every outside policy); a point in a voxel without a cell keeps its position;
+// malformed sparse lattices are refused with an error.
+
+#include "FFDTestErrorObserver.h"
+#include "FFDTestLattices.h"
+#include "FFDTestMeshes.h"
+
+#include "vtkCellData.h"
+#include "vtkFFDDeform.h"
+#include "vtkIntArray.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkUnstructuredGrid.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstring>
+#include <numeric>
+#include <set>
+
+namespace
+{
+using ffdtest::Vec;
+using Voxel = std::array<int, 3>;
+
+const int LocalBases[] = { vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::TRIQUADRATIC_BEZIER,
+  vtkFFDBuildLattice::TRICUBIC_BEZIER, vtkFFDBuildLattice::CUBIC_BSPLINE };
+
+/// The voxels of the points inside frame f of n divisions: floor(s n) along each axis, s = 1 in the last voxel.
+std::set<Voxel> VoxelsOf(vtkPointSet* mesh, const ffdref::Frame& f, const int n[3])
+{
+  std::set<Voxel> voxels;
+  for (vtkIdType i = 0; i < mesh->GetNumberOfPoints(); ++i)
+  {
+    Vec x;
+    mesh->GetPoint(i, x.data());
+    const Vec stu = ffdref::Parameters(f, x);
+    Voxel v;
+    bool inside = true;
+    for (int a = 0; a < 3; ++a)
+    {
+      inside = inside && stu[a] >= 0.0 && stu[a] <= 1.0;
+      v[a] = std::min(int(std::floor(stu[a] * n[a])), n[a] - 1);
+    }
+    if (inside)
+    {
+      voxels.insert(v);
+    }
+  }
+  return voxels;
+}
+
+/// The support of voxel v along an axis of n voxels, from the bases' definitions.
+void Support(int basis, int v, int& first, int& count)
+{
+  switch (basis)
+  {
+    case vtkFFDBuildLattice::TRILINEAR:
+      first = v, count = 2;
+      break;
+    case vtkFFDBuildLattice::TRIQUADRATIC_BEZIER:
+      first = 2 * v, count = 3;
+      break;
+    case vtkFFDBuildLattice::TRICUBIC_BEZIER:
+      first = 3 * v, count = 4;
+      break;
+    default: // the cubic B-spline
+      first = v, count = 4;
+      break;
+  }
+}
+
+/**
+ * The sparse form of the dense lattice `dense` over `voxels`: the control points of their supports (with their
+ * positions, RestPosition and LatticeIndex), one VTK_POLY_VERTEX cell per voxel with its VoxelIndex. Cells and
+ * the points of each cell come in a random order.
+ */
+vtkSmartPointer<vtkUnstructuredGrid> SparseOf(
+  vtkStructuredGrid* dense, const std::set<Voxel>& voxels, std::mt19937& rng)
+{
+  int basis, n[3], dims[3];
+  vtkFFDDataContract::GetBasis(dense, basis);
+  vtkFFDDataContract::GetDivisions(dense, n);
+  dense->GetDimensions(dims);
+  std::vector<Voxel> cells(voxels.begin(), voxels.end());
+  std::shuffle(cells.begin(), cells.end(), rng);
+  std::vector<vtkIdType> sparseOf(size_t(dense->GetNumberOfPoints()), -1);
+  auto lattice = vtkSmartPointer<vtkUnstructuredGrid>::New();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkDoubleArray> rest;
+  rest->SetName(vtkFFDDataContract::RestPositionArrayName());
+  rest->SetNumberOfComponents(3);
+  vtkNew<vtkIntArray> index;
+  index->SetName(vtkFFDDataContract::LatticeIndexArrayName());
+  index->SetNumberOfComponents(3);
+  vtkNew<vtkIntArray> voxelIndex;
+  voxelIndex->SetName(vtkFFDDataContract::VoxelIndexArrayName());
+  voxelIndex->SetNumberOfComponents(3);
+  vtkDataArray* denseRest = dense->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
+  lattice->Allocate(vtkIdType(cells.size()));
+  for (const Voxel& v : cells)
+  {
+    int first[3], count[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      Support(basis, v[a], first[a], count[a]);
+    }
+    std::vector<vtkIdType> ids;
+    for (int k = first[2]; k < first[2] + count[2]; ++k)
+    {
+      for (int j = first[1]; j < first[1] + count[1]; ++j)
+      {
+        for (int i = first[0]; i < first[0] + count[0]; ++i)
+        {
+          const vtkIdType d = i + vtkIdType(dims[0]) * (j + vtkIdType(dims[1]) * k);
+          if (sparseOf[d] < 0)
+          {
+            sparseOf[d] = points->InsertNextPoint(dense->GetPoint(d));
+            rest->InsertNextTuple(denseRest->GetTuple3(d));
+            index->InsertNextTuple3(i, j, k);
+          }
+          ids.push_back(sparseOf[d]);
+        }
+      }
+    }
+    std::shuffle(ids.begin(), ids.end(), rng);
+    lattice->InsertNextCell(VTK_POLY_VERTEX, vtkIdType(ids.size()), ids.data());
+    voxelIndex->InsertNextTuple3(v[0], v[1], v[2]);
+  }
+  lattice->SetPoints(points);
+  lattice->GetPointData()->AddArray(rest);
+  lattice->GetPointData()->AddArray(index);
+  lattice->GetCellData()->AddArray(voxelIndex);
+  lattice->GetFieldData()->ShallowCopy(dense->GetFieldData());
+  return lattice;
+}
+
+/// A frame around the mesh's bounds, padded by 5 % of the largest extent.
+ffdref::Frame FrameAround(vtkPointSet* mesh)
+{
+  double b[6];
+  mesh->GetBounds(b);
+  const double pad = 0.05 * std::max({ b[1] - b[0], b[3] - b[2], b[5] - b[4] });
+  return { { b[0] - pad, b[2] - pad, b[4] - pad }, { b[1] - b[0] + 2 * pad, 0, 0 }, { 0, b[3] - b[2] + 2 * pad, 0 },
+    { 0, 0, b[5] - b[4] + 2 * pad } };
+}
+
+/// The outputs of vtkFFDDeform of `mesh` by `lattice`: points, then normals, then det J, as raw bytes.
+std::vector<char> DeformedBytes(vtkPointSet* mesh, vtkPointSet* lattice, int policy)
+{
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(mesh);
+  deform->SetLatticeData(lattice);
+  deform->SetBackendToCPU();
+  deform->SetOutsidePolicy(policy);
+  deform->TransformNormalsOn();
+  deform->ComputeJacobianDeterminantOn();
+  deform->Update();
+  vtkPointSet* out = vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0));
+  std::vector<char> bytes;
+  auto append = [&](vtkDataArray* a)
+  {
+    EXPECT_NE(a, nullptr);
+    if (a)
+    {
+      const char* p = static_cast<const char*>(a->GetVoidPointer(0));
+      bytes.insert(bytes.end(), p, p + a->GetDataSize() * a->GetDataTypeSize());
+    }
+  };
+  append(out->GetPoints()->GetData());
+  append(out->GetPointData()->GetNormals());
+  append(out->GetPointData()->GetArray(vtkFFDDeform::JacobianDeterminantArrayName()));
+  return bytes;
+}
+} // namespace
+
+TEST(vtkFFDDeformSparse, DeformsAsTheDenseLatticeBitForBit)
+{
+  // Real meshes (double and float points), every local basis, a perturbed lattice of 5x6x7 voxels, both grid outside
+  // policy: the sparse lattice over the mesh's voxels gives the dense lattice's output bytes.
+  std::mt19937 rng(1717);
+  int compared = 0;
+  for (const char* name : { "bear", "elephant" })
+  {
+    const vtkSmartPointer<vtkPolyData> mesh = ffdtest::WithPointNormals(ReadTestMesh(name));
+    vtkNew<vtkPolyData> floatMesh;
+    floatMesh->DeepCopy(mesh);
+    vtkNew<vtkPoints> floatPoints;
+    floatPoints->SetDataTypeToFloat();
+    floatPoints->DeepCopy(mesh->GetPoints());
+    floatMesh->SetPoints(floatPoints);
+    const ffdref::Frame f = FrameAround(mesh);
+    const int n[3] = { 5, 6, 7 };
+    const std::set<Voxel> voxels = VoxelsOf(mesh, f, n);
+    for (int basis : LocalBases)
+    {
+      const vtkSmartPointer<vtkStructuredGrid> dense = ffdtest::MakeLattice(f, basis, n);
+      ffdtest::Perturb(dense, rng, 0.03 * ffdtest::Diagonal(f));
+      const vtkSmartPointer<vtkUnstructuredGrid> sparse = SparseOf(dense, voxels, rng);
+      ASSERT_LT(sparse->GetNumberOfPoints(), dense->GetNumberOfPoints()) << name;
+      for (vtkPointSet* input : { static_cast<vtkPointSet*>(mesh), static_cast<vtkPointSet*>(floatMesh) })
+      {
+        for (int policy : { vtkFFDDeform::KEEP_POSITION, vtkFFDDeform::CLAMP_TO_EDGE })
+        {
+          const std::vector<char> want = DeformedBytes(input, dense, policy);
+          ASSERT_GT(want.size(), 0u);
+          ASSERT_TRUE(want == DeformedBytes(input, sparse, policy))
+            << name << " basis " << basis << " policy " << policy << " points of type "
+            << input->GetPoints()->GetDataType();
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(compared, 2 * 4 * 2 * 2);
+}
+
+TEST(vtkFFDDeformSparse, PointsInVoxelsWithoutACellKeepTheirPosition)
+{
+  // A trilinear 4x4x4 lattice with random displacements and cells in half of its voxels; 2000 random points of
+  // the frame: a point whose voxel has a cell moves as with the dense lattice (bit for bit), the others keep
+  // their position exactly.
+  std::mt19937 rng(1718);
+  const ffdref::Frame f = { { -1, 0.5, 2 }, { 2, 0.1, 0 }, { 0, 1.5, 0.2 }, { 0.1, 0, 1 } };
+  const int n[3] = { 4, 4, 4 };
+  std::set<Voxel> voxels;
+  std::bernoulli_distribution half(0.5);
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i)
+        if (half(rng))
+          voxels.insert({ i, j, k });
+  const vtkSmartPointer<vtkStructuredGrid> dense = ffdtest::MakeLattice(f, vtkFFDBuildLattice::TRILINEAR, n);
+  ffdtest::Perturb(dense, rng, 0.2);
+  const vtkSmartPointer<vtkUnstructuredGrid> sparse = SparseOf(dense, voxels, rng);
+  vtkNew<vtkPolyData> cloud;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int p = 0; p < 2000; ++p)
+  {
+    points->InsertNextPoint(ffdtest::At(f, unit(rng), unit(rng), unit(rng)).data());
+  }
+  cloud->SetPoints(points);
+  auto deformed = [&](vtkPointSet* lattice)
+  {
+    vtkNew<vtkFFDDeform> deform;
+    deform->SetInputData(cloud);
+    deform->SetLatticeData(lattice);
+    deform->Update();
+    auto out = vtkSmartPointer<vtkPoints>::New();
+    out->SetDataTypeToDouble();
+    out->DeepCopy(vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0))->GetPoints());
+    return out;
+  };
+  const vtkSmartPointer<vtkPoints> onDense = deformed(dense), onSparse = deformed(sparse);
+  int kept = 0, moved = 0;
+  for (vtkIdType p = 0; p < points->GetNumberOfPoints(); ++p)
+  {
+    Vec x, want, got;
+    points->GetPoint(p, x.data());
+    const Vec stu = ffdref::Parameters(f, x);
+    const Voxel v = { std::min(int(stu[0] * 4), 3), std::min(int(stu[1] * 4), 3), std::min(int(stu[2] * 4), 3) };
+    onSparse->GetPoint(p, got.data());
+    if (voxels.count(v))
+    {
+      onDense->GetPoint(p, want.data());
+      ++moved;
+    }
+    else
+    {
+      want = x;
+      ++kept;
+    }
+    ASSERT_EQ(0, std::memcmp(want.data(), got.data(), sizeof(want))) << "point " << p;
+  }
+  EXPECT_GT(kept, 100);
+  EXPECT_GT(moved, 100);
+}
+
+TEST(vtkFFDDeformSparse, MalformedSparseLatticesAreRefused)
+{
+  // Each defect of a sparse lattice gives an error naming it, and an empty output; no crash.
+  std::mt19937 rng(1719);
+  const ffdref::Frame f = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+  const int n[3] = { 3, 3, 3 };
+  const std::set<Voxel> voxels = { { 0, 0, 0 }, { 1, 0, 0 }, { 2, 2, 2 } };
+  vtkNew<vtkPolyData> cloud;
+  vtkNew<vtkPoints> points;
+  points->InsertNextPoint(0.1, 0.1, 0.1);
+  cloud->SetPoints(points);
+  struct Defect
+  {
+    const char* Expected;
+    void (*Apply)(vtkUnstructuredGrid*);
+  };
+  const Defect defects[] = {
+    { "LatticeIndex point array",
+      [](vtkUnstructuredGrid* l)
+      {
+        vtkNew<vtkDoubleArray> wrong; // of doubles, not ints
+        wrong->SetName(vtkFFDDataContract::LatticeIndexArrayName());
+        wrong->SetNumberOfComponents(3);
+        wrong->SetNumberOfTuples(l->GetNumberOfPoints());
+        l->GetPointData()->AddArray(wrong);
+      } },
+    { "VoxelIndex cell array",
+      [](vtkUnstructuredGrid* l) { l->GetCellData()->RemoveArray(vtkFFDDataContract::VoxelIndexArrayName()); } },
+    { "outside the lattice's FFDDivisions",
+      [](vtkUnstructuredGrid* l)
+      {
+        vtkIntArray::SafeDownCast(l->GetCellData()->GetArray(vtkFFDDataContract::VoxelIndexArrayName()))
+          ->SetTypedComponent(0, 0, 3);
+      } },
+    { "outside the lattice's control points per axis",
+      [](vtkUnstructuredGrid* l)
+      {
+        vtkIntArray::SafeDownCast(l->GetPointData()->GetArray(vtkFFDDataContract::LatticeIndexArrayName()))
+          ->SetTypedComponent(0, 2, -1);
+      } },
+    { "the same VoxelIndex",
+      [](vtkUnstructuredGrid* l)
+      {
+        auto* v = vtkIntArray::SafeDownCast(l->GetCellData()->GetArray(vtkFFDDataContract::VoxelIndexArrayName()));
+        v->SetTypedTuple(1, v->GetPointer(0));
+      } },
+    { "outside the voxel's support",
+      [](vtkUnstructuredGrid* l)
+      {
+        auto* v = vtkIntArray::SafeDownCast(l->GetCellData()->GetArray(vtkFFDDataContract::VoxelIndexArrayName()));
+        for (vtkIdType c = 0; c < v->GetNumberOfTuples(); ++c)
+        {
+          if (v->GetTypedComponent(c, 0) == 2)
+          {
+            v->SetTypedComponent(c, 0, 1); // voxel (1, 2, 2), whose support is not the cell's points
+            v->SetTypedComponent(c, 1, 2);
+          }
+        }
+      } },
+    { "has 7 points",
+      [](vtkUnstructuredGrid* l)
+      {
+        vtkNew<vtkCellArray> cells; // cell 0 without its last point
+        vtkNew<vtkIdList> ids;
+        for (vtkIdType c = 0; c < l->GetNumberOfCells(); ++c)
+        {
+          l->GetCellPoints(c, ids);
+          cells->InsertNextCell(c == 0 ? 7 : ids->GetNumberOfIds(), ids->GetPointer(0));
+        }
+        l->SetCells(VTK_POLY_VERTEX, cells);
+      } },
+    { "two points of the same LatticeIndex",
+      [](vtkUnstructuredGrid* l)
+      {
+        vtkNew<vtkIdList> ids;
+        l->GetCellPoints(0, ids);
+        ids->SetId(1, ids->GetId(0));
+        l->ReplaceCell(0, 8, ids->GetPointer(0));
+      } },
+  };
+  for (const Defect& defect : defects)
+  {
+    const vtkSmartPointer<vtkStructuredGrid> dense = ffdtest::MakeLattice(f, vtkFFDBuildLattice::TRILINEAR, n);
+    const vtkSmartPointer<vtkUnstructuredGrid> sparse = SparseOf(dense, voxels, rng);
+    defect.Apply(sparse);
+    vtkNew<vtkFFDDeform> deform;
+    deform->SetInputData(cloud);
+    deform->SetLatticeData(sparse);
+    vtkNew<FFDTestErrorObserver> errors;
+    errors->WatchWithExecutive(deform);
+    deform->Update();
+    EXPECT_NE(errors->Errors.find(defect.Expected), std::string::npos) << defect.Expected << ": " << errors->Errors;
+    EXPECT_EQ(vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0))->GetNumberOfPoints(), 0) << defect.Expected;
+  }
+}
