@@ -9,6 +9,7 @@
 #ifdef VOXELFFD_HAS_CUDA
 #include "FFDCudaGridDeformer.h"
 #include "FFDCudaTetrahedralDeformer.h"
+#include "vtkFFDGridDeformer.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #endif
 
@@ -108,17 +109,28 @@ struct vtkFFDCudaBackend::vtkState
   vtkMTimeType TetrahedraBindTime = 0; // vtkFFDTetrahedralDeformer::GetBindTime() of its binding
   NormalsOnDevice TetrahedraNormals;
 
+  // `sparse`: the host's binding to a sparse lattice, null for a dense one (bound on the device).
   template <typename Real>
-  bool RunGrid(const vtkFFDBindingKey& key, vtkPoints* points, vtkDataArray* normals, const double* displacements,
-    vtkIdType controlPoints, vtkAOSDataArrayTemplate<Real>* outPoints, vtkDataArray* outNormals,
-    vtkAOSDataArrayTemplate<Real>* outDeterminants, bool& bound)
+  bool RunGrid(const vtkFFDBindingKey& key, const vtkFFDGridDeformer* sparse, vtkPoints* points, vtkDataArray* normals,
+    const double* displacements, vtkIdType controlPoints, vtkAOSDataArrayTemplate<Real>* outPoints,
+    vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outDeterminants, bool& bound)
   {
     const int type = outPoints->GetDataType();
     const bool rebind = key != this->GridKey || type != this->GridType;
     this->GridKey = vtkFFDBindingKey(); // valid again once everything succeeded
     if (!Run(
           this->Grid, this->GridNormals, rebind, rebind, points, normals, outPoints, outNormals, outDeterminants,
-          [&] { return this->Grid.Bind(key.Frame.data(), key.Basis, key.Divisions.data(), key.ClampsOutside()); },
+          [&]
+          {
+            if (!sparse)
+            {
+              return this->Grid.Bind(key.Frame.data(), key.Basis, key.Divisions.data(), key.ClampsOutside());
+            }
+            const vtkFFDSparseCells& cells = *sparse->GetSparseCells();
+            return this->Grid.BindSparse(key.Frame.data(), key.Basis, key.Divisions.data(),
+              sparse->GetCellOfPoint().data(), cells.GetVoxels().data(), cells.GetSupports().data(),
+              cells.GetNumberOfCells(), controlPoints);
+          },
           [&](bool withNormals, bool withDeterminants)
           { return this->Grid.Evaluate(displacements, controlPoints, withNormals, withDeterminants); }))
     {
@@ -212,7 +224,7 @@ bool vtkFFDCudaBackend::Deform(const vtkFFDBindingKey& key, vtkPoints* points, v
     [&](auto* out, auto* determinants)
     {
       return this->State->RunGrid(
-        key, points, normals, displacements, controlPoints, out, outNormals, determinants, bound);
+        key, nullptr, points, normals, displacements, controlPoints, out, outNormals, determinants, bound);
     });
   if (!ok)
   {
@@ -225,6 +237,37 @@ bool vtkFFDCudaBackend::Deform(const vtkFFDBindingKey& key, vtkPoints* points, v
   (void)normals;
   (void)displacements;
   (void)controlPoints;
+  (void)outPoints;
+  (void)outNormals;
+  (void)outDeterminants;
+  why = "VoxelFFD was built without CUDA";
+  return false;
+#endif
+}
+
+bool vtkFFDCudaBackend::DeformSparse(const vtkFFDGridDeformer& grid, const vtkFFDBindingKey& key, vtkPoints* points,
+  vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants, bool& bound,
+  std::string& why)
+{
+  bound = false;
+#ifdef VOXELFFD_HAS_CUDA
+  const std::vector<double>& displacements = grid.GetLattice().Displacements;
+  const bool ok = vtkState::WithOutputs(outPoints, outDeterminants,
+    [&](auto* out, auto* determinants)
+    {
+      return this->State->RunGrid(key, &grid, points, normals, displacements.data(),
+        vtkIdType(displacements.size() / 3), out, outNormals, determinants, bound);
+    });
+  if (!ok)
+  {
+    why = this->State->Grid.GetLastError();
+  }
+  return ok;
+#else
+  (void)grid;
+  (void)key;
+  (void)points;
+  (void)normals;
   (void)outPoints;
   (void)outNormals;
   (void)outDeterminants;

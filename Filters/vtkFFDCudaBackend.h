@@ -7,7 +7,8 @@
  * ffd::cuda::TetrahedralDeformer per vtkFFDDeform, uploads the input's points and normals only when they change.
  * A grid lattice's points are re-bound on the device only when they or the lattice's rest frame, shape or the
  * outside policy change (the same key as the CPU binding, vtkFFDBindingKey); a tetrahedral lattice's binding is
- * the host's (vtkFFDTetrahedralDeformer: it needs VTK's cell locator), uploaded once per binding. An update
+ * the host's (vtkFFDTetrahedralDeformer: it needs VTK's cell locator), uploaded once per binding, and so is a
+ * sparse grid lattice's (vtkFFDGridDeformer: it needs the lookup of its voxels' cells). An update
  * uploads only the lattice's displacements (of control points or of nodes) and downloads straight into the
  * output arrays.
  *
@@ -23,6 +24,7 @@
 #include <string>
 
 class vtkDataArray;
+class vtkFFDGridDeformer;
 class vtkFFDTetrahedralDeformer;
 class vtkPoints;
 
@@ -47,6 +49,14 @@ public:
    */
   bool Deform(const vtkFFDBindingKey& key, vtkPoints* points, vtkDataArray* normals, const double* displacements,
     vtkIdType controlPoints, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
+    bool& bound, std::string& why);
+
+  /**
+   * Deform() for a sparse lattice, whose binding is the host's (`grid`, whose Bind() ran for these points:
+   * finding a voxel's cell needs its lookup), uploaded with the lattice's cells when the key changes.
+   */
+  bool DeformSparse(const vtkFFDGridDeformer& grid, const vtkFFDBindingKey& key, vtkPoints* points,
+    vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
     bool& bound, std::string& why);
 
   /**

@@ -267,9 +267,25 @@ bool vtkFFDDeform::DeformByGrid(vtkPoints* points, vtkDataArray* normals)
   const bool onCuda = this->DeformedOnCuda(
     [&](std::string& why)
     {
-      return internals.Cuda.Deform(grid.KeyOf(points, this->OutsidePolicy), points, normals,
-        lattice.Displacements.data(), vtkIdType(lattice.Displacements.size() / 3), internals.Points, internals.Normals,
-        internals.Determinants, rebound, why);
+      const vtkFFDBindingKey key = grid.KeyOf(points, this->OutsidePolicy);
+      if (!lattice.Sparse)
+      {
+        return internals.Cuda.Deform(key, points, normals, lattice.Displacements.data(),
+          vtkIdType(lattice.Displacements.size() / 3), internals.Points, internals.Normals, internals.Determinants,
+          rebound, why);
+      }
+      // A sparse lattice's voxels are looked up on the host: the points are bound there, then uploaded.
+      bool boundOnHost = false;
+      if (!grid.Bind(points, this->OutsidePolicy, this, 0.0, 0.5, boundOnHost))
+      {
+        why = "aborted";
+        return false;
+      }
+      this->NumberOfBindings += boundOnHost ? 1 : 0;
+      const bool deformed = internals.Cuda.DeformSparse(
+        grid, key, points, normals, internals.Points, internals.Normals, internals.Determinants, rebound, why);
+      rebound = false; // the upload of the host's binding, counted above
+      return deformed;
     });
   this->NumberOfBindings += rebound ? 1 : 0; // on the device, also where it failed after binding
   if (onCuda)

@@ -218,11 +218,15 @@ std::string vtkFFDSparseCells::Read(vtkUnstructuredGrid* lattice, ffd::GridBasis
     return why + fix;
   }
 
-  // FNV-1a over the cells' voxels: the binding depends on them alone.
+  // FNV-1a over the cells' voxels (what a binding depends on) and supports (what a device holds).
   std::uint64_t hash = 14695981039346656037ull;
   for (const std::int64_t key : this->Keys)
   {
     hash = (hash ^ std::uint64_t(key)) * 1099511628211ull;
+  }
+  for (const int id : this->Supports)
+  {
+    hash = (hash ^ std::uint64_t(id)) * 1099511628211ull;
   }
   this->Fingerprint = hash;
   std::copy(source, source + 3, this->Source);

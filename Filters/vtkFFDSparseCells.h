@@ -41,7 +41,7 @@ public:
   /// The cell of the voxel whose flat index is `key` (i + nx (j + ny k)), or -1 where the lattice has none.
   int Find(std::int64_t key) const;
 
-  /// A hash of the cells: equal for lattices of the same cells and points (the binding's key).
+  /// A hash of the cells' voxels and supports: the same for the same cells (the binding's key).
   std::uint64_t GetFingerprint() const { return this->Fingerprint; }
 
 private:

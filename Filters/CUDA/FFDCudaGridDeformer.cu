@@ -417,6 +417,55 @@ struct GridDeformer::Impl : ResidentPoints::State
   ffd::GridBasis Basis = ffd::GridBasis::Bernstein;
   int Divisions[3] = { 0, 0, 0 };
   double Frame[12] = {};
+  // A sparse lattice's cells (BindSparse()); SparseControlPoints is 0 for a dense lattice.
+  Buffer CellVoxels, CellSupports;
+  std::int64_t SparseControlPoints = 0;
+
+  // The deformation `d` over the device's lattice `values`, a sparse lattice's cells included.
+  template <typename Deformation>
+  Deformation WithCells(Deformation d) const
+  {
+    if (this->SparseControlPoints > 0)
+    {
+      d.CellVoxels = this->CellVoxels.As<int>();
+      d.CellSupports = this->CellSupports.As<int>();
+    }
+    return d;
+  }
+
+  void RunBindSparse(const int* cellOfPoint, const int* cellVoxels, const int* cellSupports, std::int64_t cells,
+    std::int64_t controlPoints)
+  {
+    // An index out of range would read outside the device's arrays: refused here, for the price of one pass.
+    const int n = ffd::SupportSize(this->Basis, this->Divisions[0]);
+    const std::int64_t supportCount = cells * n * n * n;
+    for (std::int64_t i = 0; i < this->Count; ++i)
+    {
+      if (cellOfPoint[i] < -1 || cellOfPoint[i] >= cells)
+      {
+        throw CudaError{ cudaErrorInvalidValue, "binding: a point's cell is out of range" };
+      }
+    }
+    for (std::int64_t i = 0; i < supportCount; ++i)
+    {
+      if (cellSupports[i] < 0 || cellSupports[i] >= controlPoints)
+      {
+        throw CudaError{ cudaErrorInvalidValue, "binding: a cell's control point is out of range" };
+      }
+    }
+    const std::size_t pointBytes = std::size_t(this->Count) * sizeof(int);
+    const std::size_t voxelBytes = std::size_t(3 * cells) * sizeof(int);
+    const std::size_t supportBytes = std::size_t(supportCount) * sizeof(int);
+    this->Cells.Reserve(pointBytes, "allocating the binding");
+    this->CellVoxels.Reserve(voxelBytes, "allocating the lattice's cells");
+    this->CellSupports.Reserve(supportBytes, "allocating the lattice's cells");
+    Check(cudaMemcpy(this->Cells.Data, cellOfPoint, pointBytes, cudaMemcpyHostToDevice), "uploading the binding");
+    Check(cudaMemcpy(this->CellVoxels.Data, cellVoxels, voxelBytes, cudaMemcpyHostToDevice),
+      "uploading the lattice's cells");
+    Check(cudaMemcpy(this->CellSupports.Data, cellSupports, supportBytes, cudaMemcpyHostToDevice),
+      "uploading the lattice's cells");
+    this->SparseControlPoints = controlPoints;
+  }
 
   template <typename Real>
   void RunBind(const ffd::Frame<double>& frame, bool clampOutside)
@@ -435,7 +484,9 @@ struct GridDeformer::Impl : ResidentPoints::State
     const int dims[3] = { ffd::ControlPointsAlongAxis(this->Basis, this->Divisions[0]),
       ffd::ControlPointsAlongAxis(this->Basis, this->Divisions[1]),
       ffd::ControlPointsAlongAxis(this->Basis, this->Divisions[2]) };
-    if (controlPoints != std::int64_t(dims[0]) * dims[1] * dims[2])
+    const std::int64_t expected =
+      this->SparseControlPoints > 0 ? this->SparseControlPoints : std::int64_t(dims[0]) * dims[1] * dims[2];
+    if (controlPoints != expected)
     {
       throw CudaError{ cudaErrorInvalidValue, "evaluating: the lattice does not match the binding's basis" };
     }
@@ -492,8 +543,8 @@ struct GridDeformer::Impl : ResidentPoints::State
       [&](auto maxCount, auto basis)
       {
         using Deformation = ffd::GridDeformation<decltype(maxCount)::value, Real, decltype(basis)::value>;
-        const Deformation deformation{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
-          { dims[0], dims[1], dims[2] }, d, frame };
+        const Deformation deformation = this->WithCells(Deformation{ this->Basis,
+          { this->Divisions[0], this->Divisions[1], this->Divisions[2] }, { dims[0], dims[1], dims[2] }, d, frame });
         detail::LaunchDeform(deformation, this->Points.As<Real>(), this->Cells.As<int>(), this->Count,
           this->OutPoints.As<Real>(), this->Normals.As<Real>(), normalsOut, determinantsOut, this->Stream);
       });
@@ -508,8 +559,8 @@ struct GridDeformer::Impl : ResidentPoints::State
     auto launch = [&](auto maxCount, auto basis)
     {
       using Deformation = ffd::GridDeformation<decltype(maxCount)::value, float4, decltype(basis)::value, float>;
-      const Deformation grid{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
-        { dims[0], dims[1], dims[2] }, d, frame };
+      const Deformation grid = this->WithCells(Deformation{ this->Basis,
+        { this->Divisions[0], this->Divisions[1], this->Divisions[2] }, { dims[0], dims[1], dims[2] }, d, frame });
       detail::LaunchDeformPoints(SplitCellDeformation<Deformation>{ grid, split }, this->Points.As<float>(),
         this->Cells.As<int>(), this->Count, this->OutPoints.As<float>(), this->Stream);
     };
@@ -646,6 +697,7 @@ bool GridDeformer::Bind(const double frame[12], int basis, const int divisions[3
       std::copy(frame, frame + 12, p.Frame);
       std::copy(divisions, divisions + 3, p.Divisions);
       p.Basis = static_cast<ffd::GridBasis>(basis);
+      p.SparseControlPoints = 0;
       p.Cells.Reserve(std::size_t(p.Count) * sizeof(int), "allocating the binding");
       const ffd::Frame<double> f = ffd::Frame<double>::FromArray(frame);
       if (p.IsDouble)
@@ -656,6 +708,29 @@ bool GridDeformer::Bind(const double frame[12], int basis, const int divisions[3
       {
         p.RunBind<float>(f, clampOutside);
       }
+      p.Bound = true;
+      p.Evaluated = false;
+      ++p.Counts.Bindings;
+    });
+}
+
+bool GridDeformer::BindSparse(const double frame[12], int basis, const int divisions[3], const int* cellOfPoint,
+  const int* cellVoxels, const int* cellSupports, std::int64_t cells, std::int64_t controlPoints)
+{
+  Impl& p = static_cast<Impl&>(*this->S);
+  return p.Guard(
+    [&]
+    {
+      if (p.Count == 0 || !ffd::IsGridBasis(basis) || basis == int(ffd::GridBasis::Bernstein) || cells <= 0 ||
+        controlPoints <= 0)
+      {
+        throw CudaError{ cudaErrorInvalidValue, "binding: no points, or not a sparse lattice of a local basis" };
+      }
+      std::copy(frame, frame + 12, p.Frame);
+      std::copy(divisions, divisions + 3, p.Divisions);
+      p.Basis = static_cast<ffd::GridBasis>(basis);
+      p.SparseControlPoints = 0; // valid again once uploaded
+      p.RunBindSparse(cellOfPoint, cellVoxels, cellSupports, cells, controlPoints);
       p.Bound = true;
       p.Evaluated = false;
       ++p.Counts.Bindings;

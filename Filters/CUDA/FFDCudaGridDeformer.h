@@ -26,9 +26,20 @@ public:
   /// divisions (voxels per axis). The binding stays on the device.
   bool Bind(const double frame[12], int basis, const int divisions[3], bool clampOutside);
 
+  /**
+   * Takes the binding of the points to a sparse lattice, computed on the host (its voxels' lookup needs the
+   * lattice's cells): each point's cell (-1: it keeps its position), and per cell its voxel's indices (3 ints)
+   * and its support's control points (SupportSize()^3 indices into the displacements, i fastest), as
+   * ffd::GridDeformation's CellVoxels and CellSupports. Frame, basis and divisions as Bind(); `controlPoints`
+   * is the sparse lattice's count, which Evaluate() is then given.
+   */
+  bool BindSparse(const double frame[12], int basis, const int divisions[3], const int* cellOfPoint,
+    const int* cellVoxels, const int* cellSupports, std::int64_t cells, std::int64_t controlPoints);
+
   /// Uploads the displacements (3 doubles per control point, VTK order, `controlPoints` of them, as many as the
-  /// basis and divisions of Bind() give) and evaluates every point on the device, with the transformed normals
-  /// (needs SetNormals()) and det(J) when asked for. The results stay on the device until Download().
+  /// basis and divisions of Bind() give, or a sparse lattice's of BindSparse()) and evaluates every point on the
+  /// device, with the transformed normals (needs SetNormals()) and det(J) when asked for. The results stay on the
+  /// device until Download().
   bool Evaluate(const double* displacements, std::int64_t controlPoints, bool withNormals, bool withDeterminants);
 
 private:

@@ -150,13 +150,14 @@ ffdref::Frame FrameAround(vtkPointSet* mesh)
     { 0, 0, b[5] - b[4] + 2 * pad } };
 }
 
-/// The outputs of vtkFFDDeform of `mesh` by `lattice`: points, then normals, then det J, as raw bytes.
-std::vector<char> DeformedBytes(vtkPointSet* mesh, vtkPointSet* lattice, int policy)
+/// The outputs of vtkFFDDeform of `mesh` by `lattice` on `backend`: points, then normals, then det J, as raw
+/// bytes, and the backend that ran them.
+std::vector<char> DeformedBytes(vtkPointSet* mesh, vtkPointSet* lattice, int policy, int backend, std::string& ran)
 {
   vtkNew<vtkFFDDeform> deform;
   deform->SetInputData(mesh);
   deform->SetLatticeData(lattice);
-  deform->SetBackendToCPU();
+  deform->SetBackend(backend);
   deform->SetOutsidePolicy(policy);
   deform->TransformNormalsOn();
   deform->ComputeJacobianDeterminantOn();
@@ -175,14 +176,16 @@ std::vector<char> DeformedBytes(vtkPointSet* mesh, vtkPointSet* lattice, int pol
   append(out->GetPoints()->GetData());
   append(out->GetPointData()->GetNormals());
   append(out->GetPointData()->GetArray(vtkFFDDeform::JacobianDeterminantArrayName()));
+  ran = deform->GetLastBackendUsed();
   return bytes;
 }
 } // namespace
 
 TEST(vtkFFDDeformSparse, DeformsAsTheDenseLatticeBitForBit)
 {
-  // Real meshes (double and float points), every local basis, a perturbed lattice of 5x6x7 voxels, both grid outside
-  // policy: the sparse lattice over the mesh's voxels gives the dense lattice's output bytes.
+  // Real meshes (double and float points), every local basis, a perturbed lattice of 5x6x7 voxels, both outside
+  // policies of grid lattices, on the CPU and on the automatic backend (CUDA where a device is): the sparse lattice
+  // over the mesh's voxels gives the dense lattice's output bytes on the same backend.
   std::mt19937 rng(1717);
   int compared = 0;
   for (const char* name : { "bear", "elephant" })
@@ -207,17 +210,22 @@ TEST(vtkFFDDeformSparse, DeformsAsTheDenseLatticeBitForBit)
       {
         for (int policy : { vtkFFDDeform::KEEP_POSITION, vtkFFDDeform::CLAMP_TO_EDGE })
         {
-          const std::vector<char> want = DeformedBytes(input, dense, policy);
-          ASSERT_GT(want.size(), 0u);
-          ASSERT_TRUE(want == DeformedBytes(input, sparse, policy))
-            << name << " basis " << basis << " policy " << policy << " points of type "
-            << input->GetPoints()->GetDataType();
-          ++compared;
+          for (int backend : { vtkFFDDeform::CPU, vtkFFDDeform::AUTOMATIC })
+          {
+            std::string ranDense, ranSparse;
+            const std::vector<char> want = DeformedBytes(input, dense, policy, backend, ranDense);
+            ASSERT_GT(want.size(), 0u);
+            ASSERT_TRUE(want == DeformedBytes(input, sparse, policy, backend, ranSparse))
+              << name << " basis " << basis << " policy " << policy << " points of type "
+              << input->GetPoints()->GetDataType() << " on " << ranSparse;
+            ASSERT_EQ(ranDense, ranSparse);
+            ++compared;
+          }
         }
       }
     }
   }
-  EXPECT_EQ(compared, 2 * 4 * 2 * 2);
+  EXPECT_EQ(compared, 2 * 4 * 2 * 2 * 2);
 }
 
 TEST(vtkFFDDeformSparse, PointsInVoxelsWithoutACellKeepTheirPosition)
@@ -377,4 +385,31 @@ TEST(vtkFFDDeformSparse, MalformedSparseLatticesAreRefused)
     EXPECT_NE(errors->Errors.find(defect.Expected), std::string::npos) << defect.Expected << ": " << errors->Errors;
     EXPECT_EQ(vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0))->GetNumberOfPoints(), 0) << defect.Expected;
   }
+}
+
+TEST(vtkFFDDeformSparse, MovingControlPointsReevaluatesWithoutRebinding)
+{
+  // The binding to a sparse lattice is kept while only its points move (an update re-reads neither its cells nor
+  // the points' voxels), and redone when its cells change.
+  std::mt19937 rng(1720);
+  const vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("bear");
+  const ffdref::Frame f = FrameAround(mesh);
+  const int n[3] = { 6, 6, 6 };
+  const std::set<Voxel> voxels = VoxelsOf(mesh, f, n);
+  const vtkSmartPointer<vtkStructuredGrid> dense = ffdtest::MakeLattice(f, vtkFFDBuildLattice::CUBIC_BSPLINE, n);
+  const vtkSmartPointer<vtkUnstructuredGrid> sparse = SparseOf(dense, voxels, rng);
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(mesh);
+  deform->SetLatticeData(sparse);
+  deform->Update();
+  EXPECT_EQ(deform->GetNumberOfBindings(), 1);
+  ffdtest::Perturb(sparse, rng, 0.01 * ffdtest::Diagonal(f));
+  deform->Update();
+  EXPECT_EQ(deform->GetNumberOfBindings(), 1);
+  EXPECT_GT(ffdtest::MaxRelativeMotion(mesh, vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0)), f), 1e-4);
+  std::set<Voxel> fewer = voxels;
+  fewer.erase(fewer.begin());
+  deform->SetLatticeData(SparseOf(dense, fewer, rng));
+  deform->Update();
+  EXPECT_EQ(deform->GetNumberOfBindings(), 2);
 }
