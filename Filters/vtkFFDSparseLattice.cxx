@@ -1,0 +1,299 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkFFDSparseLattice.h"
+
+#include "vtkAlgorithm.h"
+#include "vtkCellType.h"
+#include "vtkDoubleArray.h"
+#include "vtkFFDMemory.h"
+#include "vtkHigherOrderHexahedron.h"
+#include "vtkNew.h"
+#include "vtkPoints.h"
+#include "vtkSMPThreadLocal.h"
+#include "vtkSMPTools.h"
+
+// OpenVDB is confined to this translation unit: its headers cost ~12 s to compile.
+#include <openvdb/openvdb.h>
+#include <openvdb/tree/ValueAccessor.h>
+
+#include <algorithm>
+#include <memory>
+#include <sstream>
+
+struct vtkFFDActiveSet::Internals
+{
+  openvdb::MaskTree Tree;
+};
+
+namespace
+{
+using MaskTree = openvdb::MaskTree;
+
+/// Marks boxes in one thread's tree through an accessor, which caches the path to the last leaf touched (a
+/// chunk's coordinates are mostly near each other). The accessor is not registered with the tree (IsSafe
+/// false), which saves a locked insertion per chunk: the tree outlives it and loses no node meanwhile.
+class TreeMarker final : public vtkFFDBoxMarker
+{
+public:
+  explicit TreeMarker(MaskTree& tree)
+    : Accessor(tree)
+  {
+  }
+
+  void Mark(const int first[3], const int count[3]) override
+  {
+    for (int k = first[2]; k < first[2] + count[2]; ++k)
+    {
+      for (int j = first[1]; j < first[1] + count[1]; ++j)
+      {
+        for (int i = first[0]; i < first[0] + count[0]; ++i)
+        {
+          this->Accessor.setValueOn(openvdb::Coord(i, j, k));
+        }
+      }
+    }
+  }
+
+private:
+  openvdb::tree::ValueAccessor<MaskTree, false> Accessor;
+};
+
+/// The first element of the sorted [begin, end) not below `key`, searched outwards from `hint`: the voxels come in
+/// increasing order from vtkFFDVoxelize, so a row of a voxel's support lies a few places after the same row of the
+/// previous voxel's, found in O(log distance) rather than O(log size) with its cache misses.
+const vtkTypeInt64* FindFrom(
+  const vtkTypeInt64* begin, const vtkTypeInt64* end, const vtkTypeInt64* hint, vtkTypeInt64 key)
+{
+  if (hint == end || *hint > key)
+  {
+    return std::lower_bound(begin, hint, key);
+  }
+  std::ptrdiff_t step = 1;
+  while (end - hint > step && hint[step] <= key)
+  {
+    hint += step;
+    step *= 2;
+  }
+  return std::lower_bound(hint, hint + std::min(step, end - hint), key);
+}
+
+/// The cells of `lattice` over the voxels, with ids stored as ArrayT's values (32 or 64 bits).
+template <typename ArrayT>
+vtkSmartPointer<vtkCellArray> MakeCells(
+  const vtkFFDSparseLattice& lattice, ffd::GridBasis basis, const int divisions[3], const int* voxels, vtkIdType n)
+{
+  using Id = typename ArrayT::ValueType;
+  const int c = ffd::SupportSize(basis, divisions[0]); // the same along every axis for a local basis
+  const int perCell = c * c * c;
+  // The place in the cell of support point (a, b, d), taken in tensor order a + c (b + c d): VTK's order of the
+  // Bezier hexahedron of that degree (the corners first, as a VTK_HEXAHEDRON for degree 1), or tensor order.
+  const int degree = ffd::BezierDegree(basis);
+  const int order[3] = { degree, degree, degree };
+  std::vector<int> place(perCell);
+  for (int d = 0; d < c; ++d)
+  {
+    for (int b = 0; b < c; ++b)
+    {
+      for (int a = 0; a < c; ++a)
+      {
+        const int t = a + c * (b + c * d);
+        place[t] = degree > 0 ? vtkHigherOrderHexahedron::PointIndexFromIJK(a, b, d, order) : t;
+      }
+    }
+  }
+
+  vtkNew<ArrayT> offsets, connectivity;
+  offsets->SetNumberOfValues(n + 1);
+  connectivity->SetNumberOfValues(n * perCell);
+  Id* offset = offsets->GetPointer(0);
+  Id* ids = connectivity->GetPointer(0);
+  const vtkTypeInt64* keys = lattice.Points.data();
+  const vtkTypeInt64* keysEnd = keys + lattice.Points.size();
+  const vtkTypeInt64 nI = lattice.PointsPerAxis[0], nJ = lattice.PointsPerAxis[1];
+  vtkSMPTools::For(0, n,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      // Per row (b, d) of the support: where the previous voxel's row was found.
+      std::vector<const vtkTypeInt64*> hints(c * c, keys);
+      for (vtkIdType v = begin; v < end; ++v)
+      {
+        int first[3], count[3];
+        for (int a = 0; a < 3; ++a)
+        {
+          ffd::VoxelSupport(basis, divisions[a], voxels[3 * v + a], first[a], count[a]);
+        }
+        offset[v] = Id(v * perCell);
+        Id* cell = ids + v * perCell;
+        for (int d = 0; d < c; ++d)
+        {
+          for (int b = 0; b < c; ++b)
+          {
+            // A row's c points have consecutive linear indices, all in the set: they are consecutive there too.
+            const vtkTypeInt64 key = first[0] + nI * (first[1] + b + nJ * vtkTypeInt64(first[2] + d));
+            const vtkTypeInt64*& hint = hints[b + c * d];
+            hint = FindFrom(keys, keysEnd, hint, key);
+            const Id rank = Id(hint - keys);
+            for (int a = 0; a < c; ++a)
+            {
+              cell[place[a + c * (b + c * d)]] = rank + Id(a);
+            }
+          }
+        }
+      }
+    });
+  offset[n] = Id(n * perCell);
+  auto cells = vtkSmartPointer<vtkCellArray>::New();
+  cells->SetData(offsets, connectivity);
+  return cells;
+}
+} // namespace
+
+//------------------------------------------------------------------------------------------------------------
+vtkFFDActiveSet::vtkFFDActiveSet()
+  : Internal(new Internals)
+{
+}
+
+vtkFFDActiveSet::~vtkFFDActiveSet() = default;
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDActiveSet::Mark(vtkIdType n, const std::function<void(vtkIdType, vtkIdType, vtkFFDBoxMarker&)>& body)
+{
+  // Each thread's tree, made at its first chunk (a tree cannot be copied from an exemplar).
+  vtkSMPThreadLocal<std::shared_ptr<MaskTree>> trees;
+  vtkSMPTools::For(0, n,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      std::shared_ptr<MaskTree>& tree = trees.Local();
+      if (!tree)
+      {
+        tree = std::make_shared<MaskTree>();
+      }
+      TreeMarker marker(*tree);
+      body(begin, end, marker);
+    });
+  // A set union: the same set whatever the threads and their order. It runs TBB tasks of its own, so it is
+  // made here rather than in the vtkSMPTools body.
+  for (const std::shared_ptr<MaskTree>& tree : trees)
+  {
+    this->Internal->Tree.topologyUnion(*tree);
+  }
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkIdType vtkFFDActiveSet::GetNumberOfMarked() const
+{
+  return vtkIdType(this->Internal->Tree.activeVoxelCount());
+}
+
+//------------------------------------------------------------------------------------------------------------
+std::vector<vtkTypeInt64> vtkFFDActiveSet::TakeSortedIndices(const vtkTypeInt64 dims[3])
+{
+  // Marking sets single voxels, and the union of leaves keeps leaves: the tree has no active tiles, and its leaves
+  // hold every marked coordinate. Each leaf writes its own range of the result.
+  const MaskTree& tree = this->Internal->Tree;
+  std::vector<const MaskTree::LeafNodeType*> leaves;
+  leaves.reserve(tree.leafCount());
+  tree.getNodes(leaves);
+  std::vector<vtkIdType> start(leaves.size() + 1, 0);
+  for (size_t l = 0; l < leaves.size(); ++l)
+  {
+    start[l + 1] = start[l] + vtkIdType(leaves[l]->onVoxelCount());
+  }
+  std::vector<vtkTypeInt64> indices(start.back());
+  vtkSMPTools::For(0, vtkIdType(leaves.size()),
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType l = begin; l < end; ++l)
+      {
+        vtkTypeInt64* out = indices.data() + start[l];
+        for (auto it = leaves[l]->cbeginValueOn(); it; ++it)
+        {
+          const openvdb::Coord x = it.getCoord();
+          *out++ = x.x() + dims[0] * (x.y() + dims[1] * vtkTypeInt64(x.z()));
+        }
+      }
+    });
+  this->Internal->Tree.clear();
+  vtkSMPTools::Sort(indices.begin(), indices.end());
+  return indices;
+}
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDSparseLattice::Build(vtkAlgorithm* self, ffd::GridBasis basis, const int divisions[3], const int* voxels,
+  vtkIdType numVoxels, double bytesPerPoint, double bytesPerCell, const std::string& what)
+{
+  vtkTypeInt64 dims[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    this->PointsPerAxis[a] = ffd::ControlPointsAlongAxis(basis, divisions[a]);
+    dims[a] = this->PointsPerAxis[a];
+  }
+  vtkFFDActiveSet set;
+  set.Mark(numVoxels,
+    [&](vtkIdType begin, vtkIdType end, vtkFFDBoxMarker& marker)
+    {
+      for (vtkIdType v = begin; v < end; ++v)
+      {
+        int first[3], count[3];
+        for (int a = 0; a < 3; ++a)
+        {
+          ffd::VoxelSupport(basis, divisions[a], voxels[3 * v + a], first[a], count[a]);
+        }
+        marker.Mark(first, count);
+      }
+    });
+
+  const vtkIdType numPoints = set.GetNumberOfMarked();
+  const int c = ffd::SupportSize(basis, divisions[0]);
+  const vtkIdType perCell = c * c * c;
+  const bool narrow = numPoints <= VTK_TYPE_INT32_MAX && numVoxels * perCell <= VTK_TYPE_INT32_MAX;
+  // The sorted indices (8 bytes a point), the cells' ids and offsets, and the cell types that SetCells() adds.
+  const double idBytes = narrow ? 4.0 : 8.0;
+  const double bytes = (8.0 + bytesPerPoint) * double(numPoints) +
+    (idBytes * double(perCell + 1) + 1.0 + bytesPerCell) * double(numVoxels);
+  std::ostringstream request;
+  request << what << " (" << numVoxels << " cells of " << perCell << " points, " << numPoints << " points)";
+  if (!vtkFFDCheckMemory(self, request.str(), bytes))
+  {
+    return false;
+  }
+  this->Points = set.TakeSortedIndices(dims);
+  this->CellType = basis == ffd::GridBasis::Trilinear ? VTK_HEXAHEDRON
+    : basis == ffd::GridBasis::CubicBSpline           ? VTK_POLY_VERTEX
+                                                      : VTK_BEZIER_HEXAHEDRON;
+  this->Cells = narrow ? MakeCells<vtkCellArray::ArrayType32>(*this, basis, divisions, voxels, numVoxels)
+                       : MakeCells<vtkCellArray::ArrayType64>(*this, basis, divisions, voxels, numVoxels);
+  return true;
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDSparseLattice::GetIndex(vtkIdType id, int index[3]) const
+{
+  const vtkTypeInt64 key = this->Points[id], nI = this->PointsPerAxis[0], nJ = this->PointsPerAxis[1];
+  index[0] = int(key % nI);
+  index[1] = int(key / nI % nJ);
+  index[2] = int(key / nI / nJ);
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkSmartPointer<vtkPoints> vtkFFDSparseLattice::MakeRestPoints(
+  const ffd::Frame<double>& frame, ffd::GridBasis basis, const int divisions[3]) const
+{
+  const vtkIdType n = vtkIdType(this->Points.size());
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  double* x = vtkDoubleArray::SafeDownCast(points->GetData())->GetPointer(0);
+  vtkSMPTools::For(0, n,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType id = begin; id < end; ++id)
+      {
+        int ijk[3];
+        this->GetIndex(id, ijk);
+        const ffd::Vec3<double> p = vtkFFDRestPoint(frame, basis, divisions, ijk[0], ijk[1], ijk[2]);
+        std::copy(&p.x, &p.x + 3, x + 3 * id);
+      }
+    });
+  return points;
+}
