@@ -2,12 +2,17 @@
 #include "vtkFFDBuildLattice.h"
 
 #include "vtkCellData.h"
+#include "vtkDataSet.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkDoubleArray.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDSparseLattice.h"
+#include "vtkFieldData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkIntArray.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
@@ -15,6 +20,7 @@
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStructuredGrid.h"
 #include "vtkUnsignedCharArray.h"
+#include "vtkUnstructuredGrid.h"
 
 #include "FFDBernstein.h"
 #include "FFDFrame.h"
@@ -23,7 +29,6 @@
 #include <algorithm>
 #include <sstream>
 #include <string>
-#include <vector>
 
 vtkStandardNewMacro(vtkFFDBuildLattice);
 
@@ -35,10 +40,21 @@ static_assert(int(ffd::GridBasis::Bernstein) == vtkFFDBuildLattice::BERNSTEIN &&
     int(ffd::GridBasis::CubicBSpline) == vtkFFDBuildLattice::CUBIC_BSPLINE,
   "vtkFFDBuildLattice::Bases and ffd::GridBasis disagree");
 
+namespace
+{
+/// Whether `form` makes a sparse lattice of `basis`.
+bool IsSparse(int form, int basis)
+{
+  return form == vtkFFDBuildLattice::SPARSE ||
+    (form == vtkFFDBuildLattice::AUTOMATIC && basis != vtkFFDBuildLattice::BERNSTEIN);
+}
+} // namespace
+
 //------------------------------------------------------------------------------
 // The per-basis formulas (points per axis, rest parameters, supports) live in FFDGridBasis.h, shared with the
 // deformation kernels, so that the lattice and its evaluation cannot disagree.
-bool vtkFFDBuildLattice::GetControlPointsPerAxis(int basis, const int divisions[3], int points[3], std::string& why)
+bool vtkFFDBuildLattice::GetControlPointsPerAxis(
+  int basis, const int divisions[3], int points[3], std::string& why, int form)
 {
   if (!ffd::IsGridBasis(basis))
   {
@@ -69,12 +85,16 @@ bool vtkFFDBuildLattice::GetControlPointsPerAxis(int basis, const int divisions[
     }
     points[a] = ffd::ControlPointsAlongAxis(grid, divisions[a]);
   }
-  // The deformation's kernels index control points by int.
-  if (double(points[0]) * points[1] * points[2] > double(VTK_INT_MAX))
+  // The dense deformation's kernels index control points by int; a sparse lattice's points are found by their
+  // linear index i + nI*(j + nJ*k), an int64.
+  const double count = double(points[0]) * points[1] * points[2];
+  if (form == SPARSE ? count >= 0x1p63 : count > double(VTK_INT_MAX))
   {
     std::ostringstream msg;
     msg << "the " << GetBasisAsString(basis) << " lattice over " << divisions[0] << "x" << divisions[1] << "x"
-        << divisions[2] << " voxels would have more than 2^31 - 1 control points.";
+        << divisions[2] << " voxels would have more than "
+        << (form == SPARSE ? "2^63 - 1 control points: use fewer divisions."
+                           : "2^31 - 1 control points: use fewer divisions, or a SPARSE lattice of a local basis.");
     why = msg.str();
     return false;
   }
@@ -84,8 +104,23 @@ bool vtkFFDBuildLattice::GetControlPointsPerAxis(int basis, const int divisions[
 //------------------------------------------------------------------------------
 vtkFFDBuildLattice::vtkFFDBuildLattice()
   : Basis(BERNSTEIN)
+  , LatticeForm(AUTOMATIC)
   , NumberOfActiveControlPoints(0)
 {
+}
+
+//------------------------------------------------------------------------------
+const char* vtkFFDBuildLattice::GetLatticeFormAsString()
+{
+  switch (this->LatticeForm)
+  {
+    case DENSE:
+      return "Dense";
+    case SPARSE:
+      return "Sparse";
+    default:
+      return "Automatic";
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -109,39 +144,52 @@ const char* vtkFFDBuildLattice::GetBasisAsString(int basis)
 }
 
 //------------------------------------------------------------------------------
-int vtkFFDBuildLattice::RequestInformation(
-  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+int vtkFFDBuildLattice::FillInputPortInformation(int, vtkInformation* info)
 {
-  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  int extent[6];
-  inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent);
-  const int divisions[3] = { extent[1] - extent[0], extent[3] - extent[2], extent[5] - extent[4] };
-  if (divisions[0] < 1 || divisions[1] < 1 || divisions[2] < 1)
-  {
-    // No voxel: an empty input (empty output) or not a voxel grid (RequestData says so).
-    outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
-    return 1;
-  }
-  int points[3];
-  std::string why;
-  if (!GetControlPointsPerAxis(this->Basis, divisions, points, why))
-  {
-    vtkErrorMacro(<< "Cannot build the lattice: " << why);
-    return 0;
-  }
-  const int latticeExtent[6] = { 0, points[0] - 1, 0, points[1] - 1, 0, points[2] - 1 };
-  outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), latticeExtent, 6);
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkDataSet");
   return 1;
 }
 
 //------------------------------------------------------------------------------
-int vtkFFDBuildLattice::RequestUpdateExtent(vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
+int vtkFFDBuildLattice::RequestDataObject(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  // The lattice's extent is not the voxel grid's (a quadratic lattice has 2n + 1 points per axis, a B-spline
-  // lattice n + 3), and every control point depends on the whole grid through the culling: ask for all of it
-  // rather than the pipeline's default, which would copy the lattice's extent upstream.
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  vtkDataObject* output = vtkDataObject::GetData(outInfo);
+  if (IsSparse(this->LatticeForm, this->Basis))
+  {
+    if (!vtkUnstructuredGrid::SafeDownCast(output))
+    {
+      outInfo->Set(vtkDataObject::DATA_OBJECT(), vtkSmartPointer<vtkUnstructuredGrid>::New());
+    }
+  }
+  else if (!vtkStructuredGrid::SafeDownCast(output))
+  {
+    outInfo->Set(vtkDataObject::DATA_OBJECT(), vtkSmartPointer<vtkStructuredGrid>::New());
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkFFDBuildLattice::ExecuteInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  // The dense lattice's extent follows the input's FFDDivisions, which comes with its data: unknown until
+  // RequestData. The executive copied the input's WHOLE_EXTENT, if any (a structured voxel grid's), which is not
+  // the lattice's; without one it announces an empty extent.
+  outputVector->GetInformationObject(0)->Remove(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT());
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkFFDBuildLattice::ComputeInputUpdateExtent(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
+{
+  // Every control point depends on the whole voxel grid through the culling and the supports: ask for all of it,
+  // one piece without ghost levels (and the whole extent of a structured one) rather than a share of the
+  // lattice's request.
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
+  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
+  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
   if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
   {
     inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
@@ -162,12 +210,13 @@ vtkTypeBool vtkFFDBuildLattice::ProcessRequest(
 int vtkFFDBuildLattice::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkStructuredGrid* input = vtkStructuredGrid::GetData(inputVector[0]);
-  vtkStructuredGrid* output = vtkStructuredGrid::GetData(outputVector);
+  vtkDataSet* input = vtkDataSet::GetData(inputVector[0]);
+  vtkDataObject* output = vtkDataObject::GetData(outputVector);
   this->NumberOfActiveControlPoints = 0;
-  if (!input || input->GetNumberOfPoints() == 0)
+  if (!input ||
+    (input->GetNumberOfCells() == 0 && !input->GetFieldData()->GetAbstractArray(vtkFFDDataContract::FrameArrayName())))
   {
-    return 1; // an empty input gives an empty output
+    return 1; // an empty input gives an empty output (a voxel grid without active voxels still has its frame)
   }
 
   double frame[12];
@@ -184,21 +233,6 @@ int vtkFFDBuildLattice::RequestData(
                   << " field array (3 ints >= 1): connect the output of vtkFFDVoxelize.");
     return 0;
   }
-  int dims[3];
-  input->GetDimensions(dims);
-  bool dimsMatch = input->GetNumberOfPoints() == vtkIdType(dims[0]) * dims[1] * dims[2];
-  for (int a = 0; a < 3; ++a)
-  {
-    dimsMatch = dimsMatch && vtkIdType(dims[a]) == vtkIdType(divisions[a]) + 1;
-  }
-  if (!dimsMatch)
-  {
-    vtkErrorMacro(<< "The input's dimensions (" << dims[0] << ", " << dims[1] << ", " << dims[2] << ") and "
-                  << input->GetNumberOfPoints() << " points do not match its "
-                  << vtkFFDDataContract::DivisionsArrayName() << " (" << divisions[0] << ", " << divisions[1] << ", "
-                  << divisions[2] << ") plus one: connect the output of vtkFFDVoxelize.");
-    return 0;
-  }
   if (ffd::CheckFrame(frame) != ffd::FrameStatus::Valid)
   {
     vtkErrorMacro(<< "The input's " << vtkFFDDataContract::FrameArrayName()
@@ -206,70 +240,121 @@ int vtkFFDBuildLattice::RequestData(
                      "connect the output of vtkFFDVoxelize or fix the frame.");
     return 0;
   }
+  const bool sparse = IsSparse(this->LatticeForm, this->Basis);
+  if (sparse && this->Basis == BERNSTEIN)
+  {
+    vtkErrorMacro(<< "A SPARSE lattice of the global BERNSTEIN basis is not possible: each of its control points "
+                     "influences every voxel. Call SetLatticeFormToDense() or SetLatticeFormToAutomatic(), or "
+                     "choose a local basis.");
+    return 0;
+  }
   int pointsPerAxis[3];
   std::string why;
-  if (!GetControlPointsPerAxis(this->Basis, divisions, pointsPerAxis, why))
+  if (!GetControlPointsPerAxis(this->Basis, divisions, pointsPerAxis, why, sparse ? SPARSE : DENSE))
   {
     vtkErrorMacro(<< "Cannot build the lattice: " << why);
     return 0;
   }
-  const ffd::GridBasis basis = static_cast<ffd::GridBasis>(this->Basis);
 
-  // Which control points influence an active voxel: the union of the active voxels' supports (paper section
-  // III.D). A voxel is active unless the input's cell ghost array hides it. The cost is that of visiting the
-  // active voxels' supports; once a support covers the whole lattice (always so for the global basis) no
-  // further voxel can add to it.
+  // The active voxels: one (i, j, k) per cell, each within the divisions, each once.
+  vtkIntArray* voxels =
+    vtkIntArray::SafeDownCast(input->GetCellData()->GetAbstractArray(vtkFFDDataContract::VoxelIndexArrayName()));
+  const vtkIdType numVoxels = input->GetNumberOfCells();
+  if (!voxels || voxels->GetNumberOfComponents() != 3 || voxels->GetNumberOfTuples() != numVoxels)
+  {
+    vtkErrorMacro(<< "The input has no " << vtkFFDDataContract::VoxelIndexArrayName()
+                  << " cell array of 3 ints (a vtkIntArray) per cell, the (i, j, k) of each active voxel: "
+                     "connect the output of vtkFFDVoxelize.");
+    return 0;
+  }
+  const int* ijk = voxels->GetPointer(0);
+  for (vtkIdType v = 0; v < numVoxels; ++v)
+  {
+    const int* x = ijk + 3 * v;
+    if (x[0] < 0 || x[0] >= divisions[0] || x[1] < 0 || x[1] >= divisions[1] || x[2] < 0 || x[2] >= divisions[2])
+    {
+      vtkErrorMacro(<< "The input's " << vtkFFDDataContract::VoxelIndexArrayName() << " of cell " << v << ", (" << x[0]
+                    << ", " << x[1] << ", " << x[2] << "), lies outside its "
+                    << vtkFFDDataContract::DivisionsArrayName() << " (" << divisions[0] << ", " << divisions[1] << ", "
+                    << divisions[2] << "): each index must be in [0, divisions); connect the output of "
+                    << "vtkFFDVoxelize or fix the voxel grid.");
+      return 0;
+    }
+  }
+  vtkFFDActiveSet distinct;
+  distinct.Mark(numVoxels,
+    [ijk](vtkIdType begin, vtkIdType end, vtkFFDBoxMarker& marker)
+    {
+      const int one[3] = { 1, 1, 1 };
+      for (vtkIdType v = begin; v < end; ++v)
+      {
+        marker.Mark(ijk + 3 * v, one);
+      }
+    });
+  if (distinct.GetNumberOfMarked() != numVoxels)
+  {
+    vtkErrorMacro(<< "The input's " << numVoxels << " cells name only " << distinct.GetNumberOfMarked()
+                  << " distinct voxels in " << vtkFFDDataContract::VoxelIndexArrayName()
+                  << ": give each active voxel one cell, as vtkFFDVoxelize does.");
+    return 0;
+  }
+
+  const int built = sparse
+    ? this->BuildSparse(frame, divisions, voxels, vtkUnstructuredGrid::SafeDownCast(output))
+    : this->BuildDense(frame, divisions, pointsPerAxis, voxels, vtkStructuredGrid::SafeDownCast(output));
+  if (!built)
+  {
+    return 0;
+  }
+  vtkFFDDataContract::SetFrame(output, frame);
+  vtkFFDDataContract::SetDivisions(output, divisions);
+  vtkFFDDataContract::SetBasis(output, this->Basis);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkFFDBuildLattice::BuildDense(const double frame[12], const int divisions[3], const int pointsPerAxis[3],
+  vtkIntArray* voxels, vtkStructuredGrid* output)
+{
+  const ffd::GridBasis basis = static_cast<ffd::GridBasis>(this->Basis);
   const int nI = pointsPerAxis[0], nJ = pointsPerAxis[1], nK = pointsPerAxis[2];
   const vtkIdType numControlPoints = static_cast<vtkIdType>(nI) * nJ * nK;
   // Per control point: its position and RestPosition (24 bytes each), Active and the ghost array (1 each).
   std::ostringstream request;
-  request << "A " << GetBasisAsString(this->Basis) << " lattice over " << divisions[0] << "x" << divisions[1] << "x"
-          << divisions[2] << " voxels (" << nI << "x" << nJ << "x" << nK << " control points)";
+  request << "A dense " << GetBasisAsString(this->Basis) << " lattice over " << divisions[0] << "x" << divisions[1]
+          << "x" << divisions[2] << " voxels (" << nI << "x" << nJ << "x" << nK << " control points)";
   if (!vtkFFDCheckMemory(this, request.str(), 50.0 * double(numControlPoints)))
   {
     return 0;
   }
-  vtkUnsignedCharArray* cellGhosts = input->GetCellGhostArray();
-  if (cellGhosts && cellGhosts->GetNumberOfValues() != input->GetNumberOfCells())
-  {
-    vtkErrorMacro(<< "The input's cell array " << vtkDataSetAttributes::GhostArrayName() << " has "
-                  << cellGhosts->GetNumberOfValues() << " values for " << input->GetNumberOfCells()
-                  << " voxels: connect the output of vtkFFDVoxelize.");
-    return 0;
-  }
+
+  // Which control points influence an active voxel: the union of the active voxels' supports (paper section
+  // III.D). Once a support covers the whole lattice (always so for the global basis) no further voxel can add
+  // to it.
   vtkNew<vtkUnsignedCharArray> activeArray;
   activeArray->SetName(vtkFFDDataContract::ActiveArrayName());
   activeArray->SetNumberOfValues(numControlPoints);
   unsigned char* active = activeArray->GetPointer(0);
   std::fill(active, active + numControlPoints, static_cast<unsigned char>(0));
-  const unsigned char* voxelGhosts = cellGhosts ? cellGhosts->GetPointer(0) : nullptr;
+  const int* ijk = voxels->GetPointer(0);
   bool covered = false;
-  vtkIdType voxel = 0;
-  for (int k = 0; k < divisions[2] && !covered; ++k)
+  for (vtkIdType v = 0; v < voxels->GetNumberOfTuples() && !covered; ++v)
   {
-    for (int j = 0; j < divisions[1] && !covered; ++j)
+    int first[3], count[3];
+    for (int a = 0; a < 3; ++a)
     {
-      for (int i = 0; i < divisions[0] && !covered; ++i, ++voxel)
+      ffd::VoxelSupport(basis, divisions[a], ijk[3 * v + a], first[a], count[a]);
+    }
+    for (int c = first[2]; c < first[2] + count[2]; ++c)
+    {
+      for (int b = first[1]; b < first[1] + count[1]; ++b)
       {
-        if (voxelGhosts && (voxelGhosts[voxel] & vtkDataSetAttributes::HIDDENCELL))
-        {
-          continue;
-        }
-        int first[3], count[3];
-        ffd::VoxelSupport(basis, divisions[0], i, first[0], count[0]);
-        ffd::VoxelSupport(basis, divisions[1], j, first[1], count[1]);
-        ffd::VoxelSupport(basis, divisions[2], k, first[2], count[2]);
-        for (int c = first[2]; c < first[2] + count[2]; ++c)
-        {
-          for (int b = first[1]; b < first[1] + count[1]; ++b)
-          {
-            unsigned char* row = active + static_cast<size_t>(nI) * (b + static_cast<size_t>(nJ) * c);
-            std::fill(row + first[0], row + first[0] + count[0], static_cast<unsigned char>(1));
-          }
-        }
-        covered = count[0] == nI && count[1] == nJ && count[2] == nK;
+        unsigned char* row = active + static_cast<size_t>(nI) * (b + static_cast<size_t>(nJ) * c);
+        std::fill(row + first[0], row + first[0] + count[0], static_cast<unsigned char>(1));
       }
     }
+    covered = count[0] == nI && count[1] == nJ && count[2] == nK;
   }
   this->UpdateProgress(0.5);
   if (this->GetAbortExecute())
@@ -279,14 +364,6 @@ int vtkFFDBuildLattice::RequestData(
 
   // The rest positions, each computed directly from the frame (no accumulated steps); the B-spline's outer
   // ring has parameters outside [0, 1].
-  std::vector<double> restParameters[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    for (int i = 0; i < pointsPerAxis[a]; ++i)
-    {
-      restParameters[a].push_back(ffd::RestParameter(basis, divisions[a], i));
-    }
-  }
   const ffd::Frame<double> bound = ffd::Frame<double>::FromArray(frame);
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
@@ -302,8 +379,8 @@ int vtkFFDBuildLattice::RequestData(
     {
       for (vtkIdType id = begin; id < end; ++id)
       {
-        const vtkIdType i = id % nI, j = (id / nI) % nJ, k = id / (static_cast<vtkIdType>(nI) * nJ);
-        const ffd::Vec3<double> x = bound.ToWorld({ restParameters[0][i], restParameters[1][j], restParameters[2][k] });
+        const ffd::Vec3<double> x = vtkFFDRestPoint(
+          bound, basis, divisions, int(id % nI), int((id / nI) % nJ), int(id / (static_cast<vtkIdType>(nI) * nJ)));
         for (int c = 0; c < 3; ++c)
         {
           pointValues[3 * id + c] = restValues[3 * id + c] = x[c];
@@ -312,7 +389,6 @@ int vtkFFDBuildLattice::RequestData(
     });
 
   const vtkIdType numActive = std::count(active, active + numControlPoints, static_cast<unsigned char>(1));
-
   output->SetExtent(0, nI - 1, 0, nJ - 1, 0, nK - 1);
   output->SetPoints(points);
   output->GetPointData()->AddArray(rest);
@@ -329,11 +405,62 @@ int vtkFFDBuildLattice::RequestData(
     }
     output->GetPointData()->AddArray(pointGhosts);
   }
-  vtkFFDDataContract::SetFrame(output, frame);
-  vtkFFDDataContract::SetDivisions(output, divisions);
-  vtkFFDDataContract::SetBasis(output, this->Basis);
   this->NumberOfActiveControlPoints = numActive;
-  this->UpdateProgress(1.0);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkFFDBuildLattice::BuildSparse(
+  const double frame[12], const int divisions[3], vtkIntArray* voxels, vtkUnstructuredGrid* output)
+{
+  const ffd::GridBasis basis = static_cast<ffd::GridBasis>(this->Basis);
+  std::ostringstream request;
+  request << "A sparse " << GetBasisAsString(this->Basis) << " lattice over " << voxels->GetNumberOfTuples()
+          << " active voxels of " << divisions[0] << "x" << divisions[1] << "x" << divisions[2];
+  // Per control point: its position and RestPosition (24 bytes each), LatticeIndex (12) and Active (1). The
+  // cells' VoxelIndex is the input's array, shared.
+  vtkFFDSparseLattice lattice;
+  if (!lattice.Build(
+        this, basis, divisions, voxels->GetPointer(0), voxels->GetNumberOfTuples(), 61.0, 0.0, request.str()))
+  {
+    return 0;
+  }
+  this->UpdateProgress(0.5);
+  if (this->GetAbortExecute())
+  {
+    return 1;
+  }
+
+  const vtkIdType numPoints = vtkIdType(lattice.Points.size());
+  vtkSmartPointer<vtkPoints> points = lattice.MakeRestPoints(ffd::Frame<double>::FromArray(frame), basis, divisions);
+  vtkNew<vtkDoubleArray> rest;
+  rest->DeepCopy(points->GetData());
+  rest->SetName(vtkFFDDataContract::RestPositionArrayName());
+  vtkNew<vtkIntArray> latticeIndex;
+  latticeIndex->SetName(vtkFFDDataContract::LatticeIndexArrayName());
+  latticeIndex->SetNumberOfComponents(3);
+  latticeIndex->SetNumberOfTuples(numPoints);
+  int* index = latticeIndex->GetPointer(0);
+  vtkSMPTools::For(0, numPoints,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType id = begin; id < end; ++id)
+      {
+        lattice.GetIndex(id, index + 3 * id);
+      }
+    });
+  vtkNew<vtkUnsignedCharArray> active;
+  active->SetName(vtkFFDDataContract::ActiveArrayName());
+  active->SetNumberOfValues(numPoints);
+  active->FillValue(1);
+
+  output->SetPoints(points);
+  output->SetCells(lattice.CellType, lattice.Cells);
+  output->GetPointData()->AddArray(rest);
+  output->GetPointData()->AddArray(active);
+  output->GetPointData()->AddArray(latticeIndex);
+  output->GetCellData()->AddArray(voxels);
+  this->NumberOfActiveControlPoints = numPoints;
   return 1;
 }
 
@@ -342,5 +469,6 @@ void vtkFFDBuildLattice::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "Basis: " << this->GetBasisAsString() << "\n";
+  os << indent << "LatticeForm: " << this->GetLatticeFormAsString() << "\n";
   os << indent << "NumberOfActiveControlPoints: " << this->NumberOfActiveControlPoints << "\n";
 }

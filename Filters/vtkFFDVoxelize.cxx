@@ -4,30 +4,24 @@
 #include "vtkArrayDispatch.h"
 #include "vtkCellData.h"
 #include "vtkDataArrayRange.h"
-#include "vtkDataSetAttributes.h"
-#include "vtkDoubleArray.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDSparseLattice.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkIntArray.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
 #include "vtkSMPTools.h"
-#include "vtkStreamingDemandDrivenPipeline.h"
-#include "vtkStructuredGrid.h"
-#include "vtkUnsignedCharArray.h"
+#include "vtkUnstructuredGrid.h"
 
 #include "FFDFrame.h"
 
 #include <Eigen/Eigenvalues>
 
-// OpenVDB is confined to this translation unit: its headers cost ~12 s to compile.
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/PointsToMask.h>
-
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -37,8 +31,6 @@ vtkStandardNewMacro(vtkFFDVoxelize);
 
 namespace
 {
-using VoxelIndex = std::array<int, 3>;
-
 /// Calls fn(range) with `range` the 3-component tuple range of the points, typed for float and double point
 /// arrays and going through the generic vtkDataArray API for any other type.
 template <typename Fn>
@@ -162,19 +154,6 @@ bool PrincipalAxes(vtkDataArray* points, Eigen::Vector3d& mean, Eigen::Matrix3d&
   axes.col(2) = axes.col(0).cross(axes.col(1));
   return true;
 }
-
-/// The point list OpenVDB's PointsToMask reads: voxel indices as index-space positions (the grid's transform
-/// is the identity, and an integer position is the centre of that voxel).
-struct VoxelPointList
-{
-  const std::vector<VoxelIndex>* Voxels;
-  size_t size() const { return this->Voxels->size(); }
-  void getPos(size_t n, openvdb::Vec3R& xyz) const
-  {
-    const VoxelIndex& v = (*this->Voxels)[n];
-    xyz = openvdb::Vec3R(v[0], v[1], v[2]);
-  }
-};
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -222,7 +201,7 @@ int vtkFFDVoxelize::FillInputPortInformation(int, vtkInformation* info)
 }
 
 //------------------------------------------------------------------------------
-int vtkFFDVoxelize::RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+int vtkFFDVoxelize::RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*)
 {
   const int* n = this->Divisions;
   if (n[0] < 1 || n[1] < 1 || n[2] < 1)
@@ -231,8 +210,6 @@ int vtkFFDVoxelize::RequestInformation(vtkInformation*, vtkInformationVector**, 
                   << ") must be at least 1 on every axis: call SetDivisions() with positive numbers.");
     return 0;
   }
-  const int extent[6] = { 0, n[0], 0, n[1], 0, n[2] };
-  outputVector->GetInformationObject(0)->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
   return 1;
 }
 
@@ -248,7 +225,7 @@ vtkTypeBool vtkFFDVoxelize::ProcessRequest(
 int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkPointSet* input = vtkPointSet::GetData(inputVector[0]);
-  vtkStructuredGrid* output = vtkStructuredGrid::GetData(outputVector);
+  vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector);
   this->NumberOfActiveVoxels = 0;
   const vtkIdType numPoints = input ? input->GetNumberOfPoints() : 0;
   if (numPoints == 0)
@@ -257,14 +234,12 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
   }
   vtkDataArray* points = input->GetPoints()->GetData();
   const int nx = this->Divisions[0], ny = this->Divisions[1], nz = this->Divisions[2];
-  // The output is dense: a corner point (24 bytes) per voxel corner and a ghost byte per voxel; the voxel of
-  // each input point takes 12 bytes meanwhile.
-  const double voxelCount = double(nx) * ny * nz, cornerCount = (nx + 1.0) * (ny + 1.0) * (nz + 1.0);
-  std::ostringstream request;
-  request << "Divisions (" << nx << ", " << ny << ", " << nz << "): a voxel grid of " << voxelCount << " voxels and "
-          << cornerCount << " corner points";
-  if (!vtkFFDCheckMemory(this, request.str(), 24.0 * cornerCount + voxelCount + 12.0 * double(numPoints)))
+  // Voxels and corners are found by their int64 linear index i + nx (j + ny k): the corners' count must fit.
+  if ((nx + 1.0) * (ny + 1.0) * (nz + 1.0) >= 0x1p63)
   {
+    vtkErrorMacro(<< "Divisions (" << nx << ", " << ny << ", " << nz
+                  << ") have more voxel corners than a 64-bit index counts: use at most 2^21 divisions per "
+                     "axis, or fewer on the others.");
     return 0;
   }
 
@@ -324,91 +299,84 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
     return 1;
   }
 
-  // Phase 2: the voxel of every point, in parallel. Points outside the frame or non-finite get {-1, -1, -1}.
-  // Parameters are clamped to [0, 1], so s * nx >= 0 truncates to floor(s * nx); s = 1 (the upper face)
-  // belongs to the last voxel.
-  std::vector<VoxelIndex> voxels(static_cast<size_t>(numPoints));
+  // Phase 2: the active voxels, each thread marking the voxels of its points. Points outside the frame and
+  // non-finite ones mark none. Parameters are clamped to [0, 1], so s * nx >= 0 truncates to floor(s * nx);
+  // s = 1 (the upper face) belongs to the last voxel.
   const ffd::Frame<double> bound = ffd::Frame<double>::FromArray(frame);
+  vtkFFDActiveSet active;
   WithPointRange(points,
     [&](auto range)
     {
-      vtkSMPTools::For(0, numPoints,
-        [&](vtkIdType begin, vtkIdType end)
+      active.Mark(numPoints,
+        [&](vtkIdType begin, vtkIdType end, vtkFFDBoxMarker& marker)
         {
+          const int one[3] = { 1, 1, 1 };
           for (vtkIdType id = begin; id < end; ++id)
           {
             const auto p = range[id];
-            const ffd::Vec3<double> x{ static_cast<double>(p[0]), static_cast<double>(p[1]),
-              static_cast<double>(p[2]) };
             ffd::Vec3<double> stu;
-            VoxelIndex& v = voxels[id];
-            if (!bound.Bind(x, stu))
+            if (bound.Bind({ static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2]) }, stu))
             {
-              v = { -1, -1, -1 };
-              continue;
+              const int v[3] = { std::min(static_cast<int>(stu.x * nx), nx - 1),
+                std::min(static_cast<int>(stu.y * ny), ny - 1), std::min(static_cast<int>(stu.z * nz), nz - 1) };
+              marker.Mark(v, one);
             }
-            v = { std::min(static_cast<int>(stu.x * nx), nx - 1), std::min(static_cast<int>(stu.y * ny), ny - 1),
-              std::min(static_cast<int>(stu.z * nz), nz - 1) };
           }
         });
     });
-  voxels.erase(
-    std::remove_if(voxels.begin(), voxels.end(), [](const VoxelIndex& v) { return v[0] < 0; }), voxels.end());
+  const vtkIdType numVoxels = active.GetNumberOfMarked();
   this->UpdateProgress(0.4);
   if (this->GetAbortExecute())
   {
     return 1;
   }
 
-  // Phase 3: the sparse set of active voxels. PointsToMask threads with TBB itself, so it is called here, in
-  // the serial part, never inside vtkSMPTools.
-  static const bool vdbInitialized = (openvdb::initialize(), true);
-  (void)vdbInitialized;
-  const openvdb::MaskGrid::Ptr mask =
-    openvdb::tools::createPointMask(VoxelPointList{ &voxels }, *openvdb::math::Transform::createLinearTransform());
-  this->UpdateProgress(0.7);
+  // Phase 3: the voxels in increasing order (8 bytes each while sorted) and their VoxelIndex (12 bytes).
+  std::ostringstream request;
+  request << numVoxels << " active voxels of divisions (" << nx << ", " << ny << ", " << nz << ")";
+  if (!vtkFFDCheckMemory(this, "The " + request.str(), 20.0 * double(numVoxels)))
+  {
+    return 0;
+  }
+  vtkNew<vtkIntArray> voxelIndex;
+  voxelIndex->SetName(vtkFFDDataContract::VoxelIndexArrayName());
+  voxelIndex->SetNumberOfComponents(3);
+  voxelIndex->SetNumberOfTuples(numVoxels);
+  {
+    const vtkTypeInt64 dims[3] = { nx, ny, nz };
+    const std::vector<vtkTypeInt64> sorted = active.TakeSortedIndices(dims);
+    int* ijk = voxelIndex->GetPointer(0);
+    vtkSMPTools::For(0, numVoxels,
+      [&](vtkIdType begin, vtkIdType end)
+      {
+        for (vtkIdType v = begin; v < end; ++v)
+        {
+          ijk[3 * v] = int(sorted[v] % nx);
+          ijk[3 * v + 1] = int(sorted[v] / nx % ny);
+          ijk[3 * v + 2] = int(sorted[v] / nx / ny);
+        }
+      });
+  }
+  this->UpdateProgress(0.6);
   if (this->GetAbortExecute())
   {
     return 1;
   }
 
-  // Phase 4: the output. Every voxel starts hidden; the active ones (single voxels or whole tiles, whose
-  // bounding box the iterator gives) are shown.
-  const vtkIdType numCells = static_cast<vtkIdType>(nx) * ny * nz;
-  vtkNew<vtkUnsignedCharArray> ghosts;
-  ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
-  ghosts->SetNumberOfValues(numCells);
-  ghosts->FillValue(vtkDataSetAttributes::HIDDENCELL);
-  for (auto it = mask->cbeginValueOn(); it; ++it)
+  // Phase 4: the corners, which are the active control points of a TRILINEAR lattice over the active voxels (its
+  // point (i, j, k) rests at (i/nx, j/ny, k/nz)), and the hexahedra on them.
+  vtkFFDSparseLattice corners;
+  if (!corners.Build(this, ffd::GridBasis::Trilinear, this->Divisions, voxelIndex->GetPointer(0), numVoxels, 24.0, 0.0,
+        "The corners and hexahedra of " + request.str()))
   {
-    for (const openvdb::Coord& c : it.getBoundingBox())
-    {
-      ghosts->SetValue(c.x() + static_cast<vtkIdType>(nx) * (c.y() + static_cast<vtkIdType>(ny) * c.z()), 0);
-    }
+    return 0;
   }
-
-  const vtkIdType cx = vtkIdType(nx) + 1, cy = vtkIdType(ny) + 1, numCorners = cx * cy * (vtkIdType(nz) + 1);
-  vtkNew<vtkPoints> corners;
-  corners->SetDataTypeToDouble();
-  corners->SetNumberOfPoints(numCorners);
-  vtkDoubleArray* cornerArray = vtkDoubleArray::SafeDownCast(corners->GetData());
-  vtkSMPTools::For(0, numCorners,
-    [&](vtkIdType begin, vtkIdType end)
-    {
-      for (vtkIdType id = begin; id < end; ++id)
-      {
-        const vtkIdType i = id % cx, j = (id / cx) % cy, k = id / (cx * cy);
-        const ffd::Vec3<double> x =
-          bound.ToWorld({ static_cast<double>(i) / nx, static_cast<double>(j) / ny, static_cast<double>(k) / nz });
-        cornerArray->SetTypedTuple(id, &x.x);
-      }
-    });
-  output->SetExtent(0, nx, 0, ny, 0, nz);
-  output->SetPoints(corners);
-  output->GetCellData()->AddArray(ghosts);
+  output->SetPoints(corners.MakeRestPoints(bound, ffd::GridBasis::Trilinear, this->Divisions));
+  output->SetCells(corners.CellType, corners.Cells);
+  output->GetCellData()->AddArray(voxelIndex);
   vtkFFDDataContract::SetFrame(output, frame);
   vtkFFDDataContract::SetDivisions(output, this->Divisions);
-  this->NumberOfActiveVoxels = static_cast<vtkIdType>(mask->activeVoxelCount());
+  this->NumberOfActiveVoxels = numVoxels;
   this->UpdateProgress(1.0);
   return 1;
 }

@@ -11,14 +11,23 @@
  *   tight around the points, then padded the same way;
  * - EXPLICIT: the frame set with SetFrame() (which selects this mode), any parallelepiped.
  *
- * The output is a vtkStructuredGrid of (nx+1)(ny+1)(nz+1) voxel corners whose cells are the voxels. A voxel is
- * active when at least one input point lies in it (points on a face shared by two voxels count for the one
- * with the higher index; points outside an explicit frame count for none). The active set is found with an
- * OpenVDB MaskGrid, sparse whatever the divisions; inactive voxels are hidden (HIDDENCELL in the ghost array).
- * The frame and divisions are stored as the `FFDFrame` and `FFDDivisions` field arrays (vtkFFDDataContract).
+ * A voxel is active when at least one input point lies in it (points on a face shared by two voxels count for the
+ * one with the higher index; points outside an explicit frame count for none). The output is sparse, a
+ * vtkUnstructuredGrid of the active voxels only (README, "Data contract"): one VTK_HEXAHEDRON per active voxel, in
+ * increasing voxel order (i fastest, then j, then k), with its (i, j, k) in the `VoxelIndex` cell array (3 ints);
+ * its points are the active voxels' corners, each once, in increasing corner order, corner (i, j, k) at
+ * X0 + (i/nx) S + (j/ny) T + (k/nz) U in double precision. The frame and divisions are stored as the `FFDFrame`
+ * and `FFDDivisions` field arrays (vtkFFDDataContract). Any VTK filter or ParaView draws it as it is.
+ *
+ * Memory and time follow the input's points and the active voxels, never nx*ny*nz, so divisions of 1024^3 and
+ * beyond are cheap over a small mesh: the active voxels are found in parallel with OpenVDB (a MaskTree per thread,
+ * merged by topology union), and their corners and the cells' point ids by sorting and binary search (the same
+ * output whatever the number of threads). The output takes about 50 bytes an active voxel and 24 bytes a corner
+ * (at most 8 corners a voxel, fewer where voxels touch); that, and the 8 bytes an index that sorting takes
+ * meanwhile, is checked against the memory the system can give before it is allocated.
  *
  * Non-finite input points are ignored. An empty input gives an empty output without an error. Divisions below
- * one, a flat or non-finite frame are errors.
+ * one or with more corners than an int64 counts, a flat or non-finite frame are errors.
  *
  * @sa vtkFFDBuildLattice vtkFFDDeform vtkFFDDataContract
  */
@@ -26,13 +35,13 @@
 #define vtkFFDVoxelize_h
 
 #include "vtkFFDFiltersModule.h" // For export macro
-#include "vtkStructuredGridAlgorithm.h"
+#include "vtkUnstructuredGridAlgorithm.h"
 
-class VTKFFDFILTERS_EXPORT vtkFFDVoxelize : public vtkStructuredGridAlgorithm
+class VTKFFDFILTERS_EXPORT vtkFFDVoxelize : public vtkUnstructuredGridAlgorithm
 {
 public:
   static vtkFFDVoxelize* New();
-  vtkTypeMacro(vtkFFDVoxelize, vtkStructuredGridAlgorithm);
+  vtkTypeMacro(vtkFFDVoxelize, vtkUnstructuredGridAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
   ///@{

@@ -4,14 +4,14 @@
  * @brief   the edges of the visible cells of a data set, each once, as lines between the input's own points
  *
  * Draws a lattice's edges and a voxel grid's boxes. For every cell that is not hidden (HIDDENCELL in the cell
- * ghost array: vtkFFDVoxelize hides its inactive voxels that way), the cell's edges are output as lines, each
- * edge shared by several cells once. The output keeps the input's points, in the input's order (point i of
- * the output is point i of the input), so an edge follows its control points when they move and nothing is
- * merged: two control points dragged onto each other keep their own edges.
+ * ghost array), the cell's edges are output as lines, each edge shared by several cells once. The output keeps the
+ * input's points, in the input's order (point i of the output is point i of the input), so an edge follows its control
+ * points when they move and nothing is merged: two control points dragged onto each other keep their own edges.
  *
- * It works for any cell type with edges (hexahedra of a structured lattice or voxel grid, tetrahedra of an
- * unstructured lattice); polylines give their segments; vertices give nothing. Unlike vtkExtractEdges of VTK 9.1, it
- * skips hidden cells, which is the whole point for a voxel grid whose inactive voxels must not be drawn.
+ * It works for any cell type with edges (hexahedra of a structured lattice or of vtkFFDVoxelize's voxel grid,
+ * whose cells are the active voxels, tetrahedra of an unstructured lattice); polylines give their segments;
+ * vertices give nothing. Unlike vtkExtractEdges of VTK 9.1, it skips hidden cells, which a data set whose hidden
+ * cells must not be drawn needs.
  *
  * @sa vtkFFDLatticeActor vtkFFDVoxelize vtkExtractEdges
  */

@@ -3,7 +3,7 @@
  * @class   vtkFFDLatticeActor
  * @brief   draws a free-form deformation lattice: control points, lattice edges and active voxels
  *
- * A vtkAssembly of up to four parts that show a control lattice (the vtkStructuredGrid from
+ * A vtkAssembly of up to four parts that show a control lattice (the dense vtkStructuredGrid from
  * vtkFFDBuildLattice, as it is or deformed by moving its points, or a vtkUnstructuredGrid of tetrahedra with
  * the same point arrays) and, optionally, the voxel grid it was built over:
  * - the active control points, as sphere glyphs, red by default (GetPointProperty()), or coloured by how far
@@ -13,8 +13,9 @@
  * - the lattice edges, the edges of the lattice's cells (grid lines of a structured lattice, tetrahedron
  *   edges of an unstructured one), dark grey lines of width 2 (GetEdgeProperty());
  * - the active voxels as wireframe boxes, when a voxel grid from vtkFFDVoxelize is set (SetVoxelGridData() or
- *   SetVoxelGridConnection()): its inactive voxels are hidden cells and are not drawn; steel blue lines of
- *   width 1 by default (GetVoxelProperty()). The boxes stay where the voxel grid is: the rest frame.
+ *   SetVoxelGridConnection()): its cells are the active voxels (hidden cells of another data set are not
+ *   drawn); steel blue lines of width 1 by default (GetVoxelProperty()). The boxes stay where the voxel grid
+ *   is: the rest frame.
  *
  * Every part reads its input through its own pipeline (vtkFFDControlPoints, vtkFFDCellEdges), so the actor
  * follows the lattice: moving its points (and marking them modified) or re-executing the upstream filter shows

@@ -235,8 +235,9 @@ int main(int argc, char* argv[])
   vtkNew<vtkFFDBuildLattice> build;
   build->SetInputConnection(voxelize->GetOutputPort());
   build->SetBasis(basis);
+  build->SetLatticeFormToDense(); // the form vtkFFDDeform and vtkFFDLatticeActor read
   build->Update();
-  vtkStructuredGrid* restLattice = build->GetOutput();
+  vtkStructuredGrid* restLattice = build->GetStructuredGridOutput();
   if (restLattice->GetNumberOfPoints() == 0)
   {
     std::cerr << "the lattice could not be built (see the errors above)\n";

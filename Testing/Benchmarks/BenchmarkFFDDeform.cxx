@@ -286,6 +286,7 @@ void BuildLattice(vtkPolyData* mesh, int basis, int divisions, BenchmarkLattice&
   vtkNew<vtkFFDBuildLattice> build;
   build->SetInputConnection(voxelize->GetOutputPort());
   build->SetBasis(basis);
+  build->SetLatticeFormToDense();
   build->Update();
   lattice.Grid->DeepCopy(build->GetOutput());
   lattice.Rest.resize(3 * lattice.Grid->GetNumberOfPoints());

@@ -110,6 +110,7 @@ int main(int argc, char* argv[])
     vtkNew<vtkFFDBuildLattice> build;
     build->SetInputConnection(voxelize->GetOutputPort());
     build->SetBasis(basis);
+    build->SetLatticeFormToDense();
     build->Update();
     vtkNew<vtkStructuredGrid> lattice;
     lattice->DeepCopy(build->GetOutput());

@@ -195,6 +195,7 @@ int main(int argc, char* argv[])
   vtkNew<vtkFFDBuildLattice> buildGrid;
   buildGrid->SetInputConnection(voxelize->GetOutputPort());
   buildGrid->SetBasisToTrilinear();
+  buildGrid->SetLatticeFormToDense();
   buildGrid->Update();
   vtkNew<vtkStructuredGrid> grid;
   grid->DeepCopy(buildGrid->GetOutput());

@@ -112,6 +112,7 @@ int main(int argc, char* argv[])
       vtkNew<vtkFFDBuildLattice> build;
       build->SetInputConnection(voxelize->GetOutputPort());
       build->SetBasis(grids[row]);
+      build->SetLatticeFormToDense();
       lattice = CopyOf<vtkStructuredGrid>(build);
       name = vtkFFDBuildLattice::GetBasisAsString(grids[row]);
     }

@@ -294,6 +294,7 @@ struct Pipeline
     this->Voxelize->SetDivisions(nx, ny, nz);
     this->Build->SetInputConnection(this->Voxelize->GetOutputPort());
     this->Build->SetBasis(basis);
+    this->Build->SetLatticeFormToDense();
     this->Build->Update();
     this->Lattice->DeepCopy(this->Build->GetOutput());
     this->Deform->SetInputData(mesh);

@@ -764,6 +764,7 @@ TEST(vtkFFDDeformTetrahedral, ExtrapolateNeedsATetrahedralLattice)
   vtkNew<vtkFFDBuildLattice> build;
   build->SetInputConnection(voxelize->GetOutputPort());
   build->SetBasisToTrilinear();
+  build->SetLatticeFormToDense();
   vtkNew<FFDTestErrorObserver> observer;
   vtkNew<vtkFFDDeform> deform;
   observer->WatchWithExecutive(deform);

@@ -1,23 +1,24 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // vtkFFDVoxelize: the frame of each mode, the active voxels against an independent brute-force count written
-// from the paper's equation 2 (ffdref::Parameters), the output's data contract, and every bad input.
+// from the paper's equation 2 (ffdref::Parameters), the sparse output's data contract (cells, corners, order),
+// its independence of the number of threads, its cost at 1024^3 divisions, and every bad input.
 #include "vtkFFDVoxelize.h"
 
+#include "vtkCellArray.h"
 #include "vtkCellData.h"
-#include "vtkDataSetAttributes.h"
+#include "vtkCellType.h"
 #include "vtkDoubleArray.h"
 #include "vtkExecutive.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
-#include "vtkInformation.h"
+#include "vtkIdList.h"
 #include "vtkIntArray.h"
 #include "vtkNew.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
-#include "vtkStreamingDemandDrivenPipeline.h"
-#include "vtkStructuredGrid.h"
-#include "vtkUnsignedCharArray.h"
+#include "vtkSMPTools.h"
+#include "vtkUnstructuredGrid.h"
 
 #include "FFDReference.h"
 #include "FFDTestComparisons.h"
@@ -28,10 +29,13 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
+#include <iostream>
 #include <limits>
 #include <random>
 #include <set>
+#include <tuple>
 
 namespace
 {
@@ -81,28 +85,104 @@ std::set<Voxel> BruteForceActiveVoxels(const std::vector<Vec>& xs, const ffdref:
   return active;
 }
 
-/// The voxels the output shows (no HIDDENCELL bit).
-std::set<Voxel> ShownVoxels(vtkStructuredGrid* grid, const int n[3])
+/// The output's voxels, from its VoxelIndex cell array, in cell order.
+std::vector<Voxel> VoxelsOf(vtkUnstructuredGrid* grid)
 {
-  std::set<Voxel> shown;
-  vtkUnsignedCharArray* ghosts =
-    vtkUnsignedCharArray::SafeDownCast(grid->GetCellData()->GetArray(vtkDataSetAttributes::GhostArrayName()));
-  EXPECT_NE(ghosts, nullptr);
-  if (!ghosts)
+  vtkIntArray* index =
+    vtkIntArray::SafeDownCast(grid->GetCellData()->GetAbstractArray(vtkFFDDataContract::VoxelIndexArrayName()));
+  EXPECT_NE(index, nullptr);
+  std::vector<Voxel> voxels;
+  if (!index)
   {
-    return shown;
+    return voxels;
   }
-  EXPECT_EQ(ghosts->GetNumberOfValues(), static_cast<vtkIdType>(n[0]) * n[1] * n[2]);
-  for (int k = 0; k < n[2]; ++k)
-    for (int j = 0; j < n[1]; ++j)
-      for (int i = 0; i < n[0]; ++i)
+  EXPECT_EQ(index->GetNumberOfComponents(), 3);
+  EXPECT_EQ(index->GetNumberOfTuples(), grid->GetNumberOfCells());
+  for (vtkIdType c = 0; c < index->GetNumberOfTuples(); ++c)
+  {
+    voxels.push_back({ index->GetValue(3 * c), index->GetValue(3 * c + 1), index->GetValue(3 * c + 2) });
+  }
+  return voxels;
+}
+
+double Norm(const Vec& v)
+{
+  return std::sqrt(ffdref::Dot(v, v));
+}
+
+/// Whether a comes before b in increasing grid order (i fastest, then j, then k).
+bool Before(const Voxel& a, const Voxel& b)
+{
+  return std::make_tuple(a[2], a[1], a[0]) < std::make_tuple(b[2], b[1], b[0]);
+}
+
+/// The output's voxels as a set, after checking that they come in increasing order, which also means each once.
+std::set<Voxel> ActiveVoxels(vtkUnstructuredGrid* grid)
+{
+  const std::vector<Voxel> voxels = VoxelsOf(grid);
+  for (size_t c = 1; c < voxels.size(); ++c)
+  {
+    EXPECT_TRUE(Before(voxels[c - 1], voxels[c])) << "cell " << c;
+  }
+  return std::set<Voxel>(voxels.begin(), voxels.end());
+}
+
+/// VTK_HEXAHEDRON's corners in its order: (0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), then the same at k + 1.
+const int HexCorners[8][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, { 0, 0, 1 }, { 1, 0, 1 },
+  { 1, 1, 1 }, { 0, 1, 1 } };
+
+/**
+ * Checks the voxel grid's cells and points against the data contract, from its definitions: every cell a
+ * VTK_HEXAHEDRON whose m-th point is its voxel's corner HexCorners[m]; every point the corner of some cell and
+ * of one only, at X0 + (i/nx) S + (j/ny) T + (k/nz) U; the points in increasing corner order (so no corner twice);
+ * as many points as the active voxels have distinct corners.
+ */
+void ExpectCellsOnTheirCorners(vtkUnstructuredGrid* out, const int n[3])
+{
+  const std::vector<Voxel> voxels = VoxelsOf(out);
+  const vtkIdType numPoints = out->GetNumberOfPoints();
+  ASSERT_EQ(out->GetPoints()->GetDataType(), VTK_DOUBLE);
+  std::vector<Voxel> cornerOfPoint(numPoints, Voxel{ -1, -1, -1 });
+  std::set<Voxel> corners;
+  vtkNew<vtkIdList> ids;
+  for (vtkIdType c = 0; c < out->GetNumberOfCells(); ++c)
+  {
+    ASSERT_EQ(out->GetCellType(c), VTK_HEXAHEDRON) << c;
+    out->GetCellPoints(c, ids);
+    ASSERT_EQ(ids->GetNumberOfIds(), 8) << c;
+    for (int m = 0; m < 8; ++m)
+    {
+      const Voxel corner = { voxels[c][0] + HexCorners[m][0], voxels[c][1] + HexCorners[m][1],
+        voxels[c][2] + HexCorners[m][2] };
+      corners.insert(corner);
+      const vtkIdType id = ids->GetId(m);
+      ASSERT_TRUE(id >= 0 && id < numPoints) << "cell " << c << " names point " << id;
+      if (cornerOfPoint[id][0] < 0)
       {
-        if (!(ghosts->GetValue(i + n[0] * (j + n[1] * k)) & vtkDataSetAttributes::HIDDENCELL))
-        {
-          shown.insert({ i, j, k });
-        }
+        cornerOfPoint[id] = corner;
       }
-  return shown;
+      ASSERT_EQ(cornerOfPoint[id], corner) << "point " << id << " is two corners";
+    }
+  }
+  EXPECT_EQ(static_cast<vtkIdType>(corners.size()), numPoints);
+  // A few roundings apart: X0 + aS + bT + cU from the same doubles.
+  const ffdref::Frame f = FrameOf(out);
+  const double scale = Norm(f.X0) + Norm(f.S) + Norm(f.T) + Norm(f.U);
+  for (vtkIdType id = 0; id < numPoints; ++id)
+  {
+    const Voxel& c = cornerOfPoint[id];
+    ASSERT_GE(c[0], 0) << "point " << id << " is no cell's corner";
+    if (id > 0)
+    {
+      ASSERT_TRUE(Before(cornerOfPoint[id - 1], c)) << "points " << id - 1 << " and " << id;
+    }
+    const double a = double(c[0]) / n[0], b = double(c[1]) / n[1], d = double(c[2]) / n[2];
+    const Vec expected = { f.X0[0] + a * f.S[0] + b * f.T[0] + d * f.U[0],
+      f.X0[1] + a * f.S[1] + b * f.T[1] + d * f.U[1], f.X0[2] + a * f.S[2] + b * f.T[2] + d * f.U[2] };
+    double x[3];
+    out->GetPoint(id, x);
+    ASSERT_TRUE(ffdtest::VectorNear(x, expected, 1e-15 * scale)) << id;
+  }
 }
 
 /// Runs the filter's pipeline; returns the executive's result with errors captured in `observer`.
@@ -119,12 +199,13 @@ void ExpectActiveVoxelsMatchBruteForce(vtkPointSet* input, vtkFFDVoxelize* filte
   filter->SetInputData(input);
   ASSERT_EQ(RunPipeline(filter, observer), 1) << observer->Errors;
   EXPECT_EQ(observer->Errors, "");
-  vtkStructuredGrid* out = filter->GetOutput();
+  vtkUnstructuredGrid* out = filter->GetOutput();
   const int* n = filter->GetDivisions();
   const std::set<Voxel> expected = BruteForceActiveVoxels(PointsOf(input), FrameOf(out), n);
   EXPECT_FALSE(expected.empty());
-  EXPECT_EQ(ShownVoxels(out, n), expected);
+  EXPECT_EQ(ActiveVoxels(out), expected);
   EXPECT_EQ(filter->GetNumberOfActiveVoxels(), static_cast<vtkIdType>(expected.size()));
+  ExpectCellsOnTheirCorners(out, n);
 }
 
 /// Rotation R = Rz(c) Ry(b) Rx(a), columns = images of the unit axes.
@@ -135,11 +216,6 @@ std::array<Vec, 3> Rotation(double a, double b, double c)
   const double m[3][3] = { { cc * cb, cc * sb * sa - sc * ca, cc * sb * ca + sc * sa },
     { sc * cb, sc * sb * sa + cc * ca, sc * sb * ca - cc * sa }, { -sb, cb * sa, cb * ca } };
   return { Vec{ m[0][0], m[1][0], m[2][0] }, Vec{ m[0][1], m[1][1], m[2][1] }, Vec{ m[0][2], m[1][2], m[2][2] } };
-}
-
-double Norm(const Vec& v)
-{
-  return std::sqrt(ffdref::Dot(v, v));
 }
 } // namespace
 
@@ -181,7 +257,7 @@ TEST(vtkFFDVoxelize, FloatAndDoublePointsGiveTheSameVoxels)
   b->SetDivisions(9, 8, 7);
   ExpectActiveVoxelsMatchBruteForce(asFloat, a);
   ExpectActiveVoxelsMatchBruteForce(asDouble, b);
-  EXPECT_EQ(ShownVoxels(a->GetOutput(), a->GetDivisions()), ShownVoxels(b->GetOutput(), b->GetDivisions()));
+  EXPECT_EQ(ActiveVoxels(a->GetOutput()), ActiveVoxels(b->GetOutput()));
 }
 
 TEST(vtkFFDVoxelize, AxisAlignedFrameIsThePaddedBounds)
@@ -357,8 +433,7 @@ TEST(vtkFFDVoxelize, PointsOnFacesGoToTheHigherVoxel)
   voxelize->SetFrame(origin, s, t, u);
   voxelize->SetDivisions(2, 2, 2);
   ExpectActiveVoxelsMatchBruteForce(cloud, voxelize);
-  const int n[3] = { 2, 2, 2 };
-  EXPECT_EQ(ShownVoxels(voxelize->GetOutput(), n), (std::set<Voxel>{ { 1, 1, 1 }, { 1, 0, 0 }, { 0, 0, 0 } }));
+  EXPECT_EQ(ActiveVoxels(voxelize->GetOutput()), (std::set<Voxel>{ { 1, 1, 1 }, { 1, 0, 0 }, { 0, 0, 0 } }));
 }
 
 TEST(vtkFFDVoxelize, OutputFollowsTheDataContract)
@@ -369,19 +444,14 @@ TEST(vtkFFDVoxelize, OutputFollowsTheDataContract)
   voxelize->SetFrameModeToPrincipalAxes();
   voxelize->SetDivisions(3, 5, 2);
   voxelize->Update();
-  vtkStructuredGrid* out = voxelize->GetOutput();
+  vtkUnstructuredGrid* out = voxelize->GetOutput();
 
-  int dims[3];
-  out->GetDimensions(dims);
-  EXPECT_EQ(dims[0], 4);
-  EXPECT_EQ(dims[1], 6);
-  EXPECT_EQ(dims[2], 3);
-  EXPECT_EQ(out->GetNumberOfCells(), 30);
-  EXPECT_EQ(out->GetPoints()->GetDataType(), VTK_DOUBLE);
-  int whole[6];
-  voxelize->GetOutputInformation(0)->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-  EXPECT_EQ(std::vector<int>(whole, whole + 6), (std::vector<int>{ 0, 3, 0, 5, 0, 2 }));
-
+  EXPECT_GT(out->GetNumberOfCells(), 0);
+  EXPECT_LT(out->GetNumberOfCells(), 30); // the elephant leaves voxels empty
+  EXPECT_EQ(out->GetNumberOfCells(), voxelize->GetNumberOfActiveVoxels());
+  EXPECT_NE(vtkIntArray::SafeDownCast(out->GetCellData()->GetAbstractArray(vtkFFDDataContract::VoxelIndexArrayName())),
+    nullptr);
+  EXPECT_FALSE(out->GetCells()->IsStorage64Bit()); // ids that fit 32 bits are stored in 32 bits
   vtkIntArray* divisions =
     vtkIntArray::SafeDownCast(out->GetFieldData()->GetAbstractArray(vtkFFDDataContract::DivisionsArrayName()));
   ASSERT_NE(divisions, nullptr);
@@ -393,21 +463,126 @@ TEST(vtkFFDVoxelize, OutputFollowsTheDataContract)
     vtkDoubleArray::SafeDownCast(out->GetFieldData()->GetAbstractArray(vtkFFDDataContract::FrameArrayName()));
   ASSERT_NE(frame, nullptr);
   ASSERT_EQ(frame->GetNumberOfValues(), 12);
+  ExpectCellsOnTheirCorners(out, voxelize->GetDivisions());
+}
 
-  // Corner (i, j, k) at X0 + (i/nx) S + (j/ny) T + (k/nz) U (equation 1), in VTK order; a few roundings apart.
-  const ffdref::Frame f = FrameOf(out);
-  const std::vector<Vec> expected = ffdref::RestLattice(f, 3, 5, 2);
-  const double scale = Norm(f.X0) + Norm(f.S) + Norm(f.T) + Norm(f.U);
-  ASSERT_EQ(out->GetNumberOfPoints(), static_cast<vtkIdType>(expected.size()));
-  for (vtkIdType id = 0; id < out->GetNumberOfPoints(); ++id)
+TEST(vtkFFDVoxelize, RandomPointsAtFineDivisionsMatchBruteForce)
+{
+  // Points spread over a skewed frame and around it, at divisions where most voxels hold one point or none.
+  const double origin[3] = { 0.5, -1.0, 2.0 }, s[3] = { 2.0, 0.3, -0.1 }, t[3] = { -0.4, 1.5, 0.2 },
+               u[3] = { 0.1, 0.5, 1.2 };
+  std::mt19937 rng(20240917);
+  std::uniform_real_distribution<double> param(-0.05, 1.05);
+  std::vector<Vec> xs(20000);
+  for (Vec& x : xs)
   {
-    double x[3];
-    out->GetPoint(id, x);
-    ASSERT_TRUE(ffdtest::VectorNear(x, expected[id], 1e-15 * scale)) << id;
+    const double a = param(rng), b = param(rng), c = param(rng);
+    for (int k = 0; k < 3; ++k)
+    {
+      x[k] = origin[k] + a * s[k] + b * t[k] + c * u[k];
+    }
   }
-  EXPECT_EQ(vtkUnsignedCharArray::SafeDownCast(out->GetCellData()->GetArray(vtkDataSetAttributes::GhostArrayName()))
-              ->GetNumberOfValues(),
-    30);
+  vtkSmartPointer<vtkPolyData> cloud = PointCloud(xs);
+  vtkNew<vtkFFDVoxelize> voxelize;
+  voxelize->SetFrame(origin, s, t, u);
+  voxelize->SetDivisions(300, 170, 233);
+  ExpectActiveVoxelsMatchBruteForce(cloud, voxelize);
+  EXPECT_GT(voxelize->GetNumberOfActiveVoxels(), 15000); // few points share a voxel: a real test of the order
+}
+
+TEST(vtkFFDVoxelize, SameOutputWhateverTheNumberOfThreads)
+{
+  // The bear at fine divisions and a random cloud: the active sets are merged from per-thread grids, the corners
+  // and cells found by sorting and searching; the output must not depend on how the points were shared out.
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Vec> xs(30000);
+  for (Vec& x : xs)
+  {
+    x = { unit(rng), unit(rng), unit(rng) };
+  }
+  for (vtkSmartPointer<vtkPolyData> input : { ReadTestMesh("bear"), PointCloud(xs) })
+  {
+    std::vector<vtkSmartPointer<vtkUnstructuredGrid>> outputs;
+    for (int threads : { 1, 2 })
+    {
+      vtkSMPTools::Initialize(threads);
+      vtkNew<vtkFFDVoxelize> voxelize;
+      voxelize->SetInputData(input);
+      voxelize->SetDivisions(97, 89, 101);
+      voxelize->Update();
+      outputs.push_back(voxelize->GetOutput());
+    }
+    vtkSMPTools::Initialize(); // back to the default
+    vtkUnstructuredGrid* one = outputs[0];
+    ASSERT_GT(one->GetNumberOfCells(), 1000);
+    for (size_t o = 1; o < outputs.size(); ++o)
+    {
+      vtkUnstructuredGrid* other = outputs[o];
+      ASSERT_EQ(other->GetNumberOfPoints(), one->GetNumberOfPoints());
+      ASSERT_EQ(other->GetNumberOfCells(), one->GetNumberOfCells());
+      EXPECT_EQ(VoxelsOf(other), VoxelsOf(one));
+      for (vtkIdType id = 0; id < one->GetNumberOfPoints(); ++id)
+      {
+        double a[3], b[3];
+        one->GetPoint(id, a);
+        other->GetPoint(id, b);
+        ASSERT_TRUE(ffdtest::VectorEqual(b, a, "corner")) << id;
+      }
+      vtkNew<vtkIdList> a, b;
+      for (vtkIdType c = 0; c < one->GetNumberOfCells(); ++c)
+      {
+        one->GetCellPoints(c, a);
+        other->GetCellPoints(c, b);
+        for (vtkIdType k = 0; k < 8; ++k)
+        {
+          ASSERT_EQ(b->GetId(k), a->GetId(k)) << "cell " << c;
+        }
+      }
+    }
+  }
+}
+
+TEST(vtkFFDVoxelize, DivisionsOf1024CubedCostWhatTheActiveVoxelsCost)
+{
+  // A dense grid of 1024^3 voxels would need 1025^3 corners, 25 GB; the sparse one holds the bear's voxels.
+  vtkSmartPointer<vtkPolyData> bear = ReadTestMesh("bear");
+  vtkNew<vtkFFDVoxelize> voxelize;
+  voxelize->SetDivisions(1024, 1024, 1024);
+  const auto begin = std::chrono::steady_clock::now();
+  ExpectActiveVoxelsMatchBruteForce(bear, voxelize);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  vtkUnstructuredGrid* out = voxelize->GetOutput();
+  const double voxels = double(out->GetNumberOfCells()), corners = double(out->GetNumberOfPoints());
+  const double bytes = 1024.0 * double(out->GetActualMemorySize());
+  std::cout << "bear at 1024^3: " << voxels << " active voxels, " << corners << " corners, " << bytes / 1e6 << " MB, "
+            << seconds << " s with the brute-force check\n";
+  // Per voxel its VoxelIndex (12 bytes), 8 point ids, an offset and a type (37 in 32 bits); 24 bytes a corner;
+  // at most 8 corners a voxel. 64 KB for the arrays' and the field data's fixed parts.
+  EXPECT_LE(corners, 8.0 * voxels);
+  EXPECT_LE(bytes, 64.0 * voxels + 32.0 * corners + 65536.0);
+  EXPECT_LT(seconds, 5.0);
+}
+
+TEST(vtkFFDVoxelize, NoActiveVoxelGivesAGridWithItsFrameOnly)
+{
+  // Every point outside the explicit frame: no cell, no point, but the frame and divisions for the lattice.
+  vtkSmartPointer<vtkPolyData> cloud = PointCloud({ { 5, 5, 5 }, { 6, 6, 6 } });
+  const double o[3] = { 0, 0, 0 }, s[3] = { 1, 0, 0 }, t[3] = { 0, 1, 0 }, u[3] = { 0, 0, 1 };
+  vtkNew<vtkFFDVoxelize> voxelize;
+  voxelize->SetInputData(cloud);
+  voxelize->SetFrame(o, s, t, u);
+  vtkNew<FFDTestErrorObserver> observer;
+  EXPECT_EQ(RunPipeline(voxelize, observer), 1);
+  EXPECT_EQ(observer->Errors, "");
+  vtkUnstructuredGrid* out = voxelize->GetOutput();
+  EXPECT_EQ(out->GetNumberOfCells(), 0);
+  EXPECT_EQ(out->GetNumberOfPoints(), 0);
+  EXPECT_EQ(voxelize->GetNumberOfActiveVoxels(), 0);
+  int divisions[3];
+  EXPECT_TRUE(vtkFFDDataContract::GetDivisions(out, divisions));
+  const ffdref::Frame unit = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+  EXPECT_TRUE(ffdtest::FramesEqual(FrameOf(out), unit));
 }
 
 TEST(vtkFFDVoxelize, NonFinitePointsAreIgnored)
@@ -474,6 +649,15 @@ TEST(vtkFFDVoxelize, DivisionsBelowOneAreAnError)
     voxelize->SetDivisions(n[0], n[1], n[2]);
     ExpectFailure(voxelize, cloud, "must be at least 1");
   }
+}
+
+TEST(vtkFFDVoxelize, DivisionsBeyondA64BitIndexAreAnError)
+{
+  // Voxels and corners are found by their linear index, an int64: (2^31)^2 * 3 corners overflow it.
+  vtkSmartPointer<vtkPolyData> cloud = PointCloud({ { 0, 0, 0 }, { 1, 1, 1 } });
+  vtkNew<vtkFFDVoxelize> voxelize;
+  voxelize->SetDivisions(VTK_INT_MAX, VTK_INT_MAX, 2);
+  ExpectFailure(voxelize, cloud, "64-bit index");
 }
 
 TEST(vtkFFDVoxelize, BadExplicitFramesAreAnError)

@@ -22,6 +22,7 @@ int main()
   vtkNew<vtkFFDBuildLattice> build;
   build->SetInputConnection(voxelize->GetOutputPort());
   build->SetBasisToTrilinear();
+  build->SetLatticeFormToDense();
   build->Update();
   vtkNew<vtkStructuredGrid> lattice;
   lattice->DeepCopy(build->GetOutput());

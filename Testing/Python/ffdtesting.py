@@ -42,8 +42,9 @@ def bbox_diagonal(points):
 
 def build_lattice(source, divisions, basis=None):
     """vtkFFDVoxelize of `source` (a data set, or an algorithm's output port) into `divisions` voxels, then
-    vtkFFDBuildLattice (of `basis`, or its default basis), updated; returns (voxelize, build, lattice), the lattice a
-    deep copy of the builder's output for the test to move (the filters keep their own output)."""
+    vtkFFDBuildLattice (of `basis`, or its default basis) in the dense form, updated; returns (voxelize, build,
+    lattice), the lattice a deep copy of the builder's output for the test to move (the filters keep their own
+    output)."""
     voxelize = vtkffd.vtkFFDVoxelize()
     if isinstance(source, vtkAlgorithmOutput):
         voxelize.SetInputConnection(source)
@@ -54,6 +55,7 @@ def build_lattice(source, divisions, basis=None):
     build.SetInputConnection(voxelize.GetOutputPort())
     if basis is not None:
         build.SetBasis(basis)
+    build.SetLatticeFormToDense()  # the grid that the tests index and vtkFFDDeform reads
     build.Update()
     lattice = vtkStructuredGrid()
     lattice.DeepCopy(build.GetOutput())

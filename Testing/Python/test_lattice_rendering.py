@@ -81,38 +81,42 @@ class LatticeActorTest(unittest.TestCase):
         lines = [d for d in part_inputs(actor) if d.GetNumberOfLines() > 0][0]
         self.assertEqual(lines.GetPoint(7), (2.0, 2.0, 2.0))
 
-    def test_voxel_boxes_skip_hidden_voxels(self):
+    def test_voxel_boxes_are_the_active_voxels(self):
         voxelize, build, lattice = sphere_lattice()
         voxelize.Update()
         grid = voxelize.GetOutput()
         active = voxelize.GetNumberOfActiveVoxels()
         self.assertLess(active, 125)  # the sphere leaves the corner and inner voxels empty
+        self.assertEqual(grid.GetNumberOfCells(), active)  # the voxel grid holds the active voxels only
         edges = vtkffd.vtkFFDCellEdges()
         edges.SetInputData(grid)
         edges.Update()
-        # Reference: the unique edges of the visible hexahedra, from the structured indices.
+        # Reference: the unique edges of the active voxels, from their VoxelIndex, as pairs of corners.
         unique = set()
-        for k in range(5):
-            for j in range(5):
-                for i in range(5):
-                    if not grid.IsCellVisible(i + 5 * (j + 5 * k)):
-                        continue
-                    for a in range(8):
-                        for axis in range(3):
-                            c = [i + (a & 1), j + ((a >> 1) & 1), k + ((a >> 2) & 1)]
-                            if c[axis] == [i, j, k][axis] + 1:
-                                continue
-                            d = list(c)
-                            d[axis] += 1
-                            unique.add((c[0] + 6 * (c[1] + 6 * c[2]), d[0] + 6 * (d[1] + 6 * d[2])))
+        for i, j, k in vtk_to_numpy(grid.GetCellData().GetArray("VoxelIndex")):
+            for a in range(8):
+                c = (i + (a & 1), j + ((a >> 1) & 1), k + ((a >> 2) & 1))
+                for axis in range(3):
+                    if c[axis] == (i, j, k)[axis]:
+                        d = list(c)
+                        d[axis] += 1
+                        unique.add((c, tuple(d)))
         self.assertEqual(edges.GetOutput().GetNumberOfLines(), len(unique))
-        # Every cell visible: the full 5x5x5 grid's 3 * 5 * 6 * 6 edges.
-        unhidden = vtkStructuredGrid()
-        unhidden.SetDimensions(6, 6, 6)
-        unhidden.SetPoints(grid.GetPoints())
-        edges.SetInputData(unhidden)
+
+        # Hidden cells are skipped: the full 5x5x5 grid's 3 * 5 * 6 * 6 edges, and fewer with a hidden corner cell.
+        full = vtkStructuredGrid()
+        full.SetDimensions(6, 6, 6)
+        corners = vtkPoints()
+        corners.SetData(numpy_to_vtk(np.array([[i, j, k] for k in range(6) for j in range(6) for i in range(6)],
+                                              dtype=float), deep=True))
+        full.SetPoints(corners)
+        edges.SetInputData(full)
         edges.Update()
         self.assertEqual(edges.GetOutput().GetNumberOfLines(), 3 * 5 * 6 * 6)
+        full.BlankCell(0)
+        full.Modified()
+        edges.Update()
+        self.assertEqual(edges.GetOutput().GetNumberOfLines(), 3 * 5 * 6 * 6 - 3)  # its edges on the grid's corner
 
         actor = vtkffd.vtkFFDLatticeActor()
         actor.SetInputData(lattice)

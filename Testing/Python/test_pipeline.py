@@ -165,30 +165,41 @@ class TestPipeline(unittest.TestCase):
         self.assertTrue(any(needle in message for message in errors.messages), errors.messages)
         self.assertEqual(algorithm.GetOutputDataObject(0).GetNumberOfPoints(), 0)
 
-    def test_sizes_that_no_memory_holds_are_errors(self):
-        # The issue's abort: a voxel grid far beyond any machine's memory is refused before anything is
-        # allocated, with what it needs; the interpreter goes on, and the filter works again with sane sizes.
-        for divisions in [(100000, 100000, 100000), (2**31 - 1, 2**31 - 1, 1)]:
-            self.voxelize.SetDivisions(*divisions)
-            self.expect_error(self.voxelize, "of memory, but only")
+    def test_memory_follows_the_active_voxels(self):
+        # The issue's abort: divisions of 100000^3 once asked for a dense voxel grid beyond any machine's memory.
+        # The voxel grid and a sparse lattice now hold the active voxels only; a dense lattice of that size is
+        # still refused before anything is allocated, with what it needs. The interpreter goes on.
+        self.voxelize.SetDivisions(100000, 100000, 100000)
+        self.voxelize.Update()
+        active = self.voxelize.GetNumberOfActiveVoxels()
+        self.assertEqual(self.voxelize.GetOutput().GetNumberOfCells(), active)
+        self.assertLessEqual(active, self.mesh.GetNumberOfPoints())
+        build = vtkffd.vtkFFDBuildLattice()
+        build.SetInputConnection(self.voxelize.GetOutputPort())
+        build.SetBasisToTrilinear()
+        build.Update()
+        self.assertGreater(build.GetOutput().GetNumberOfPoints(), active)  # sparse: the active voxels' corners
+        self.voxelize.SetDivisions(1200, 1200, 1200)
+        build.SetLatticeFormToDense()  # 1201^3 control points, 86 GB
+        self.expect_error(build, "of memory, but only")
+        # Voxels and corners are indexed by int64: (2^31)^2 * 2 corners are beyond it.
+        self.voxelize.SetDivisions(2**31 - 1, 2**31 - 1, 1)
+        self.expect_error(self.voxelize, "64-bit index")
         self.voxelize.SetDivisions(2, 3, 4)
         self.voxelize.Update()
-        self.assertEqual(self.voxelize.GetOutput().GetNumberOfCells(), 24)
+        self.assertEqual(self.voxelize.GetNumberOfActiveVoxels(), self.voxelize.GetOutput().GetNumberOfCells())
 
     @unittest.skipIf("LD_PRELOAD" in os.environ, "the sanitizers' runtime reserves more address space than the limit")
     def test_an_allocation_that_fails_is_an_error_not_an_abort(self):
-        # Under an address-space limit of 512 MB above what the interpreter has mapped, divisions that the
-        # machine's memory would hold (1.3 GB of corners estimated) cannot be allocated: VTK throws std::bad_alloc, which the filter turns into an error
-        # and an empty output. In a child process, so that the limit stays there; before the fix the child died
-        # of SIGABRT.
+        # Under an address-space limit of 512 MB above what the interpreter has mapped, a dense lattice that the
+        # machine's memory would hold (1.4 GB estimated for 301^3 control points) cannot be allocated: VTK throws
+        # std::bad_alloc, which the filter turns into an error and an empty output. In a child process, so that the
+        # limit stays there; before the fix the child died of SIGABRT.
         script = """
 import resource, sys
 import vtkffd
 from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkCommonCore import vtkPoints
-size = next(int(line.split()[1]) for line in open("/proc/self/status") if line.startswith("VmSize:"))
-limit = size * 1024 + (512 << 20)
-resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 points = vtkPoints()
 points.InsertNextPoint(0, 0, 0)
 points.InsertNextPoint(1, 1, 1)
@@ -196,17 +207,25 @@ cloud = vtkPolyData()
 cloud.SetPoints(points)
 voxelize = vtkffd.vtkFFDVoxelize()
 voxelize.SetInputData(cloud)
-voxelize.SetDivisions(380, 380, 380)
+voxelize.SetDivisions(300, 300, 300)
+voxelize.Update()
+build = vtkffd.vtkFFDBuildLattice()
+build.SetInputConnection(voxelize.GetOutputPort())
+build.SetBasisToTrilinear()
+build.SetLatticeFormToDense()
 messages = []
 class Catcher:
     CallDataType = "string0"
     def __call__(self, caller, event, message):
         messages.append(message)
 catcher = Catcher()
-voxelize.AddObserver("ErrorEvent", catcher)
-voxelize.GetExecutive().AddObserver("ErrorEvent", Catcher())
-status = voxelize.GetExecutive().Update()
-print(status, voxelize.GetOutput().GetNumberOfPoints(), any("Out of memory" in m for m in messages))
+build.AddObserver("ErrorEvent", catcher)
+build.GetExecutive().AddObserver("ErrorEvent", Catcher())
+size = next(int(line.split()[1]) for line in open("/proc/self/status") if line.startswith("VmSize:"))
+limit = size * 1024 + (512 << 20)
+resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+status = build.GetExecutive().Update()
+print(status, build.GetOutput().GetNumberOfPoints(), any("Out of memory" in m for m in messages))
 """
         import subprocess
         import sys

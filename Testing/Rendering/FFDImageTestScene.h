@@ -32,6 +32,7 @@
 #include "vtkSmartPointer.h"
 #include "vtkStructuredGrid.h"
 #include "vtkTesting.h"
+#include "vtkUnstructuredGrid.h"
 
 #include <algorithm>
 #include <cmath>
@@ -42,8 +43,8 @@
 struct FFDTestLattice
 {
   vtkSmartPointer<vtkStructuredGrid> Grid;
-  vtkSmartPointer<vtkStructuredGrid> VoxelGrid; ///< vtkFFDVoxelize's output: inactive voxels hidden
-  double Frame[12];                             ///< X0, S, T, U
+  vtkSmartPointer<vtkUnstructuredGrid> VoxelGrid; ///< vtkFFDVoxelize's output: the active voxels
+  double Frame[12];                               ///< X0, S, T, U
   int Divisions[3];
   int Dims[3]; ///< control points per axis
   vtkIdType ActiveVoxels = 0;
@@ -78,11 +79,12 @@ inline bool BuildTestLattice(
   vtkNew<vtkFFDBuildLattice> build;
   build->SetInputConnection(voxelize->GetOutputPort());
   build->SetBasis(basis);
+  build->SetLatticeFormToDense(); // indexed as a grid (Id()); vtkFFDLatticeActor draws the dense form
   build->Update();
   lattice.Grid = vtkSmartPointer<vtkStructuredGrid>::New();
   lattice.Grid->DeepCopy(build->GetOutput());
   lattice.Grid->GetDimensions(lattice.Dims);
-  lattice.VoxelGrid = vtkSmartPointer<vtkStructuredGrid>::New();
+  lattice.VoxelGrid = vtkSmartPointer<vtkUnstructuredGrid>::New();
   lattice.VoxelGrid->DeepCopy(voxelize->GetOutput());
   std::copy(divisions, divisions + 3, lattice.Divisions);
   lattice.ActiveVoxels = voxelize->GetNumberOfActiveVoxels();
