@@ -21,7 +21,7 @@
 
 struct vtkFFDActiveSet::Internals
 {
-  openvdb::MaskTree Tree;
+  std::shared_ptr<openvdb::MaskTree> Tree = std::make_shared<openvdb::MaskTree>();
 };
 
 namespace
@@ -172,17 +172,26 @@ void vtkFFDActiveSet::Mark(vtkIdType n, const std::function<void(vtkIdType, vtkI
       body(begin, end, marker);
     });
   // A set union: the same set whatever the threads and their order. It runs TBB tasks of its own, so it is
-  // made here rather than in the vtkSMPTools body.
-  for (const std::shared_ptr<MaskTree>& tree : trees)
+  // made here rather than in the vtkSMPTools body. The first tree is taken rather than copied into an empty one,
+  // and each is freed once merged: the peak is the threads' trees and what the union adds to the first.
+  for (std::shared_ptr<MaskTree>& tree : trees)
   {
-    this->Internal->Tree.topologyUnion(*tree);
+    if (this->Internal->Tree->empty())
+    {
+      std::swap(this->Internal->Tree, tree);
+    }
+    else
+    {
+      this->Internal->Tree->topologyUnion(*tree);
+    }
+    tree.reset();
   }
 }
 
 //------------------------------------------------------------------------------------------------------------
 vtkIdType vtkFFDActiveSet::GetNumberOfMarked() const
 {
-  return vtkIdType(this->Internal->Tree.activeVoxelCount());
+  return vtkIdType(this->Internal->Tree->activeVoxelCount());
 }
 
 //------------------------------------------------------------------------------------------------------------
@@ -190,7 +199,7 @@ std::vector<vtkTypeInt64> vtkFFDActiveSet::TakeSortedIndices(const vtkTypeInt64 
 {
   // Marking sets single voxels, and the union of leaves keeps leaves: the tree has no active tiles, and its leaves
   // hold every marked coordinate. Each leaf writes its own range of the result.
-  const MaskTree& tree = this->Internal->Tree;
+  const MaskTree& tree = *this->Internal->Tree;
   std::vector<const MaskTree::LeafNodeType*> leaves;
   leaves.reserve(tree.leafCount());
   tree.getNodes(leaves);
@@ -213,7 +222,7 @@ std::vector<vtkTypeInt64> vtkFFDActiveSet::TakeSortedIndices(const vtkTypeInt64 
         }
       }
     });
-  this->Internal->Tree.clear();
+  this->Internal->Tree->clear();
   vtkSMPTools::Sort(indices.begin(), indices.end());
   return indices;
 }
