@@ -19,10 +19,10 @@
  *   the control points of the voxel's support: VTK_HEXAHEDRON (TRILINEAR), VTK_BEZIER_HEXAHEDRON of 27 or 64
  *   points in VTK's order (the Bezier sub-regions, which VTK and ParaView draw as the sub-regions themselves) and
  *   VTK_POLY_VERTEX of 64 points, i fastest (CUBIC_BSPLINE, which has no VTK cell type). Its memory and time
- *   follow the active voxels and control points (about 70 bytes a control point and 4 to 8 bytes a cell's point),
- *   never nI*nJ*nK, so lattices over 1024^3 voxels and beyond are cheap over a small mesh: the union of the
- *   supports is found in parallel with OpenVDB and the cells' point ids by binary search in it (the same output
- *   whatever the number of threads).
+ *   follow the active voxels and control points (61 bytes a control point and 4 bytes a cell's point, 8 where ids
+ *   pass 2^31), never nI*nJ*nK, so lattices over 1024^3 voxels and beyond are cheap over a small mesh: the union
+ *   of the supports is found in parallel with OpenVDB and the cells' point ids by binary search in it (the same
+ *   output whatever the number of threads).
  * - AUTOMATIC (the default): SPARSE for the local bases, whose memory then follows the mesh rather than the
  *   divisions, and DENSE for BERNSTEIN, whose every control point influences every voxel. A user who indexes the
  *   lattice as a grid (numpy's reshape(nK, nJ, nI, 3), i + nI*(j + nJ*k)) asks for SetLatticeFormToDense().
