@@ -3,7 +3,8 @@
 // dimensions and rest positions against the formulas of the paper, culling by support against a brute force
 // on hand-made grids and real meshes, the figure-caption statistics, the data contract, and every bad input;
 // the sparse form against the dense one (bit for bit) and the supports written from their definitions, its cells
-// as VTK evaluates and draws them, its independence of the number of threads, and its cost at 1024^3 voxels.
+// as VTK evaluates and draws them, its independence of the number of threads, its cost at 1024^3 voxels, and the
+// two forms deforming a mesh alike.
 #include "vtkFFDBuildLattice.h"
 
 #include "vtkCellArray.h"
@@ -14,6 +15,7 @@
 #include "vtkDoubleArray.h"
 #include "vtkExecutive.h"
 #include "vtkFFDDataContract.h"
+#include "vtkFFDDeform.h"
 #include "vtkFFDVoxelize.h"
 #include "vtkFieldData.h"
 #include "vtkGenericCell.h"
@@ -1161,5 +1163,58 @@ TEST(vtkFFDBuildLattice, PipelineExecutesOnlyWhenSomethingChanged)
     EXPECT_EQ(divisions[0], 5);
     EXPECT_EQ(build->GetOutput()->GetNumberOfPoints() > 0, true);
     voxelize->SetDivisions(4, 5, 6);
+  }
+}
+
+TEST(vtkFFDBuildLattice, SparseAndDenseLatticesDeformAlike)
+{
+  // The whole pipeline in either form: both lattices moved by the same function of their rest positions,
+  // vtkFFDDeform gives the mesh the same coordinates, bit for bit, from the sparse lattice as from the dense one.
+  vtkSmartPointer<vtkPolyData> bear = ReadTestMesh("bear");
+  vtkNew<vtkFFDVoxelize> voxelize;
+  voxelize->SetInputData(bear);
+  voxelize->SetDivisions(6, 5, 7);
+  for (int basis : LocalBases)
+  {
+    SCOPED_TRACE(vtkFFDBuildLattice::GetBasisAsString(basis));
+    std::vector<vtkSmartPointer<vtkPointSet>> deformed;
+    for (int form : { vtkFFDBuildLattice::DENSE, vtkFFDBuildLattice::SPARSE })
+    {
+      vtkNew<vtkFFDBuildLattice> build;
+      build->SetInputConnection(voxelize->GetOutputPort());
+      build->SetBasis(basis);
+      build->SetLatticeForm(form);
+      build->Update();
+      vtkSmartPointer<vtkPointSet> lattice = vtk::TakeSmartPointer(build->GetOutput()->NewInstance());
+      lattice->DeepCopy(build->GetOutput());
+      vtkDataArray* rest = lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
+      ASSERT_NE(rest, nullptr);
+      for (vtkIdType id = 0; id < lattice->GetNumberOfPoints(); ++id)
+      {
+        double r[3];
+        rest->GetTuple(id, r);
+        lattice->GetPoints()->SetPoint(id, r[0] + 0.02 * std::sin(7.0 * r[1]), r[1] + 0.03 * std::cos(5.0 * r[2]),
+          r[2] + 0.02 * std::sin(3.0 * r[0]));
+      }
+      vtkNew<vtkFFDDeform> deform;
+      deform->SetInputData(bear);
+      deform->SetLatticeData(lattice);
+      vtkNew<FFDTestErrorObserver> observer;
+      observer->WatchWithExecutive(deform);
+      ASSERT_EQ(deform->GetExecutive()->Update(), 1) << observer->Errors;
+      deformed.push_back(vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0)));
+    }
+    ASSERT_EQ(deformed[1]->GetNumberOfPoints(), bear->GetNumberOfPoints());
+    double moved = 0.0;
+    for (vtkIdType id = 0; id < bear->GetNumberOfPoints(); ++id)
+    {
+      double x[3], y[3], z[3];
+      deformed[0]->GetPoint(id, x);
+      deformed[1]->GetPoint(id, y);
+      bear->GetPoint(id, z);
+      ASSERT_TRUE(ffdtest::VectorEqual(y, x, "deformed point")) << id;
+      moved = std::max({ moved, std::fabs(x[0] - z[0]), std::fabs(x[1] - z[1]), std::fabs(x[2] - z[2]) });
+    }
+    EXPECT_GT(moved, 1e-3); // the lattices really moved the mesh
   }
 }

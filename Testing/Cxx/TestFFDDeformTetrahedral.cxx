@@ -764,7 +764,6 @@ TEST(vtkFFDDeformTetrahedral, ExtrapolateNeedsATetrahedralLattice)
   vtkNew<vtkFFDBuildLattice> build;
   build->SetInputConnection(voxelize->GetOutputPort());
   build->SetBasisToTrilinear();
-  build->SetLatticeFormToDense();
   vtkNew<FFDTestErrorObserver> observer;
   vtkNew<vtkFFDDeform> deform;
   observer->WatchWithExecutive(deform);
