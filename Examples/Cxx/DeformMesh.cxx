@@ -235,7 +235,7 @@ int main(int argc, char* argv[])
   vtkNew<vtkFFDBuildLattice> build;
   build->SetInputConnection(voxelize->GetOutputPort());
   build->SetBasis(basis);
-  build->SetLatticeFormToDense(); // the form vtkFFDDeform and vtkFFDLatticeActor read
+  build->SetLatticeFormToDense(); // the form vtkFFDLatticeActor draws
   build->Update();
   vtkStructuredGrid* restLattice = build->GetStructuredGridOutput();
   if (restLattice->GetNumberOfPoints() == 0)

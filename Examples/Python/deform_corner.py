@@ -102,7 +102,7 @@ def main():
     build = vtkffd.vtkFFDBuildLattice()
     build.SetInputConnection(voxelize.GetOutputPort())
     getattr(build, BASES[arguments.basis])()
-    build.SetLatticeFormToDense()  # the form vtkFFDDeform and vtkFFDLatticeActor read
+    build.SetLatticeFormToDense()  # a grid: raise_arm() reshapes it
     build.Update()
     rest_lattice = build.GetOutput()
     if rest_lattice.GetNumberOfPoints() == 0:

@@ -177,7 +177,7 @@ def main():
     build = vtkffd.vtkFFDBuildLattice()
     build.SetInputConnection(voxelize.GetOutputPort())
     getattr(build, BASES[arguments.basis])()
-    build.SetLatticeFormToDense()  # the form vtkFFDDeform and vtkFFDLatticeActor read
+    build.SetLatticeFormToDense()  # a grid, reshaped below, which vtkFFDLatticeActor draws
     build.Update()
     if build.GetOutput().GetNumberOfPoints() == 0:
         sys.exit("the lattice could not be built (see the errors above)")

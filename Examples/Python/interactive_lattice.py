@@ -58,7 +58,7 @@ def build_scene(mesh, basis):
     build = vtkffd.vtkFFDBuildLattice()
     build.SetInputConnection(voxelize.GetOutputPort())
     getattr(build, BASES[basis])()
-    build.SetLatticeFormToDense()  # the form vtkFFDDeform and the widget read
+    build.SetLatticeFormToDense()  # the form the widget draws and drags
     build.Update()
     lattice = vtkStructuredGrid()  # our own copy: the widget moves its points in place
     lattice.DeepCopy(build.GetOutput())

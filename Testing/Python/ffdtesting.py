@@ -55,7 +55,7 @@ def build_lattice(source, divisions, basis=None):
     build.SetInputConnection(voxelize.GetOutputPort())
     if basis is not None:
         build.SetBasis(basis)
-    build.SetLatticeFormToDense()  # the grid that the tests index and vtkFFDDeform reads
+    build.SetLatticeFormToDense()  # the grid that the tests index
     build.Update()
     lattice = vtkStructuredGrid()
     lattice.DeepCopy(build.GetOutput())
