@@ -5,22 +5,67 @@
 #include "vtkCellArray.h"
 #include "vtkDataSet.h"
 #include "vtkDataSetAttributes.h"
+#include "vtkFFDDataContract.h"
 #include "vtkGenericCell.h"
 #include "vtkIdList.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkIntArray.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
+#include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
-#include <set>
 #include <utility>
+#include <vector>
 
 vtkStandardNewMacro(vtkFFDCellEdges);
+
+namespace
+{
+/// The control net of a sparse lattice: addEdge(a, b) for each two points whose LatticeIndex differ by one along
+/// one axis, found by binary search among the points' indices (linear over the largest index plus one).
+template <typename AddEdge>
+void AddControlNet(vtkIntArray* latticeIndex, AddEdge&& addEdge)
+{
+  const vtkIdType n = latticeIndex->GetNumberOfTuples();
+  const int* index = latticeIndex->GetPointer(0);
+  vtkTypeInt64 extent[3] = { 1, 1, 1 };
+  for (vtkIdType p = 0; p < n; ++p)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      extent[a] = std::max<vtkTypeInt64>(extent[a], vtkTypeInt64(index[3 * p + a]) + 2);
+    }
+  }
+  auto key = [&](const int* ijk)
+  { return ijk[0] + extent[0] * (vtkTypeInt64(ijk[1]) + extent[1] * vtkTypeInt64(ijk[2])); };
+  std::vector<std::pair<vtkTypeInt64, vtkIdType>> sorted(static_cast<size_t>(n));
+  for (vtkIdType p = 0; p < n; ++p)
+  {
+    sorted[p] = { key(index + 3 * p), p };
+  }
+  std::sort(sorted.begin(), sorted.end());
+  for (vtkIdType p = 0; p < n; ++p)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      int next[3] = { index[3 * p], index[3 * p + 1], index[3 * p + 2] };
+      ++next[a];
+      const vtkTypeInt64 k = key(next);
+      const auto at = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(k, vtkIdType(0)));
+      if (at != sorted.end() && at->first == k)
+      {
+        addEdge(p, at->second);
+      }
+    }
+  }
+}
+} // namespace
 
 //------------------------------------------------------------------------------
 int vtkFFDCellEdges::FillInputPortInformation(int, vtkInformation* info)
@@ -64,16 +109,22 @@ int vtkFFDCellEdges::RequestData(
     output->SetPoints(points);
   }
 
-  // Unique edges, ordered by their point ids so that the output does not depend on hashing. A set is enough:
-  // lattices and voxel grids have thousands of cells, not millions.
-  std::set<std::pair<vtkIdType, vtkIdType>> edges;
+  // Edges as pairs of point ids, sorted and made unique at the end: the output does not depend on hashing.
+  std::vector<std::pair<vtkIdType, vtkIdType>> edges;
   auto addEdge = [&edges](vtkIdType a, vtkIdType b)
   {
     if (a != b)
     {
-      edges.emplace(std::min(a, b), std::max(a, b));
+      edges.emplace_back(std::min(a, b), std::max(a, b));
     }
   };
+  vtkIntArray* latticeIndex =
+    vtkIntArray::SafeDownCast(input->GetPointData()->GetArray(vtkFFDDataContract::LatticeIndexArrayName()));
+  if (latticeIndex && latticeIndex->GetNumberOfComponents() == 3 && latticeIndex->GetNumberOfTuples() == numberOfPoints)
+  {
+    AddControlNet(latticeIndex, addEdge);
+    return this->Finish(edges, output);
+  }
   vtkUnsignedCharArray* ghosts = input->GetCellGhostArray();
   const vtkIdType numberOfCells = input->GetNumberOfCells();
   if (ghosts && ghosts->GetNumberOfValues() != numberOfCells)
@@ -85,6 +136,7 @@ int vtkFFDCellEdges::RequestData(
   }
   vtkNew<vtkGenericCell> cell;
   vtkNew<vtkIdList> ids;
+  edges.reserve(static_cast<size_t>(numberOfCells) * 12);
   for (vtkIdType cellId = 0; cellId < numberOfCells; ++cellId)
   {
     if (ghosts && (ghosts->GetValue(cellId) & vtkDataSetAttributes::HIDDENCELL))
@@ -120,6 +172,14 @@ int vtkFFDCellEdges::RequestData(
     }
   }
 
+  return this->Finish(edges, output);
+}
+
+//------------------------------------------------------------------------------
+int vtkFFDCellEdges::Finish(std::vector<std::pair<vtkIdType, vtkIdType>>& edges, vtkPolyData* output)
+{
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
   vtkNew<vtkCellArray> lines;
   lines->AllocateExact(static_cast<vtkIdType>(edges.size()), 2 * static_cast<vtkIdType>(edges.size()));
   for (const auto& edge : edges)

@@ -13,6 +13,11 @@
  * vertices give nothing. Unlike vtkExtractEdges of VTK 9.1, it skips hidden cells, which a data set whose hidden
  * cells must not be drawn needs.
  *
+ * A sparse lattice (a `LatticeIndex` point array, README "Data contract") gives its control net instead of its
+ * cells' edges: a line between each two control points whose lattice indices differ by one along one axis, the
+ * grid lines a dense lattice shows, where both points exist. (Its cells' edges would show a Bezier sub-region's
+ * corners only, and a B-spline's cells, sets of points, have none.)
+ *
  * @sa vtkFFDLatticeActor vtkFFDVoxelize vtkExtractEdges
  */
 #ifndef vtkFFDCellEdges_h
@@ -20,6 +25,9 @@
 
 #include "vtkFFDRenderingModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
+
+#include <utility> // For std::pair
+#include <vector>  // For std::vector
 
 class VTKFFDRENDERING_EXPORT vtkFFDCellEdges : public vtkPolyDataAlgorithm
 {
@@ -36,6 +44,9 @@ protected:
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
 private:
+  /// The edges, sorted and each once, as the output's lines.
+  static int Finish(std::vector<std::pair<vtkIdType, vtkIdType>>& edges, vtkPolyData* output);
+
   vtkFFDCellEdges(const vtkFFDCellEdges&) = delete;
   void operator=(const vtkFFDCellEdges&) = delete;
 };

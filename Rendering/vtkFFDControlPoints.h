@@ -3,7 +3,7 @@
  * @class   vtkFFDControlPoints
  * @brief   the control points of a lattice as vertices, active or culled ones, with their displacement length
  *
- * Turns a control lattice (any vtkPointSet: the vtkStructuredGrid of vtkFFDBuildLattice, or a vtkUnstructuredGrid
+ * Turns a control lattice (any vtkPointSet: vtkFFDBuildLattice's dense or sparse form, or a vtkUnstructuredGrid
  * of tetrahedra that keeps the same point arrays) into a vtkPolyData of vertices, one per selected control
  * point, for glyphing and picking:
  * - SelectionToActive() keeps the points whose `Active` value is not 0, SelectionToCulled() those whose value

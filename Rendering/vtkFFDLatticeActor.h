@@ -3,15 +3,15 @@
  * @class   vtkFFDLatticeActor
  * @brief   draws a free-form deformation lattice: control points, lattice edges and active voxels
  *
- * A vtkAssembly of up to four parts that show a control lattice (the dense vtkStructuredGrid from
- * vtkFFDBuildLattice, as it is or deformed by moving its points, or a vtkUnstructuredGrid of tetrahedra with
- * the same point arrays) and, optionally, the voxel grid it was built over:
+ * A vtkAssembly of up to four parts that show a control lattice (vtkFFDBuildLattice's dense vtkStructuredGrid
+ * or sparse vtkUnstructuredGrid, as it is or deformed by moving its points, or a vtkUnstructuredGrid of
+ * tetrahedra with the same point arrays) and, optionally, the voxel grid it was built over:
  * - the active control points, as sphere glyphs, red by default (GetPointProperty()), or coloured by how far
  *   they have been moved from their `RestPosition` (ColorByDisplacement);
  * - the culled control points (`Active` 0: they influence no active voxel, paper section III.D), as light
  *   grey spheres of the same size (GetCulledPointProperty(); ShowCulledPoints off hides them);
- * - the lattice edges, the edges of the lattice's cells (grid lines of a structured lattice, tetrahedron
- *   edges of an unstructured one), dark grey lines of width 2 (GetEdgeProperty());
+ * - the lattice edges (vtkFFDCellEdges: grid lines of a dense lattice, the control net of a sparse one,
+ *   tetrahedron edges of a tetrahedral one), dark grey lines of width 2 (GetEdgeProperty());
  * - the active voxels as wireframe boxes, when a voxel grid from vtkFFDVoxelize is set (SetVoxelGridData() or
  *   SetVoxelGridConnection()): its cells are the active voxels (hidden cells of another data set are not
  *   drawn); steel blue lines of width 1 by default (GetVoxelProperty()). The boxes stay where the voxel grid

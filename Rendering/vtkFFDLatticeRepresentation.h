@@ -47,7 +47,7 @@ public:
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
   ///@{
-  /// The lattice whose points are moved in place (a vtkStructuredGrid from vtkFFDBuildLattice, or any
+  /// The lattice whose points are moved in place (vtkFFDBuildLattice's dense or sparse form, or any
   /// vtkPointSet that keeps the data contract). Setting one clears the selection.
   void SetLattice(vtkPointSet* lattice);
   vtkGetObjectMacro(Lattice, vtkPointSet);

@@ -125,6 +125,41 @@ class LatticeActorTest(unittest.TestCase):
         actor.SetVoxelGridData(None)
         self.assertEqual(len(part_inputs(actor)), 3)
 
+    def test_sparse_lattice_draws_its_control_net(self):
+        # Every local basis: the sparse lattice's edges are the lines between its control points one lattice step
+        # apart (reference: pairs of LatticeIndex from numpy), the control points are all drawn active, and the
+        # edges follow a moved point.
+        sphere = vtkSphereSource()
+        sphere.SetThetaResolution(24)
+        sphere.SetPhiResolution(16)
+        for basis in (vtkffd.vtkFFDBuildLattice.TRILINEAR, vtkffd.vtkFFDBuildLattice.TRIQUADRATIC_BEZIER,
+                      vtkffd.vtkFFDBuildLattice.TRICUBIC_BEZIER, vtkffd.vtkFFDBuildLattice.CUBIC_BSPLINE):
+            voxelize = vtkffd.vtkFFDVoxelize()
+            voxelize.SetInputConnection(sphere.GetOutputPort())
+            voxelize.SetDivisions(5, 5, 5)
+            build = vtkffd.vtkFFDBuildLattice()
+            build.SetInputConnection(voxelize.GetOutputPort())
+            build.SetBasis(basis)
+            build.Update()
+            lattice = vtkUnstructuredGrid()
+            lattice.DeepCopy(build.GetOutputDataObject(0))
+            index = vtk_to_numpy(lattice.GetPointData().GetArray("LatticeIndex"))
+            present = {tuple(ijk) for ijk in index}
+            expected = sum(1 for ijk in present for axis in range(3)
+                           if tuple(ijk[a] + (a == axis) for a in range(3)) in present)
+            actor = vtkffd.vtkFFDLatticeActor()
+            actor.SetInputData(lattice)
+            inputs = part_inputs(actor)
+            lines = [d for d in inputs if d.GetNumberOfLines() > 0]
+            vertices = [d.GetNumberOfVerts() for d in inputs if d.GetNumberOfVerts() > 0]
+            self.assertEqual(len(lines), 1, basis)
+            self.assertEqual(lines[0].GetNumberOfLines(), expected, basis)
+            self.assertEqual(vertices, [lattice.GetNumberOfPoints()], basis)  # all active, none culled
+            lattice.GetPoints().SetPoint(0, 9.0, 9.0, 9.0)
+            lattice.GetPoints().Modified()
+            lines = [d for d in part_inputs(actor) if d.GetNumberOfLines() > 0][0]
+            self.assertEqual(lines.GetPoint(0), (9.0, 9.0, 9.0))
+
     def test_control_points_arrays_and_colours(self):
         _, build, lattice = sphere_lattice()
         points = vtk_to_numpy(lattice.GetPoints().GetData())
