@@ -292,7 +292,18 @@ struct EvaluateWorker
     bool& completed)
   {
     const vtkFFDSparseCells* sparse = this->Sparse;
-    const std::vector<Real> displacements(lattice.Displacements.begin(), lattice.Displacements.end());
+    // The displacements in the evaluation's precision: the lattice's own in double, a float copy otherwise.
+    std::vector<float> rounded;
+    const Real* displacements = nullptr;
+    if constexpr (std::is_same<Real, double>::value)
+    {
+      displacements = lattice.Displacements.data();
+    }
+    else
+    {
+      rounded.assign(lattice.Displacements.begin(), lattice.Displacements.end());
+      displacements = rounded.data();
+    }
     std::vector<Real> cellTable;
     if (binding.CellTable)
     {
@@ -302,7 +313,7 @@ struct EvaluateWorker
       vtkSMPTools::For(0, cells, 256,
         [&](int begin, int end)
         {
-          ffd::FillCellTable(lattice.Basis, displacements.data(), lattice.Divisions, lattice.ControlPointsPerAxis,
+          ffd::FillCellTable(lattice.Basis, displacements, lattice.Divisions, lattice.ControlPointsPerAxis,
             sparse ? sparse->GetVoxels().data() : nullptr, sparse ? sparse->GetSupports().data() : nullptr,
             cellTable.data(), begin, end);
         });
@@ -315,8 +326,8 @@ struct EvaluateWorker
         auto run = [&](auto withCellTable)
         {
           this->Run<decltype(maxCount)::value, decltype(basis)::value, decltype(withCellTable)::value>(inPoints,
-            lattice, displacements.data(), cellTable.data(), binding, inNormals, outNormals, outPoints, determinants,
-            self, progressBegin, progressEnd, completed);
+            lattice, displacements, cellTable.data(), binding, inNormals, outNormals, outPoints, determinants, self,
+            progressBegin, progressEnd, completed);
         };
         constexpr int Basis = decltype(basis)::value;
         if constexpr (Basis != int(ffd::GridBasis::Bernstein) && Basis != int(ffd::GridBasis::TricubicBezier))

@@ -6,7 +6,8 @@
  * Each row runs in a process of its own (this program started again with --row), so that its peak resident
  * memory (getrusage) is its own: the mesh is read (and subdivided), then vtkFFDVoxelize, vtkFFDBuildLattice in
  * the sparse or the dense form, the first vtkFFDDeform update (the binding and an evaluation) and re-updates
- * after the lattice's points moved (the median of several: the evaluation alone). Columns: active voxels,
+ * after the lattice's points moved (the median of several: the evaluation alone, of the points without their
+ * normals). Columns: active voxels,
  * active control points, peak memory and the part of it above the mesh's, the lattice's and the voxel grid's
  * bytes (GetActualMemorySize()) per active control point and per active voxel beyond their points (24 bytes
  * each), and the times of voxelize,
@@ -102,6 +103,7 @@ int RunRow(const std::string& meshPath, int levels, int divisions, int basis, bo
   deform->SetInputData(mesh);
   deform->SetLatticeData(lattice);
   deform->SetBackend(backend);
+  deform->TransformNormalsOff(); // the points alone, as BenchmarkFFDDeform times them
   start = Clock::now();
   deform->Update();
   const double firstSeconds = Seconds(start);
