@@ -60,9 +60,10 @@ struct LatticeValues<detail::GroupValues<Real, Group>>
 
 /// The weights along each axis at parameters stu of lanes in the cells of indices `cell` (DeformInLaneCells()),
 /// as ComputeAxisWeights() computes them for one cell.
-template <int MaxCount, typename Real, int StaticBasis, typename Lane, bool WithCellTable>
-inline void LaneCellWeights(const GridDeformation<MaxCount, Real, StaticBasis, Lane, WithCellTable>& deformation,
-  const Vec3<Lane>& stu, const Vec3<Lane>& cell, bool withDerivative, AxisWeights<MaxCount, Lane>* axes)
+template <int MaxCount, typename Real, int StaticBasis, typename Lane, bool WithCellTable, GridStorage Storage>
+inline void LaneCellWeights(
+  const GridDeformation<MaxCount, Real, StaticBasis, Lane, WithCellTable, Storage>& deformation, const Vec3<Lane>& stu,
+  const Vec3<Lane>& cell, bool withDerivative, AxisWeights<MaxCount, Lane>* axes)
 {
   const Lane p[3] = { stu.x, stu.y, stu.z };
   const Lane c[3] = { cell.x, cell.y, cell.z };
@@ -79,9 +80,11 @@ inline void LaneCellWeights(const GridDeformation<MaxCount, Real, StaticBasis, L
  * of `group` (DeformInLaneCells()): each lane's weights (or local coordinates) from its own cell's indices,
  * then each cell's sum in all lanes, kept in that cell's lanes.
  */
-template <int MaxCount, typename Real, int StaticBasis, typename Lane, bool WithCellTable, typename Group>
-inline Vec3<Lane> SumInLaneCells(const GridDeformation<MaxCount, Real, StaticBasis, Lane, WithCellTable>& deformation,
-  const Vec3<Lane>& stu, const Group& group, Mat3<Lane>* gradient)
+template <int MaxCount, typename Real, int StaticBasis, typename Lane, bool WithCellTable, GridStorage Storage,
+  typename Group>
+inline Vec3<Lane> SumInLaneCells(
+  const GridDeformation<MaxCount, Real, StaticBasis, Lane, WithCellTable, Storage>& deformation, const Vec3<Lane>& stu,
+  const Group& group, Mat3<Lane>* gradient)
 {
   Vec3<Lane> index;
   for (int k = 0; k < group.Count; ++k)
@@ -182,9 +185,10 @@ inline Vec3<Lane> SumInLaneCells(const GridDeformation<MaxCount, Real, StaticBas
  * (i + Dims[0] (j + Dims[1] k), or, for a sparse lattice, its first entry in CellSupports) (GroupCells in
  * FFDGridLanes.h).
  */
-template <int MaxCount, typename Real, int StaticBasis, typename Lane, bool WithCellTable, typename Group>
+template <int MaxCount, typename Real, int StaticBasis, typename Lane, bool WithCellTable, GridStorage Storage,
+  typename Group>
 inline Vec3<Lane> DeformInLaneCells(
-  const GridDeformation<MaxCount, Real, StaticBasis, Lane, WithCellTable>& deformation, const Vec3<Lane>& x,
+  const GridDeformation<MaxCount, Real, StaticBasis, Lane, WithCellTable, Storage>& deformation, const Vec3<Lane>& x,
   const Group& group)
 {
   Mat3<Lane>* noGradient = nullptr;
@@ -192,9 +196,10 @@ inline Vec3<Lane> DeformInLaneCells(
 }
 
 /// DeformInLaneCells() and the Jacobian dX_ffd/dX there.
-template <int MaxCount, typename Real, int StaticBasis, typename Lane, bool WithCellTable, typename Group>
+template <int MaxCount, typename Real, int StaticBasis, typename Lane, bool WithCellTable, GridStorage Storage,
+  typename Group>
 inline Vec3<Lane> DeformInLaneCells(
-  const GridDeformation<MaxCount, Real, StaticBasis, Lane, WithCellTable>& deformation, const Vec3<Lane>& x,
+  const GridDeformation<MaxCount, Real, StaticBasis, Lane, WithCellTable, Storage>& deformation, const Vec3<Lane>& x,
   const Group& group, Mat3<Lane>& jacobian)
 {
   const Vec3<Lane> stu = deformation.Frame.ToParametric(x);

@@ -421,6 +421,27 @@ struct GridDeformer::Impl : ResidentPoints::State
   Buffer CellVoxels, CellSupports;
   std::int64_t SparseControlPoints = 0;
 
+  // Calls f(storage) with the ffd::GridStorage of the bound lattice (a std::integral_constant): the kernels are
+  // instantiated for dense and sparse lattices apart. The global basis is always dense.
+  template <int StaticBasis, typename F>
+  void WithStorage(F&& f) const
+  {
+    using Dense = std::integral_constant<ffd::GridStorage, ffd::GridStorage::Dense>;
+    using Sparse = std::integral_constant<ffd::GridStorage, ffd::GridStorage::Sparse>;
+    if constexpr (StaticBasis == int(ffd::GridBasis::Bernstein))
+    {
+      f(Dense());
+    }
+    else if (this->SparseControlPoints > 0)
+    {
+      f(Sparse());
+    }
+    else
+    {
+      f(Dense());
+    }
+  }
+
   // The deformation `d` over the device's lattice `values`, a sparse lattice's cells included.
   template <typename Deformation>
   Deformation WithCells(Deformation d) const
@@ -542,11 +563,17 @@ struct GridDeformer::Impl : ResidentPoints::State
     ffd::WithStaticBasis(this->Basis,
       [&](auto maxCount, auto basis)
       {
-        using Deformation = ffd::GridDeformation<decltype(maxCount)::value, Real, decltype(basis)::value>;
-        const Deformation deformation = this->WithCells(Deformation{ this->Basis,
-          { this->Divisions[0], this->Divisions[1], this->Divisions[2] }, { dims[0], dims[1], dims[2] }, d, frame });
-        detail::LaunchDeform(deformation, this->Points.As<Real>(), this->Cells.As<int>(), this->Count,
-          this->OutPoints.As<Real>(), this->Normals.As<Real>(), normalsOut, determinantsOut, this->Stream);
+        this->WithStorage<decltype(basis)::value>(
+          [&](auto storage)
+          {
+            using Deformation = ffd::GridDeformation<decltype(maxCount)::value, Real, decltype(basis)::value, Real,
+              false, decltype(storage)::value>;
+            const Deformation deformation =
+              this->WithCells(Deformation{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
+                { dims[0], dims[1], dims[2] }, d, frame });
+            detail::LaunchDeform(deformation, this->Points.As<Real>(), this->Cells.As<int>(), this->Count,
+              this->OutPoints.As<Real>(), this->Normals.As<Real>(), normalsOut, determinantsOut, this->Stream);
+          });
       });
   }
 
@@ -558,11 +585,16 @@ struct GridDeformer::Impl : ResidentPoints::State
     const ffd::CellSplit split = ffd::CellSplit::For(this->Basis, this->Divisions);
     auto launch = [&](auto maxCount, auto basis)
     {
-      using Deformation = ffd::GridDeformation<decltype(maxCount)::value, float4, decltype(basis)::value, float>;
-      const Deformation grid = this->WithCells(Deformation{ this->Basis,
-        { this->Divisions[0], this->Divisions[1], this->Divisions[2] }, { dims[0], dims[1], dims[2] }, d, frame });
-      detail::LaunchDeformPoints(SplitCellDeformation<Deformation>{ grid, split }, this->Points.As<float>(),
-        this->Cells.As<int>(), this->Count, this->OutPoints.As<float>(), this->Stream);
+      this->WithStorage<decltype(basis)::value>(
+        [&](auto storage)
+        {
+          using Deformation = ffd::GridDeformation<decltype(maxCount)::value, float4, decltype(basis)::value, float,
+            false, decltype(storage)::value>;
+          const Deformation grid = this->WithCells(Deformation{ this->Basis,
+            { this->Divisions[0], this->Divisions[1], this->Divisions[2] }, { dims[0], dims[1], dims[2] }, d, frame });
+          detail::LaunchDeformPoints(SplitCellDeformation<Deformation>{ grid, split }, this->Points.As<float>(),
+            this->Cells.As<int>(), this->Count, this->OutPoints.As<float>(), this->Stream);
+        });
     };
     if (this->Basis == ffd::GridBasis::Trilinear)
     {

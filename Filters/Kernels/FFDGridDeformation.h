@@ -133,6 +133,15 @@ struct LatticeValues<SupportValues<Value>>
   }
 };
 
+/// Which lattices a GridDeformation evaluates: dense ones, sparse ones (CellSupports), or either, told apart at
+/// run time by CellSupports (one instantiation for both, where the branch costs less than a second one: the CPU).
+enum class GridStorage
+{
+  Either,
+  Dense,
+  Sparse
+};
+
 /**
  * A grid lattice's deformation, as plain data that host and device code evaluate alike. MaxCount bounds the
  * control points per axis that influence a point: 4 covers every local basis (and global ones up to degree 3),
@@ -148,9 +157,11 @@ struct LatticeValues<SupportValues<Value>>
  * differently (a multiply no longer fused into its add) from one caller to another.
  * A sparse lattice (CellSupports not null, a local basis) holds only its cells' control points: Displacements
  * then has one entry per control point of the sparse lattice, and cells are numbered as the binding of a sparse
- * lattice numbers them (CellVoxels, CellSupports).
+ * lattice numbers them (CellVoxels, CellSupports). Storage says which lattices an instantiation takes: the GPU's
+ * kernels are instantiated for each (the run-time test slowed the dense trilinear kernel by 8 %).
  */
-template <int MaxCount, typename Real, int StaticBasis = -1, typename Lane = Real, bool WithCellTable = false>
+template <int MaxCount, typename Real, int StaticBasis = -1, typename Lane = Real, bool WithCellTable = false,
+  GridStorage Storage = GridStorage::Either>
 struct GridDeformation
 {
   static_assert(!WithCellTable || StaticBasis != int(GridBasis::Bernstein), "a cell table is for a local basis");
@@ -170,7 +181,7 @@ struct GridDeformation
 
   /// This deformation evaluated in lanes of type OtherLane (its frame converted once, host only).
   template <typename OtherLane>
-  GridDeformation<MaxCount, Real, StaticBasis, OtherLane, WithCellTable> WithLanes() const
+  GridDeformation<MaxCount, Real, StaticBasis, OtherLane, WithCellTable, Storage> WithLanes() const
   {
     return { this->Basis, { this->Voxels[0], this->Voxels[1], this->Voxels[2] },
       { this->Dims[0], this->Dims[1], this->Dims[2] }, this->Displacements, this->Frame.template As<OtherLane>(),
@@ -180,14 +191,21 @@ struct GridDeformation
   /// True where cells are evaluated from CellTable (a compile-time constant).
   static constexpr bool UsesCellTable() { return WithCellTable; }
 
-  /// True for a sparse lattice (never for the global basis).
+  /// True for a sparse lattice (never for the global basis), a compile-time constant unless Storage is Either.
   FFD_INLINE bool IsSparse() const
   {
-    if constexpr (StaticBasis == int(GridBasis::Bernstein))
+    if constexpr (StaticBasis == int(GridBasis::Bernstein) || Storage == GridStorage::Dense)
     {
       return false;
     }
-    return this->CellSupports != nullptr;
+    else if constexpr (Storage == GridStorage::Sparse)
+    {
+      return true;
+    }
+    else
+    {
+      return this->CellSupports != nullptr;
+    }
   }
 
   /// Control points along each axis of a cell's support (a local basis).
