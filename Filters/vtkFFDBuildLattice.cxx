@@ -306,9 +306,6 @@ int vtkFFDBuildLattice::RequestData(
   {
     return 0;
   }
-  vtkFFDDataContract::SetFrame(output, frame);
-  vtkFFDDataContract::SetDivisions(output, divisions);
-  vtkFFDDataContract::SetBasis(output, this->Basis);
   this->UpdateProgress(1.0);
   return 1;
 }
@@ -405,6 +402,9 @@ int vtkFFDBuildLattice::BuildDense(const double frame[12], const int divisions[3
     }
     output->GetPointData()->AddArray(pointGhosts);
   }
+  vtkFFDDataContract::SetFrame(output, frame);
+  vtkFFDDataContract::SetDivisions(output, divisions);
+  vtkFFDDataContract::SetBasis(output, this->Basis);
   this->NumberOfActiveControlPoints = numActive;
   return 1;
 }
@@ -413,54 +413,15 @@ int vtkFFDBuildLattice::BuildDense(const double frame[12], const int divisions[3
 int vtkFFDBuildLattice::BuildSparse(
   const double frame[12], const int divisions[3], vtkIntArray* voxels, vtkUnstructuredGrid* output)
 {
-  const ffd::GridBasis basis = static_cast<ffd::GridBasis>(this->Basis);
   std::ostringstream request;
   request << "A sparse " << GetBasisAsString(this->Basis) << " lattice over " << voxels->GetNumberOfTuples()
           << " active voxels of " << divisions[0] << "x" << divisions[1] << "x" << divisions[2];
-  // Per control point: its position and RestPosition (24 bytes each), LatticeIndex (12) and Active (1). The
-  // cells' VoxelIndex is the input's array, shared.
-  vtkFFDSparseLattice lattice;
-  if (!lattice.Build(
-        this, basis, divisions, voxels->GetPointer(0), voxels->GetNumberOfTuples(), 61.0, 0.0, request.str()))
+  if (!vtkFFDMakeSparseLattice(
+        this, frame, static_cast<ffd::GridBasis>(this->Basis), divisions, voxels, request.str(), output))
   {
     return 0;
   }
-  this->UpdateProgress(0.5);
-  if (this->GetAbortExecute())
-  {
-    return 1;
-  }
-
-  const vtkIdType numPoints = vtkIdType(lattice.Points.size());
-  vtkSmartPointer<vtkPoints> points = lattice.MakeRestPoints(ffd::Frame<double>::FromArray(frame), basis, divisions);
-  vtkNew<vtkDoubleArray> rest;
-  rest->DeepCopy(points->GetData());
-  rest->SetName(vtkFFDDataContract::RestPositionArrayName());
-  vtkNew<vtkIntArray> latticeIndex;
-  latticeIndex->SetName(vtkFFDDataContract::LatticeIndexArrayName());
-  latticeIndex->SetNumberOfComponents(3);
-  latticeIndex->SetNumberOfTuples(numPoints);
-  int* index = latticeIndex->GetPointer(0);
-  vtkSMPTools::For(0, numPoints,
-    [&](vtkIdType begin, vtkIdType end)
-    {
-      for (vtkIdType id = begin; id < end; ++id)
-      {
-        lattice.GetIndex(id, index + 3 * id);
-      }
-    });
-  vtkNew<vtkUnsignedCharArray> active;
-  active->SetName(vtkFFDDataContract::ActiveArrayName());
-  active->SetNumberOfValues(numPoints);
-  active->FillValue(1);
-
-  output->SetPoints(points);
-  output->SetCells(lattice.CellType, lattice.Cells);
-  output->GetPointData()->AddArray(rest);
-  output->GetPointData()->AddArray(active);
-  output->GetPointData()->AddArray(latticeIndex);
-  output->GetCellData()->AddArray(voxels);
-  this->NumberOfActiveControlPoints = numPoints;
+  this->NumberOfActiveControlPoints = output->GetNumberOfPoints();
   return 1;
 }
 

@@ -2,17 +2,23 @@
 #include "vtkFFDSparseLattice.h"
 
 #include "vtkAlgorithm.h"
+#include "vtkCellData.h"
 #include "vtkCellType.h"
 #include "vtkDoubleArray.h"
+#include "vtkFFDDataContract.h"
 #include "vtkFFDMemory.h"
 #include "vtkHigherOrderHexahedron.h"
+#include "vtkIntArray.h"
 #include "vtkNew.h"
+#include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkSMPThreadLocal.h"
 #include "vtkSMPTools.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkUnstructuredGrid.h"
 
-// OpenVDB is confined to this translation unit: its headers cost ~12 s to compile.
-#include <openvdb/openvdb.h>
+#include "vtkFFDOpenVDB.h"
+
 #include <openvdb/tree/ValueAccessor.h>
 
 #include <algorithm>
@@ -197,33 +203,9 @@ vtkIdType vtkFFDActiveSet::GetNumberOfMarked() const
 //------------------------------------------------------------------------------------------------------------
 std::vector<vtkTypeInt64> vtkFFDActiveSet::TakeSortedIndices(const vtkTypeInt64 dims[3])
 {
-  // Marking sets single voxels, and the union of leaves keeps leaves: the tree has no active tiles, and its leaves
-  // hold every marked coordinate. Each leaf writes its own range of the result.
-  const MaskTree& tree = *this->Internal->Tree;
-  std::vector<const MaskTree::LeafNodeType*> leaves;
-  leaves.reserve(tree.leafCount());
-  tree.getNodes(leaves);
-  std::vector<vtkIdType> start(leaves.size() + 1, 0);
-  for (size_t l = 0; l < leaves.size(); ++l)
-  {
-    start[l + 1] = start[l] + vtkIdType(leaves[l]->onVoxelCount());
-  }
-  std::vector<vtkTypeInt64> indices(start.back());
-  vtkSMPTools::For(0, vtkIdType(leaves.size()),
-    [&](vtkIdType begin, vtkIdType end)
-    {
-      for (vtkIdType l = begin; l < end; ++l)
-      {
-        vtkTypeInt64* out = indices.data() + start[l];
-        for (auto it = leaves[l]->cbeginValueOn(); it; ++it)
-        {
-          const openvdb::Coord x = it.getCoord();
-          *out++ = x.x() + dims[0] * (x.y() + dims[1] * vtkTypeInt64(x.z()));
-        }
-      }
-    });
+  // Marking sets single voxels, and the union of leaves keeps leaves: the tree has no active tiles.
+  std::vector<vtkTypeInt64> indices = vtkFFDSortedIndices(*this->Internal->Tree, dims);
   this->Internal->Tree->clear();
-  vtkSMPTools::Sort(indices.begin(), indices.end());
   return indices;
 }
 
@@ -238,19 +220,7 @@ bool vtkFFDSparseLattice::Build(vtkAlgorithm* self, ffd::GridBasis basis, const 
     dims[a] = this->PointsPerAxis[a];
   }
   vtkFFDActiveSet set;
-  set.Mark(numVoxels,
-    [&](vtkIdType begin, vtkIdType end, vtkFFDBoxMarker& marker)
-    {
-      for (vtkIdType v = begin; v < end; ++v)
-      {
-        int first[3], count[3];
-        for (int a = 0; a < 3; ++a)
-        {
-          ffd::VoxelSupport(basis, divisions[a], voxels[3 * v + a], first[a], count[a]);
-        }
-        marker.Mark(first, count);
-      }
-    });
+  MarkSupports(set, basis, divisions, voxels, numVoxels);
 
   const vtkIdType numPoints = set.GetNumberOfMarked();
   const int c = ffd::SupportSize(basis, divisions[0]);
@@ -273,6 +243,25 @@ bool vtkFFDSparseLattice::Build(vtkAlgorithm* self, ffd::GridBasis basis, const 
   this->Cells = narrow ? MakeCells<vtkCellArray::ArrayType32>(*this, basis, divisions, voxels, numVoxels)
                        : MakeCells<vtkCellArray::ArrayType64>(*this, basis, divisions, voxels, numVoxels);
   return true;
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDSparseLattice::MarkSupports(
+  vtkFFDActiveSet& set, ffd::GridBasis basis, const int divisions[3], const int* voxels, vtkIdType numVoxels)
+{
+  set.Mark(numVoxels,
+    [&](vtkIdType begin, vtkIdType end, vtkFFDBoxMarker& marker)
+    {
+      for (vtkIdType v = begin; v < end; ++v)
+      {
+        int first[3], count[3];
+        for (int a = 0; a < 3; ++a)
+        {
+          ffd::VoxelSupport(basis, divisions[a], voxels[3 * v + a], first[a], count[a]);
+        }
+        marker.Mark(first, count);
+      }
+    });
 }
 
 //------------------------------------------------------------------------------------------------------------
@@ -305,4 +294,100 @@ vtkSmartPointer<vtkPoints> vtkFFDSparseLattice::MakeRestPoints(
       }
     });
   return points;
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkSmartPointer<vtkIntArray> vtkFFDMakeVoxelIndex(const std::vector<vtkTypeInt64>& sorted, const int divisions[3])
+{
+  const vtkIdType numVoxels = vtkIdType(sorted.size());
+  const vtkTypeInt64 nx = divisions[0], ny = divisions[1];
+  auto voxelIndex = vtkSmartPointer<vtkIntArray>::New();
+  voxelIndex->SetName(vtkFFDDataContract::VoxelIndexArrayName());
+  voxelIndex->SetNumberOfComponents(3);
+  voxelIndex->SetNumberOfTuples(numVoxels);
+  int* ijk = voxelIndex->GetPointer(0);
+  vtkSMPTools::For(0, numVoxels,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType v = begin; v < end; ++v)
+      {
+        ijk[3 * v] = int(sorted[v] % nx);
+        ijk[3 * v + 1] = int(sorted[v] / nx % ny);
+        ijk[3 * v + 2] = int(sorted[v] / nx / ny);
+      }
+    });
+  return voxelIndex;
+}
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDMakeVoxelGrid(vtkAlgorithm* self, const double frame[12], const int divisions[3], vtkIntArray* voxelIndex,
+  const std::string& what, vtkUnstructuredGrid* output)
+{
+  // The corners are the active control points of a TRILINEAR lattice over the active voxels (its point (i, j, k)
+  // rests at (i/nx, j/ny, k/nz)), and the hexahedra are its cells.
+  vtkFFDSparseLattice corners;
+  if (!corners.Build(self, ffd::GridBasis::Trilinear, divisions, voxelIndex->GetPointer(0),
+        voxelIndex->GetNumberOfTuples(), 24.0, 0.0, what))
+  {
+    return false;
+  }
+  output->SetPoints(corners.MakeRestPoints(ffd::Frame<double>::FromArray(frame), ffd::GridBasis::Trilinear, divisions));
+  output->SetCells(corners.CellType, corners.Cells);
+  output->GetCellData()->AddArray(voxelIndex);
+  vtkFFDDataContract::SetFrame(output, frame);
+  vtkFFDDataContract::SetDivisions(output, divisions);
+  return true;
+}
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDMakeSparseLattice(vtkAlgorithm* self, const double frame[12], ffd::GridBasis basis, const int divisions[3],
+  vtkIntArray* voxelIndex, const std::string& what, vtkUnstructuredGrid* output)
+{
+  // Per control point: its position and RestPosition (24 bytes each), LatticeIndex (12) and Active (1). The
+  // cells' VoxelIndex is the caller's array, shared.
+  vtkFFDSparseLattice lattice;
+  if (!lattice.Build(
+        self, basis, divisions, voxelIndex->GetPointer(0), voxelIndex->GetNumberOfTuples(), 61.0, 0.0, what))
+  {
+    return false;
+  }
+  self->UpdateProgress(0.5);
+  if (self->GetAbortExecute())
+  {
+    return true;
+  }
+
+  const vtkIdType numPoints = vtkIdType(lattice.Points.size());
+  vtkSmartPointer<vtkPoints> points = lattice.MakeRestPoints(ffd::Frame<double>::FromArray(frame), basis, divisions);
+  vtkNew<vtkDoubleArray> rest;
+  rest->DeepCopy(points->GetData());
+  rest->SetName(vtkFFDDataContract::RestPositionArrayName());
+  vtkNew<vtkIntArray> latticeIndex;
+  latticeIndex->SetName(vtkFFDDataContract::LatticeIndexArrayName());
+  latticeIndex->SetNumberOfComponents(3);
+  latticeIndex->SetNumberOfTuples(numPoints);
+  int* index = latticeIndex->GetPointer(0);
+  vtkSMPTools::For(0, numPoints,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType id = begin; id < end; ++id)
+      {
+        lattice.GetIndex(id, index + 3 * id);
+      }
+    });
+  vtkNew<vtkUnsignedCharArray> active;
+  active->SetName(vtkFFDDataContract::ActiveArrayName());
+  active->SetNumberOfValues(numPoints);
+  active->FillValue(1);
+
+  output->SetPoints(points);
+  output->SetCells(lattice.CellType, lattice.Cells);
+  output->GetPointData()->AddArray(rest);
+  output->GetPointData()->AddArray(active);
+  output->GetPointData()->AddArray(latticeIndex);
+  output->GetCellData()->AddArray(voxelIndex);
+  vtkFFDDataContract::SetFrame(output, frame);
+  vtkFFDDataContract::SetDivisions(output, divisions);
+  vtkFFDDataContract::SetBasis(output, int(basis));
+  return true;
 }

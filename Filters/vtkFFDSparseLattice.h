@@ -5,11 +5,12 @@
  *
  * Both sparse outputs are built here: vtkFFDVoxelize's voxel grid (the voxels that hold points, then their corners,
  * which are the active control points of a TRILINEAR lattice over them) and vtkFFDBuildLattice's sparse lattice
- * (the control points in the supports of the active voxels). Their cost follows the coordinates that are active,
+ * (the control points in the supports of the active voxels), the same way for those filters and for
+ * vtkFFDVDBReader, which rebuilds both from a file's voxels. Their cost follows the coordinates that are active,
  * never the grid's size: a set is found in parallel with OpenVDB (a MaskTree per thread, merged by topology union,
  * as OpenVDB's own tools build masks) and read out as linear indices i + n0 (j + n1 k), int64 since grids of
  * 1024^3 voxels and beyond overflow an int, sorted; a cell finds its points by binary search. Every result is the
- * same whatever the number of threads. OpenVDB's headers are compiled only by vtkFFDSparseLattice.cxx.
+ * same whatever the number of threads. This header is OpenVDB-free (vtkFFDOpenVDB.h says who includes OpenVDB).
  */
 #ifndef vtkFFDSparseLattice_h
 #define vtkFFDSparseLattice_h
@@ -27,7 +28,9 @@
 #include <vector>
 
 class vtkAlgorithm;
+class vtkIntArray;
 class vtkPoints;
+class vtkUnstructuredGrid;
 
 /// Marks boxes of grid coordinates: what the body of vtkFFDActiveSet::Mark() is given.
 class vtkFFDBoxMarker
@@ -96,6 +99,11 @@ struct vtkFFDSparseLattice
   bool Build(vtkAlgorithm* self, ffd::GridBasis basis, const int divisions[3], const int* voxels, vtkIdType numVoxels,
     double bytesPerPoint, double bytesPerCell, const std::string& what);
 
+  /// Marks the supports of the voxels in `set`: their union is the lattice's points (Build()'s first step, and
+  /// what vtkFFDVDBWriter checks a lattice's points against).
+  static void MarkSupports(
+    vtkFFDActiveSet& set, ffd::GridBasis basis, const int divisions[3], const int* voxels, vtkIdType numVoxels);
+
   /// (i, j, k) of point `id`.
   void GetIndex(vtkIdType id, int index[3]) const;
 
@@ -103,5 +111,28 @@ struct vtkFFDSparseLattice
   vtkSmartPointer<vtkPoints> MakeRestPoints(
     const ffd::Frame<double>& frame, ffd::GridBasis basis, const int divisions[3]) const;
 };
+
+/// The `VoxelIndex` array (3 ints a voxel) of the voxels whose linear indices i + nx (j + ny k) are `sorted`.
+vtkSmartPointer<vtkIntArray> vtkFFDMakeVoxelIndex(const std::vector<vtkTypeInt64>& sorted, const int divisions[3]);
+
+/**
+ * Fills `output` with vtkFFDVoxelize's voxel grid of the voxels of `voxelIndex` (distinct, within `divisions`, in
+ * increasing order as vtkFFDVoxelize finds them): their corners, one hexahedron each with its `VoxelIndex` (the
+ * array itself), `FFDFrame` and `FFDDivisions`. False, with the error reported on `self`, when the memory it needs
+ * is not there (`what` names the request).
+ */
+bool vtkFFDMakeVoxelGrid(vtkAlgorithm* self, const double frame[12], const int divisions[3], vtkIntArray* voxelIndex,
+  const std::string& what, vtkUnstructuredGrid* output);
+
+/**
+ * Fills `output` with vtkFFDBuildLattice's sparse lattice of the local `basis` at rest over the voxels of
+ * `voxelIndex` (distinct, within `divisions`): its points in increasing lattice order with `RestPosition`, `Active`
+ * and `LatticeIndex`, one cell per voxel in `voxelIndex`'s order with its `VoxelIndex` (the array itself),
+ * `FFDFrame`, `FFDDivisions` and `FFDBasis`. Reports progress 0.5 on `self` once the points are known and returns
+ * there, with the output empty, when `self` is aborted. False, with the error reported on `self`, when the memory
+ * it needs is not there (`what` names the request).
+ */
+bool vtkFFDMakeSparseLattice(vtkAlgorithm* self, const double frame[12], ffd::GridBasis basis, const int divisions[3],
+  vtkIntArray* voxelIndex, const std::string& what, vtkUnstructuredGrid* output);
 
 #endif

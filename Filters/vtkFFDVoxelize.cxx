@@ -2,19 +2,15 @@
 #include "vtkFFDVoxelize.h"
 
 #include "vtkArrayDispatch.h"
-#include "vtkCellData.h"
 #include "vtkDataArrayRange.h"
-#include "vtkFFDDataContract.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDSparseLattice.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
-#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
-#include "vtkSMPTools.h"
 #include "vtkUnstructuredGrid.h"
 
 #include "FFDFrame.h"
@@ -338,44 +334,20 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
   {
     return 0;
   }
-  vtkNew<vtkIntArray> voxelIndex;
-  voxelIndex->SetName(vtkFFDDataContract::VoxelIndexArrayName());
-  voxelIndex->SetNumberOfComponents(3);
-  voxelIndex->SetNumberOfTuples(numVoxels);
-  {
-    const vtkTypeInt64 dims[3] = { nx, ny, nz };
-    const std::vector<vtkTypeInt64> sorted = active.TakeSortedIndices(dims);
-    int* ijk = voxelIndex->GetPointer(0);
-    vtkSMPTools::For(0, numVoxels,
-      [&](vtkIdType begin, vtkIdType end)
-      {
-        for (vtkIdType v = begin; v < end; ++v)
-        {
-          ijk[3 * v] = int(sorted[v] % nx);
-          ijk[3 * v + 1] = int(sorted[v] / nx % ny);
-          ijk[3 * v + 2] = int(sorted[v] / nx / ny);
-        }
-      });
-  }
+  const vtkTypeInt64 dims[3] = { nx, ny, nz };
+  vtkSmartPointer<vtkIntArray> voxelIndex = vtkFFDMakeVoxelIndex(active.TakeSortedIndices(dims), this->Divisions);
   this->UpdateProgress(0.6);
   if (this->GetAbortExecute())
   {
     return 1;
   }
 
-  // Phase 4: the corners, which are the active control points of a TRILINEAR lattice over the active voxels (its
-  // point (i, j, k) rests at (i/nx, j/ny, k/nz)), and the hexahedra on them.
-  vtkFFDSparseLattice corners;
-  if (!corners.Build(this, ffd::GridBasis::Trilinear, this->Divisions, voxelIndex->GetPointer(0), numVoxels, 24.0, 0.0,
-        "The corners and hexahedra of " + request.str()))
+  // Phase 4: the corners and the hexahedra on them.
+  if (!vtkFFDMakeVoxelGrid(
+        this, frame, this->Divisions, voxelIndex, "The corners and hexahedra of " + request.str(), output))
   {
     return 0;
   }
-  output->SetPoints(corners.MakeRestPoints(bound, ffd::GridBasis::Trilinear, this->Divisions));
-  output->SetCells(corners.CellType, corners.Cells);
-  output->GetCellData()->AddArray(voxelIndex);
-  vtkFFDDataContract::SetFrame(output, frame);
-  vtkFFDDataContract::SetDivisions(output, this->Divisions);
   this->NumberOfActiveVoxels = numVoxels;
   this->UpdateProgress(1.0);
   return 1;
