@@ -214,38 +214,7 @@ bool vtkFFDCudaBackend::IsAvailable(std::string& why)
 #endif
 }
 
-bool vtkFFDCudaBackend::Deform(const vtkFFDBindingKey& key, vtkPoints* points, vtkDataArray* normals,
-  const double* displacements, vtkIdType controlPoints, vtkDataArray* outPoints, vtkDataArray* outNormals,
-  vtkDataArray* outDeterminants, bool& bound, std::string& why)
-{
-  bound = false;
-#ifdef VOXELFFD_HAS_CUDA
-  const bool ok = vtkState::WithOutputs(outPoints, outDeterminants,
-    [&](auto* out, auto* determinants)
-    {
-      return this->State->RunGrid(
-        key, nullptr, points, normals, displacements, controlPoints, out, outNormals, determinants, bound);
-    });
-  if (!ok)
-  {
-    why = this->State->Grid.GetLastError();
-  }
-  return ok;
-#else
-  (void)key;
-  (void)points;
-  (void)normals;
-  (void)displacements;
-  (void)controlPoints;
-  (void)outPoints;
-  (void)outNormals;
-  (void)outDeterminants;
-  why = "VoxelFFD was built without CUDA";
-  return false;
-#endif
-}
-
-bool vtkFFDCudaBackend::DeformSparse(const vtkFFDGridDeformer& grid, const vtkFFDBindingKey& key, vtkPoints* points,
+bool vtkFFDCudaBackend::DeformGrid(const vtkFFDGridDeformer& grid, const vtkFFDBindingKey& key, vtkPoints* points,
   vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants, bool& bound,
   std::string& why)
 {
@@ -255,7 +224,7 @@ bool vtkFFDCudaBackend::DeformSparse(const vtkFFDGridDeformer& grid, const vtkFF
   const bool ok = vtkState::WithOutputs(outPoints, outDeterminants,
     [&](auto* out, auto* determinants)
     {
-      return this->State->RunGrid(key, &grid, points, normals, displacements.data(),
+      return this->State->RunGrid(key, grid.GetSparseCells() ? &grid : nullptr, points, normals, displacements.data(),
         vtkIdType(displacements.size() / 3), out, outNormals, determinants, bound);
     });
   if (!ok)

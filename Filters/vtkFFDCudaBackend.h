@@ -40,30 +40,23 @@ public:
   static bool IsAvailable(std::string& why);
 
   /**
-   * Deforms on the device: the input's points (and normals, 3 components, may be null) bound per `key` to a grid
-   * lattice (frame, basis, divisions, outside policy), displaced by `displacements` (3 per control point). The
-   * results go to outPoints (a float or double AOS array with the points' count of tuples: the evaluation's
-   * precision), outNormals and outDeterminants (of outPoints' type) when not null. `bound` tells whether the
-   * points were (re)bound. On any failure: false, the reason in `why`, the outputs to be discarded, and no
-   * device state kept.
+   * Deforms on the device: the input's points (and normals, 3 components, may be null) bound per `key` to the
+   * grid lattice of `grid` (its last SetLattice()), displaced by its displacements. A dense lattice's points are
+   * bound on the device; a sparse lattice's binding is the host's (`grid`'s Bind() must have run for these
+   * points: finding a voxel's cell needs its lookup), uploaded with its cells when the key changes. The results
+   * go to outPoints (a float or double AOS array with the points' count of tuples: the evaluation's precision),
+   * outNormals and outDeterminants (of outPoints' type) when not null. `bound` tells whether the device's binding
+   * was (re)made. On any failure: false, the reason in `why`, the outputs to be discarded, and no device state
+   * kept.
    */
-  bool Deform(const vtkFFDBindingKey& key, vtkPoints* points, vtkDataArray* normals, const double* displacements,
-    vtkIdType controlPoints, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
-    bool& bound, std::string& why);
-
-  /**
-   * Deform() for a sparse lattice, whose binding is the host's (`grid`, whose Bind() ran for these points:
-   * finding a voxel's cell needs its lookup), uploaded with the lattice's cells when the key changes.
-   */
-  bool DeformSparse(const vtkFFDGridDeformer& grid, const vtkFFDBindingKey& key, vtkPoints* points,
-    vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
-    bool& bound, std::string& why);
+  bool DeformGrid(const vtkFFDGridDeformer& grid, const vtkFFDBindingKey& key, vtkPoints* points, vtkDataArray* normals,
+    vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants, bool& bound, std::string& why);
 
   /**
    * Deforms on the device the input's points bound by `tetrahedra` (whose Bind() ran for them; its binding is
    * uploaded when the device does not hold it) by the nodes' displacements of its last SetLattice(), then moves
    * the points clamped to the control mesh on the host with its ApplyClampedPoints(), as the CPU does. Outputs
-   * and failures as Deform().
+   * and failures as DeformGrid().
    */
   bool DeformTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points, vtkDataArray* normals,
     vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants, std::string& why);

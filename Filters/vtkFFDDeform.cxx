@@ -270,9 +270,8 @@ bool vtkFFDDeform::DeformByGrid(vtkPoints* points, vtkDataArray* normals)
       const vtkFFDBindingKey key = grid.KeyOf(points, this->OutsidePolicy);
       if (!lattice.Sparse)
       {
-        return internals.Cuda.Deform(key, points, normals, lattice.Displacements.data(),
-          vtkIdType(lattice.Displacements.size() / 3), internals.Points, internals.Normals, internals.Determinants,
-          rebound, why);
+        return internals.Cuda.DeformGrid(
+          grid, key, points, normals, internals.Points, internals.Normals, internals.Determinants, rebound, why);
       }
       // A sparse lattice's voxels are looked up on the host: the points are bound there, then uploaded.
       bool boundOnHost = false;
@@ -282,7 +281,7 @@ bool vtkFFDDeform::DeformByGrid(vtkPoints* points, vtkDataArray* normals)
         return false;
       }
       this->NumberOfBindings += boundOnHost ? 1 : 0;
-      const bool deformed = internals.Cuda.DeformSparse(
+      const bool deformed = internals.Cuda.DeformGrid(
         grid, key, points, normals, internals.Points, internals.Normals, internals.Determinants, rebound, why);
       rebound = false; // the upload of the host's binding, counted above
       return deformed;

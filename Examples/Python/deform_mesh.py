@@ -149,6 +149,11 @@ def render(output_path, size, mesh, lattice, camera_bounds, point_radius=None):
     renderer.ResetCamera(camera_bounds)  # the same framing before and after
     camera.Zoom(1.25)  # ResetCamera fits the bounding sphere, which leaves wide margins around a box
 
+    write_png(renderer, size, output_path)
+
+
+def write_png(renderer, size, output_path):
+    """Renders `renderer` offscreen into a window of `size` pixels and writes it as a PNG."""
     window = vtkRenderWindow()
     window.SetOffScreenRendering(1)
     window.SetSize(*size)

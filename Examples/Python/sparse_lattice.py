@@ -23,13 +23,10 @@ import numpy as np
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkLookupTable
 from vtkmodules.vtkCommonDataModel import vtkUnstructuredGrid
-from vtkmodules.vtkIOImage import vtkPNGWriter
-from vtkmodules.vtkRenderingCore import (vtkActor, vtkPolyDataMapper, vtkRenderer, vtkRenderWindow,
-                                         vtkWindowToImageFilter)
-import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
+from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper, vtkRenderer
 
-# The mesh reading of the demo (this folder is on sys.path when run as a script).
-from deform_mesh import REPOSITORY, read_mesh, vtkffd
+# The mesh reading and PNG writing of the demo (this folder is on sys.path when run as a script).
+from deform_mesh import REPOSITORY, read_mesh, vtkffd, write_png
 
 
 def parse_arguments():
@@ -87,17 +84,7 @@ def render(output_path, mesh, displacement):
     camera.Elevation(10.0)
     renderer.ResetCamera()
     camera.Zoom(1.3)
-    window = vtkRenderWindow()
-    window.SetOffScreenRendering(1)
-    window.SetSize(600, 600)
-    window.AddRenderer(renderer)
-    window.Render()
-    grabber = vtkWindowToImageFilter()
-    grabber.SetInput(window)
-    writer = vtkPNGWriter()
-    writer.SetInputConnection(grabber.GetOutputPort())
-    writer.SetFileName(str(output_path))
-    writer.Write()
+    write_png(renderer, (600, 600), output_path)
 
 
 def main():

@@ -122,6 +122,7 @@ int RunRow(const std::string& meshPath, int levels, int divisions, int basis, bo
   vtkSmartPointer<vtkPointSet> lattice = vtkSmartPointer<vtkPointSet>::Take(built->NewInstance());
   lattice->ShallowCopy(built);
   vtkNew<vtkPoints> moving;
+  moving->SetDataType(built->GetPoints()->GetDataType()); // DeepCopy() keeps the receiver's type: double
   moving->DeepCopy(built->GetPoints());
   lattice->SetPoints(moving);
   deform->SetLatticeData(lattice);
@@ -156,8 +157,7 @@ int RunRow(const std::string& meshPath, int levels, int divisions, int basis, bo
   // Beyond the points themselves (24 bytes each), as the goals count them.
   vtkDataSet* voxels = vtkDataSet::SafeDownCast(voxelize->GetOutputDataObject(0));
   const double voxelBytes = 1024.0 * double(voxels->GetActualMemorySize()) - 24.0 * double(voxels->GetNumberOfPoints());
-  const double latticeBytes =
-    1024.0 * double(lattice->GetActualMemorySize()) - 24.0 * double(points->GetNumberOfPoints());
+  const double latticeBytes = 1024.0 * double(built->GetActualMemorySize()) - 24.0 * double(built->GetNumberOfPoints());
   std::printf("row %lld %.0f %.0f %.0f %.0f %.1f %.1f %.3f %.3f %.3f %.9f %.1f %s\n",
     static_cast<long long>(mesh->GetNumberOfPoints()), activeVoxels, activePoints, peakToBind,
     peakToBind - meshMegabytes, latticeBytes / std::max(activePoints, 1.0), voxelBytes / std::max(activeVoxels, 1.0),
