@@ -75,18 +75,8 @@ std::string ReadLattice(vtkPointSet* lattice, vtkFFDGridLattice& view, vtkFFDSpa
       fix;
   }
   std::string why;
-  if (view.Sparse)
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      if (view.Divisions[a] > (VTK_INT_MAX - 1) / 3)
-      {
-        return "The lattice's FFDDivisions are too large: more control points along an axis than an int counts.";
-      }
-      view.ControlPointsPerAxis[a] = ffd::ControlPointsAlongAxis(view.Basis, view.Divisions[a]);
-    }
-  }
-  else if (!vtkFFDBuildLattice::GetControlPointsPerAxis(basis, view.Divisions, view.ControlPointsPerAxis, why))
+  if (!vtkFFDBuildLattice::GetControlPointsPerAxis(basis, view.Divisions, view.ControlPointsPerAxis, why,
+        view.Sparse ? vtkFFDBuildLattice::SPARSE : vtkFFDBuildLattice::DENSE))
   {
     return "The lattice's FFDDivisions do not fit its FFDBasis: " + why;
   }
