@@ -52,6 +52,12 @@
 #define FFD_HAVE_LANES 0
 #endif
 
+// The widest lanes compiled in, a SimdLevel value: every level (3, AVX-512) unless the build says fewer. The
+// sanitizer build compiles SSE2's only (CMakeLists.txt says why); SimdLevelOfCpu() never names one left out.
+#ifndef FFD_WIDEST_LANES
+#define FFD_WIDEST_LANES 3
+#endif
+
 namespace ffd
 {
 
@@ -82,6 +88,10 @@ inline SimdLevel SimdLevelOfCpu()
   else if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi2"))
   {
     level = SimdLevel::AVX2;
+  }
+  if (int(level) > FFD_WIDEST_LANES)
+  {
+    level = SimdLevel(FFD_WIDEST_LANES);
   }
   if (const char* cap = std::getenv("VOXELFFD_MAX_SIMD"))
   {
@@ -528,9 +538,15 @@ inline void DeformBlocksInPlace(SimdLevel level, const Deformation& deformation,
   switch (level)
   {
     case SimdLevel::AVX512:
+#if FFD_WIDEST_LANES >= 3
       return detail::BlocksInPlaceAVX512(deformation, in, cells, out, blocks, blockBegin, blockEnd, stream);
+#endif
+      [[fallthrough]];
     case SimdLevel::AVX2:
+#if FFD_WIDEST_LANES >= 2
       return detail::BlocksInPlaceAVX2(deformation, in, cells, out, blocks, blockBegin, blockEnd, stream);
+#endif
+      [[fallthrough]];
     case SimdLevel::SSE2:
       return detail::BlocksInPlaceSSE2(deformation, in, cells, out, blocks, blockBegin, blockEnd, stream);
     case SimdLevel::None:
@@ -564,11 +580,17 @@ inline void DeformWithJacobian(SimdLevel level, const Deformation& deformation, 
   switch (level)
   {
     case SimdLevel::AVX512:
+#if FFD_WIDEST_LANES >= 3
       return detail::WithJacobianAVX512(
         deformation, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
+#endif
+      [[fallthrough]];
     case SimdLevel::AVX2:
+#if FFD_WIDEST_LANES >= 2
       return detail::WithJacobianAVX2(
         deformation, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
+#endif
+      [[fallthrough]];
     case SimdLevel::SSE2:
       return detail::WithJacobianSSE2(
         deformation, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
@@ -602,11 +624,17 @@ inline void DeformGathered(SimdLevel level, const Deformation& deformation, cons
     {
 #if FFD_HAVE_LANES
       case SimdLevel::AVX512:
+#if FFD_WIDEST_LANES >= 3
         detail::GatheredAVX512(deformation, listed, gathered, t, staging, out);
         continue;
+#endif
+        [[fallthrough]];
       case SimdLevel::AVX2:
+#if FFD_WIDEST_LANES >= 2
         detail::GatheredAVX2(deformation, listed, gathered, t, staging, out);
         continue;
+#endif
+        [[fallthrough]];
       case SimdLevel::SSE2:
         detail::GatheredSSE2(deformation, listed, gathered, t, staging, out);
         continue;
