@@ -333,6 +333,33 @@ struct GridDeformation
     return x + d;
   }
 
+  /// Calls f(index, weight) for each control point that moves a point x bound to `cell` (not -1): its index
+  /// into Displacements and its weight in Deform(), the weights summing to 1. Host code with scalar lanes (the
+  /// control points' masses in vtkFFDLatticeDynamics).
+  template <typename F>
+  void ForEachWeight(const Vec3<Lane>& x, int cell, F&& f) const
+  {
+    int c[3];
+    this->CellIndices(cell, c);
+    AxisWeights<MaxCount, Lane> axes[3];
+    this->Weights(this->Frame.ToParametric(x), c, false, axes);
+    const int n = this->SupportCount();
+    const int* support = this->IsSparse() ? this->CellSupports + std::size_t(cell) * std::size_t(n * n * n) : nullptr;
+    for (int k = 0; k < axes[2].Count; ++k)
+    {
+      for (int j = 0; j < axes[1].Count; ++j)
+      {
+        for (int i = 0; i < axes[0].Count; ++i)
+        {
+          const int index = support
+            ? support[i + n * (j + n * k)]
+            : axes[0].First + i + this->Dims[0] * (axes[1].First + j + this->Dims[1] * (axes[2].First + k));
+          f(index, axes[0].W[i] * axes[1].W[j] * axes[2].W[k]);
+        }
+      }
+    }
+  }
+
   // The building blocks of Deform(), public for the CPU's lanes in several cells (Filters/CPU/FFDLaneCells.h).
 
   /// The grid on which SumTensorProduct() finds a sparse lattice's cell's control points: its support's.

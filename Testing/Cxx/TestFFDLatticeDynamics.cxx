@@ -1,0 +1,750 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// vtkFFDLatticeDynamics, vtkFFDMagneticSphere and vtkFFDSimulateLattice on the bear's lattices. The references
+// are independent: masses from the reference basis weights (Testing/Reference), the discrete backward Euler
+// translation under a uniform field, an explicit (symplectic Euler) integrator written here on springs found here,
+// and the magnetic sphere's formula. Tolerances are stated where they are used, each with its bound.
+
+#include "FFDTestErrorObserver.h"
+#include "FFDTestLattices.h"
+#include "FFDTestMeshes.h"
+#include "FFDTestTetrahedra.h"
+
+#include "vtkFFDBuildTetrahedralLattice.h"
+#include "vtkFFDDeform.h"
+#include "vtkFFDLatticeDynamics.h"
+#include "vtkFFDMagneticSphere.h"
+#include "vtkFFDSimulateLattice.h"
+#include "vtkFFDVoxelize.h"
+#include "vtkInformation.h"
+#include "vtkPlane.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkUnstructuredGrid.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace
+{
+using ffdtest::Vec;
+constexpr double Epsilon = std::numeric_limits<double>::epsilon();
+
+/// The bear in a lattice built by vtkFFDBuildLattice (divisions 5: the paper's Figure 1).
+struct Scene
+{
+  vtkSmartPointer<vtkPolyData> Mesh;
+  vtkSmartPointer<vtkPointSet> Lattice;
+  double Size = 0; // the frame's diagonal
+};
+
+Scene BearScene(int basis, int form, int divisions = 5)
+{
+  Scene scene;
+  scene.Mesh = ReadTestMesh("bear");
+  vtkNew<vtkFFDVoxelize> voxelize;
+  voxelize->SetInputData(scene.Mesh);
+  voxelize->SetDivisions(divisions, divisions, divisions);
+  vtkNew<vtkFFDBuildLattice> build;
+  build->SetInputConnection(voxelize->GetOutputPort());
+  build->SetBasis(basis);
+  build->SetLatticeForm(form);
+  build->Update();
+  scene.Lattice.TakeReference(vtkPointSet::SafeDownCast(build->GetOutput()->NewInstance()));
+  scene.Lattice->DeepCopy(build->GetOutput());
+  scene.Size = ffdtest::Diagonal(ffdtest::FrameOf(scene.Lattice));
+  return scene;
+}
+
+Scene BearTetrahedra()
+{
+  Scene scene;
+  scene.Mesh = ReadTestMesh("bear");
+  vtkNew<vtkFFDBuildTetrahedralLattice> build;
+  build->SetInputData(scene.Mesh);
+  build->Update();
+  scene.Lattice = build->GetOutput();
+  double bounds[6];
+  scene.Mesh->GetBounds(bounds);
+  scene.Size = std::sqrt(
+    std::pow(bounds[1] - bounds[0], 2) + std::pow(bounds[3] - bounds[2], 2) + std::pow(bounds[5] - bounds[4], 2));
+  return scene;
+}
+
+std::vector<Vec> PointsOf(vtkPointSet* set)
+{
+  std::vector<Vec> points(set->GetNumberOfPoints());
+  for (vtkIdType p = 0; p < set->GetNumberOfPoints(); ++p)
+  {
+    set->GetPoint(p, points[p].data());
+  }
+  return points;
+}
+
+vtkSmartPointer<vtkFFDLatticeDynamics> MakeDynamics(const Scene& scene)
+{
+  auto dynamics = vtkSmartPointer<vtkFFDLatticeDynamics>::New();
+  dynamics->SetLattice(scene.Lattice);
+  dynamics->SetMesh(scene.Mesh);
+  return dynamics;
+}
+
+/// Moves each simulated point of the lattice by up to `amplitude` per component (a start away from rest).
+void PerturbSimulated(vtkFFDLatticeDynamics* dynamics, vtkPointSet* lattice, double amplitude, unsigned seed)
+{
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> d(-amplitude, amplitude);
+  for (vtkIdType p = 0; p < lattice->GetNumberOfPoints(); ++p)
+  {
+    double x[3];
+    lattice->GetPoint(p, x);
+    const double moved[3] = { x[0] + d(rng), x[1] + d(rng), x[2] + d(rng) };
+    if (dynamics->GetMass(p) > 0)
+    {
+      lattice->GetPoints()->SetPoint(p, moved);
+    }
+  }
+  lattice->GetPoints()->Modified();
+}
+
+double Energy(vtkFFDLatticeDynamics* dynamics)
+{
+  return dynamics->GetKineticEnergy() + dynamics->GetPotentialEnergy();
+}
+
+const int Forms[] = { vtkFFDBuildLattice::DENSE, vtkFFDBuildLattice::SPARSE };
+} // namespace
+
+//------------------------------------------------------------------------------------------------------------
+// Zero forces: every term is computed from the displacements, which are exactly zero at rest, so the lattice
+// stays bit for bit where it is, on every kind of lattice.
+TEST(FFDLatticeDynamics, RestStaysRestForTenThousandSteps)
+{
+  // 10,000 steps on the paper's Figure 1 lattice, 1,000 on the others (each step computes the same zeros).
+  const std::pair<Scene, int> cases[] = { { BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::DENSE),
+                                            10000 },
+    { BearScene(vtkFFDBuildLattice::CUBIC_BSPLINE, vtkFFDBuildLattice::SPARSE), 1000 }, { BearTetrahedra(), 1000 } };
+  for (const auto& [scene, steps] : cases)
+  {
+    const std::vector<Vec> before = PointsOf(scene.Lattice);
+    auto dynamics = MakeDynamics(scene);
+    ASSERT_TRUE(dynamics->Step(steps));
+    // The time is a sum of steps: each addition rounds by at most half an ulp of the sum.
+    const double time = steps * dynamics->GetTimeStep();
+    EXPECT_NEAR(dynamics->GetTime(), time, steps * Epsilon * time);
+    const std::vector<Vec> after = PointsOf(scene.Lattice);
+    for (std::size_t p = 0; p < before.size(); ++p)
+    {
+      ASSERT_EQ(before[p], after[p]) << "point " << p << " drifted";
+    }
+    EXPECT_EQ(dynamics->GetKineticEnergy(), 0.0);
+    EXPECT_EQ(dynamics->GetPotentialEnergy(), 0.0);
+  }
+}
+
+//------------------------------------------------------------------------------------------------------------
+// Masses: each simulated control point's share of the bear's points, sum of its weights over them, from the
+// reference basis (a lattice built by hand, every control point simulated), scaled to the total mass; the
+// floor lifts the lightest. Tolerance: sums of at most 30,000 weights, each with a relative rounding of a few
+// epsilon: 1e-12 relative.
+TEST(FFDLatticeDynamics, MassesAreTheMeshPointsSharesThroughTheWeights)
+{
+  const vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("bear");
+  double b[6];
+  mesh->GetBounds(b);
+  const ffdref::Frame f = { { b[0] - 0.01, b[2] - 0.02, b[4] - 0.03 }, { b[1] - b[0] + 0.05, 0, 0 },
+    { 0, b[3] - b[2] + 0.04, 0 }, { 0, 0, b[5] - b[4] + 0.06 } };
+  for (const int basis :
+    { vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::CUBIC_BSPLINE, vtkFFDBuildLattice::BERNSTEIN })
+  {
+    const int n[3] = { 3, 4, 2 };
+    vtkSmartPointer<vtkStructuredGrid> lattice = ffdtest::MakeLattice(f, basis, n);
+    const ffdtest::Reference ref = ffdtest::ReferenceOf(lattice);
+    const int dims[3] = { ffdtest::PointsAlongAxis(basis, n[0]), ffdtest::PointsAlongAxis(basis, n[1]),
+      ffdtest::PointsAlongAxis(basis, n[2]) };
+    std::vector<double> share(lattice->GetNumberOfPoints(), 0.0);
+    double total = 0;
+    for (vtkIdType p = 0; p < mesh->GetNumberOfPoints(); ++p)
+    {
+      Vec x;
+      mesh->GetPoint(p, x.data());
+      const Vec stu = ffdref::Parameters(f, x);
+      std::vector<double> w[3];
+      for (int a = 0; a < 3; ++a)
+      {
+        w[a] = ffdref::AxisWeights(ref.Basis, n[a], stu[a]);
+      }
+      for (int k = 0; k < dims[2]; ++k)
+        for (int j = 0; j < dims[1]; ++j)
+          for (int i = 0; i < dims[0]; ++i)
+          {
+            share[i + dims[0] * (j + dims[1] * k)] += w[0][i] * w[1][j] * w[2][k];
+            total += w[0][i] * w[1][j] * w[2][k];
+          }
+    }
+    vtkNew<vtkFFDLatticeDynamics> dynamics;
+    dynamics->SetLattice(lattice);
+    dynamics->SetMesh(mesh);
+    dynamics->SetTotalMass(2.5);
+    dynamics->SetMinimumMassFraction(1e-12); // no floor: the shares alone
+    ASSERT_TRUE(dynamics->Initialize());
+    ASSERT_EQ(dynamics->GetNumberOfSimulatedPoints(), lattice->GetNumberOfPoints());
+    double least = VTK_DOUBLE_MAX, sum = 0;
+    for (vtkIdType c = 0; c < lattice->GetNumberOfPoints(); ++c)
+    {
+      const double expected = 2.5 * share[c] / total;
+      EXPECT_NEAR(dynamics->GetMass(c), expected, 1e-12 * 2.5) << "basis " << basis << " control point " << c;
+      least = std::min(least, expected);
+      sum += dynamics->GetMass(c);
+    }
+    EXPECT_NEAR(sum, 2.5, 1e-12 * 2.5);
+    // A floor above the lightest: none below it, the total kept, the order of the others kept.
+    const double mean = 2.5 / double(lattice->GetNumberOfPoints());
+    const double fraction = std::min(1.0, 2 * least / mean + 1e-3);
+    dynamics->SetMinimumMassFraction(fraction);
+    ASSERT_TRUE(dynamics->Initialize());
+    sum = 0;
+    for (vtkIdType c = 0; c < lattice->GetNumberOfPoints(); ++c)
+    {
+      EXPECT_GE(dynamics->GetMass(c), fraction * mean * (1 - 1e-12));
+      sum += dynamics->GetMass(c);
+    }
+    EXPECT_NEAR(sum, 2.5, 1e-12 * 2.5);
+  }
+}
+
+//------------------------------------------------------------------------------------------------------------
+// A uniform field (gravity) translates the body without deforming it: backward Euler from rest gives
+// u_n = g h^2 n (n + 1) / 2 exactly in real numbers. Tolerance: the linear solve's relative error is about
+// cond(A) epsilon a step, cond(A) = 1 + h^2 lambda_max(M^-1 (L + W)) = 1 + 4 (h / explicit limit)^2, below 10^3
+// here; over 120 steps the error stays below 120 * 10^3 * epsilon = 3e-11 of the translation: 1e-10.
+TEST(FFDLatticeDynamics, UniformFieldTranslatesTheBody)
+{
+  for (const int form : Forms)
+  {
+    Scene scene = BearScene(vtkFFDBuildLattice::TRILINEAR, form);
+    const std::vector<Vec> before = PointsOf(scene.Lattice);
+    auto dynamics = MakeDynamics(scene);
+    dynamics->SetGravity(0, 0, -9.81);
+    const int steps = 120;
+    ASSERT_TRUE(dynamics->Step(steps));
+    const double h = dynamics->GetTimeStep();
+    const double drop = -9.81 * h * h * steps * (steps + 1) / 2.0;
+    const std::vector<Vec> after = PointsOf(scene.Lattice);
+    double worst = 0;
+    for (std::size_t p = 0; p < before.size(); ++p)
+    {
+      const bool simulated = dynamics->GetMass(vtkIdType(p)) > 0;
+      const Vec want = { before[p][0], before[p][1], before[p][2] + (simulated ? drop : 0.0) };
+      for (int c = 0; c < 3; ++c)
+      {
+        worst = std::max(worst, std::abs(after[p][c] - want[c]));
+      }
+    }
+    EXPECT_LE(worst, 1e-10 * std::abs(drop)) << "form " << form;
+  }
+}
+
+//------------------------------------------------------------------------------------------------------------
+// Without external forces, pins or colliders the springs and the core are internal: the momentum the impulses
+// gave stays. Tolerance as above: 200 steps of at most 10^3 epsilon relative: 1e-10 of the impulses' sum.
+TEST(FFDLatticeDynamics, MomentumIsConservedWithoutExternalForces)
+{
+  for (const int form : Forms)
+  {
+    Scene scene = BearScene(vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, form);
+    auto dynamics = MakeDynamics(scene);
+    ASSERT_TRUE(dynamics->Initialize());
+    PerturbSimulated(dynamics, scene.Lattice, 0.02 * scene.Size, 7);
+    ASSERT_TRUE(dynamics->Initialize()); // starts from the perturbed points
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> d(-1.0, 1.0);
+    double given[3] = { 0, 0, 0 }, scale = 0;
+    for (vtkIdType p = 0; p < scene.Lattice->GetNumberOfPoints(); p += 7)
+    {
+      if (dynamics->GetMass(p) > 0)
+      {
+        const double j[3] = { d(rng), d(rng), d(rng) };
+        dynamics->ApplyImpulse(p, j[0], j[1], j[2]);
+        for (int c = 0; c < 3; ++c)
+        {
+          given[c] += j[c];
+          scale += std::abs(j[c]);
+        }
+      }
+    }
+    ASSERT_TRUE(dynamics->Step(200));
+    double momentum[3];
+    dynamics->GetMomentum(momentum);
+    for (int c = 0; c < 3; ++c)
+    {
+      EXPECT_NEAR(momentum[c], given[c], 1e-10 * scale) << "form " << form << " axis " << c;
+    }
+  }
+}
+
+//------------------------------------------------------------------------------------------------------------
+// Damped springs and the core take a perturbed body to rest: the energy never exceeds its start and falls
+// below 1e-6 of it within 20 s of simulated time; without damping it decays more slowly (backward Euler's own
+// dissipation only).
+TEST(FFDLatticeDynamics, EnergyDecaysToRest)
+{
+  Scene scene = BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::SPARSE);
+  const std::vector<Vec> rest = PointsOf(scene.Lattice);
+  double remaining[2];
+  for (const double damping : { 0.0, 0.05 })
+  {
+    for (vtkIdType p = 0; p < scene.Lattice->GetNumberOfPoints(); ++p)
+    {
+      scene.Lattice->GetPoints()->SetPoint(p, rest[p].data());
+    }
+    auto dynamics = MakeDynamics(scene);
+    dynamics->SetSpringDamping(damping);
+    ASSERT_TRUE(dynamics->Initialize());
+    PerturbSimulated(dynamics, scene.Lattice, 0.03 * scene.Size, 3);
+    ASSERT_TRUE(dynamics->Initialize());
+    const double start = Energy(dynamics);
+    ASSERT_GT(start, 0.0);
+    double highest = 0;
+    const int steps = int(20.0 / dynamics->GetTimeStep());
+    for (int s = 0; s < steps; ++s)
+    {
+      ASSERT_TRUE(dynamics->Step());
+      highest = std::max(highest, Energy(dynamics));
+    }
+    EXPECT_LE(highest, start) << "damping " << damping;
+    remaining[damping > 0] = Energy(dynamics) / start;
+  }
+  EXPECT_LT(remaining[1], 1e-6);
+  EXPECT_LT(remaining[1], remaining[0]);
+}
+
+//------------------------------------------------------------------------------------------------------------
+// The explicit limit is real, and backward Euler is stable far past it. An explicit (symplectic Euler)
+// integrator written here, on springs found here between the dense trilinear lattice's active neighbours, with
+// the simulation's masses: stable at 0.9 times GetExplicitTimeStepLimit() (its energy within 10 times the
+// start: symplectic Euler's energy oscillates by at most 1 / (1 - (h omega / 2)^2) = 5.3 there), blown up at 1.5
+// times (the top mode grows by more than 2 a step). The simulation at 10 times the limit stays below its
+// starting energy and comes to rest.
+TEST(FFDLatticeDynamics, StableAtTenTimesTheExplicitLimit)
+{
+  Scene scene = BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::DENSE);
+  auto dynamics = MakeDynamics(scene);
+  dynamics->SetSpringDamping(0.0);
+  dynamics->SetCoreStiffness(0.0);
+  ASSERT_TRUE(dynamics->Initialize());
+  const double limit = dynamics->GetExplicitTimeStepLimit();
+  ASSERT_GT(limit, 0.0);
+
+  // The reference: particles and springs from the lattice's structure and Active array.
+  vtkStructuredGrid* grid = vtkStructuredGrid::SafeDownCast(scene.Lattice);
+  ASSERT_NE(grid, nullptr);
+  int dims[3];
+  grid->GetDimensions(dims);
+  vtkDataArray* active = grid->GetPointData()->GetArray("Active");
+  const std::vector<Vec> rest = PointsOf(grid);
+  std::vector<std::array<vtkIdType, 2>> springs;
+  for (int k = 0; k < dims[2]; ++k)
+    for (int j = 0; j < dims[1]; ++j)
+      for (int i = 0; i < dims[0]; ++i)
+        for (int dk = -1; dk <= 1; ++dk)
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di)
+            {
+              const int o[3] = { i + di, j + dj, k + dk };
+              const vtkIdType a = i + dims[0] * (j + dims[1] * k), b = o[0] + dims[0] * (o[1] + dims[1] * o[2]);
+              if (o[0] >= 0 && o[0] < dims[0] && o[1] >= 0 && o[1] < dims[1] && o[2] >= 0 && o[2] < dims[2] && a < b &&
+                active->GetComponent(a, 0) != 0 && active->GetComponent(b, 0) != 0)
+              {
+                springs.push_back({ a, b });
+              }
+            }
+  ASSERT_EQ(vtkIdType(springs.size()), dynamics->GetNumberOfSprings());
+  const double k = dynamics->GetSpringStiffness();
+  auto explicitRun = [&](double h, int steps)
+  {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> d(-1e-4 * scene.Size, 1e-4 * scene.Size);
+    std::vector<Vec> x = rest, v(rest.size(), Vec{ 0, 0, 0 });
+    for (vtkIdType p = 0; p < vtkIdType(x.size()); ++p)
+    {
+      for (int c = 0; c < 3 && dynamics->GetMass(p) > 0; ++c)
+      {
+        x[p][c] += d(rng);
+      }
+    }
+    auto energy = [&]()
+    {
+      double e = 0;
+      for (std::size_t p = 0; p < x.size(); ++p)
+      {
+        e += 0.5 * dynamics->GetMass(vtkIdType(p)) * ffdtest::Length(v[p]) * ffdtest::Length(v[p]);
+      }
+      for (const auto& s : springs)
+      {
+        const double stretch =
+          ffdtest::Length(ffdref::Sub(x[s[1]], x[s[0]])) - ffdtest::Length(ffdref::Sub(rest[s[1]], rest[s[0]]));
+        e += 0.5 * k * stretch * stretch;
+      }
+      return e;
+    };
+    const double start = energy();
+    double highest = start;
+    for (int n = 0; n < steps && highest < 1e12 * start; ++n)
+    {
+      std::vector<Vec> force(x.size(), Vec{ 0, 0, 0 });
+      for (const auto& s : springs)
+      {
+        const Vec d = ffdref::Sub(x[s[1]], x[s[0]]);
+        const double length = ffdtest::Length(d);
+        const double pull = k * (length - ffdtest::Length(ffdref::Sub(rest[s[1]], rest[s[0]]))) / length;
+        for (int c = 0; c < 3; ++c)
+        {
+          force[s[0]][c] += pull * d[c];
+          force[s[1]][c] -= pull * d[c];
+        }
+      }
+      for (std::size_t p = 0; p < x.size(); ++p)
+      {
+        const double m = dynamics->GetMass(vtkIdType(p));
+        for (int c = 0; c < 3 && m > 0; ++c)
+        {
+          v[p][c] += h * force[p][c] / m;
+          x[p][c] += h * v[p][c];
+        }
+      }
+      highest = std::max(highest, energy());
+    }
+    return highest / start;
+  };
+  EXPECT_LT(explicitRun(0.9 * limit, 3000), 10.0);
+  EXPECT_GT(explicitRun(1.5 * limit, 3000), 1e6);
+
+  dynamics->SetTimeStep(10 * limit);
+  dynamics->SetSpringDamping(1.0);
+  PerturbSimulated(dynamics, scene.Lattice, 0.03 * scene.Size, 9);
+  ASSERT_TRUE(dynamics->Initialize());
+  const double start = Energy(dynamics);
+  double highest = 0;
+  for (int s = 0; s < 2000; ++s)
+  {
+    ASSERT_TRUE(dynamics->Step());
+    highest = std::max(highest, Energy(dynamics));
+    ASSERT_TRUE(std::isfinite(highest));
+  }
+  EXPECT_LE(highest, start);
+  EXPECT_LT(Energy(dynamics), 1e-6 * start);
+}
+
+//------------------------------------------------------------------------------------------------------------
+// Pinned points are at their targets after every step (rest + (target - rest): within an ulp or two of the
+// target), under gravity and a magnetic sphere, while the others move.
+TEST(FFDLatticeDynamics, PinnedPointsStayAtTheirTargets)
+{
+  Scene scene = BearScene(vtkFFDBuildLattice::CUBIC_BSPLINE, vtkFFDBuildLattice::SPARSE);
+  auto dynamics = MakeDynamics(scene);
+  dynamics->SetGravity(0, -9.81, 0);
+  vtkNew<vtkFFDMagneticSphere> sphere;
+  sphere->SetCenter(scene.Lattice->GetPoint(0));
+  sphere->SetRadius(0.1 * scene.Size);
+  sphere->SetStrength(50);
+  dynamics->AddMagneticSphere(sphere);
+  const vtkIdType count = scene.Lattice->GetNumberOfPoints();
+  std::map<vtkIdType, Vec> targets;
+  for (const vtkIdType p : { vtkIdType(3), count / 2, count - 1 })
+  {
+    Vec x;
+    scene.Lattice->GetPoint(p, x.data());
+    x[0] += 0.05 * scene.Size;
+    targets[p] = x;
+    dynamics->PinPoint(p, x.data());
+  }
+  const std::vector<Vec> before = PointsOf(scene.Lattice);
+  for (int s = 0; s < 30; ++s)
+  {
+    ASSERT_TRUE(dynamics->Step(10));
+    for (const auto& target : targets)
+    {
+      Vec x;
+      scene.Lattice->GetPoint(target.first, x.data());
+      for (int c = 0; c < 3; ++c)
+      {
+        // rest + (target - rest): two roundings of at most half an ulp of the larger of rest and target.
+        EXPECT_NEAR(x[c], target.second[c], 2 * Epsilon * (std::abs(target.second[c]) + scene.Size));
+      }
+    }
+  }
+  EXPECT_GT(ffdtest::Length(ffdref::Sub(PointsOf(scene.Lattice)[1], before[1])), 1e-3 * scene.Size);
+}
+
+//------------------------------------------------------------------------------------------------------------
+// The magnetic sphere's field against its formula, and its path.
+TEST(FFDMagneticSphere, AccelerationAndPath)
+{
+  vtkNew<vtkFFDMagneticSphere> sphere;
+  sphere->SetCenter(1, 2, 3);
+  sphere->SetRadius(0.5);
+  sphere->SetStrength(4);
+  sphere->SetFalloff(3);
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> d(-3, 3);
+  for (int i = 0; i < 100; ++i)
+  {
+    const double x[3] = { 1 + d(rng), 2 + d(rng), 3 + d(rng) };
+    const Vec toward = { 1 - x[0], 2 - x[1], 3 - x[2] };
+    const double r = ffdtest::Length(toward);
+    const double magnitude = r >= 0.5 ? 4 * std::pow(0.5 / r, 3) : 4 * r / 0.5;
+    for (const int mode : { vtkFFDMagneticSphere::ATTRACT, vtkFFDMagneticSphere::REPEL })
+    {
+      sphere->SetMode(mode);
+      double a[3];
+      sphere->GetAcceleration(x, 0.0, a);
+      for (int c = 0; c < 3; ++c)
+      {
+        const double want = (mode == vtkFFDMagneticSphere::ATTRACT ? 1 : -1) * magnitude * toward[c] / r;
+        EXPECT_NEAR(a[c], want, 1e-14 * magnitude);
+      }
+    }
+  }
+  sphere->SetRange(1.0);
+  const double far[3] = { 3, 2, 3 };
+  double a[3];
+  sphere->GetAcceleration(far, 0.0, a);
+  EXPECT_EQ(a[0], 0.0);
+
+  // A closed path: a circle of 32 points, one lap every 4 s.
+  vtkNew<vtkPoints> path;
+  for (int i = 0; i < 32; ++i)
+  {
+    path->InsertNextPoint(2 * std::cos(2 * vtkMath::Pi() * i / 32), 2 * std::sin(2 * vtkMath::Pi() * i / 32), 1);
+  }
+  sphere->SetPath(path);
+  sphere->SetPeriod(4);
+  double c0[3], c1[3], c2[3];
+  sphere->GetCenterAt(0.0, c0);
+  sphere->GetCenterAt(4.0, c1);
+  sphere->GetCenterAt(2.0, c2);
+  for (int c = 0; c < 3; ++c)
+  {
+    EXPECT_NEAR(c0[c], path->GetPoint(0)[c], 1e-12);
+    EXPECT_NEAR(c1[c], c0[c], 1e-12);
+    EXPECT_NEAR(c2[c], path->GetPoint(16)[c], 1e-12); // half-way along a symmetric path
+  }
+  for (double t = 0; t < 4; t += 0.1)
+  {
+    double c[3];
+    sphere->GetCenterAt(t, c);
+    EXPECT_NEAR(std::hypot(c[0], c[1]), 2.0, 2e-3); // a spline through a circle's points stays on it
+  }
+}
+
+//------------------------------------------------------------------------------------------------------------
+// A magnetic sphere accelerates each control point by a(d) of its formula: without springs or core, one step of
+// backward Euler from rest moves each by h^2 a exactly in real numbers (the system is diagonal: within a few
+// ulps of the motion). With them, it pulls (or pushes) the body as a whole: its centre of mass moves toward
+// (away from) the sphere.
+TEST(FFDLatticeDynamics, MagneticSpherePullsThePoints)
+{
+  for (const int mode : { vtkFFDMagneticSphere::ATTRACT, vtkFFDMagneticSphere::REPEL })
+  {
+    Scene scene = BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::DENSE);
+    const std::vector<Vec> before = PointsOf(scene.Lattice);
+    double bounds[6];
+    scene.Lattice->GetBounds(bounds);
+    const Vec centre = { bounds[1] + 0.1 * scene.Size, 0.5 * (bounds[2] + bounds[3]), 0.5 * (bounds[4] + bounds[5]) };
+    const double radius = 0.1 * scene.Size, strength = 20;
+    auto dynamics = MakeDynamics(scene);
+    vtkNew<vtkFFDMagneticSphere> sphere;
+    sphere->SetCenter(centre.data());
+    sphere->SetRadius(radius);
+    sphere->SetStrength(strength);
+    sphere->SetMode(mode);
+    dynamics->AddMagneticSphere(sphere);
+    dynamics->SetSpringStiffness(0);
+    dynamics->SetSpringDamping(0);
+    dynamics->SetCoreStiffness(0);
+    ASSERT_TRUE(dynamics->Step());
+    const double h = dynamics->GetTimeStep();
+    for (vtkIdType p = 0; p < vtkIdType(before.size()); ++p)
+    {
+      const Vec toward = ffdref::Sub(centre, before[p]);
+      const double d = ffdtest::Length(toward);
+      const double a = (d >= radius ? strength * std::pow(radius / d, 2.0) : strength * d / radius) *
+        (mode == vtkFFDMagneticSphere::ATTRACT ? 1 : -1) * (dynamics->GetMass(p) > 0 ? 1 : 0);
+      Vec x;
+      scene.Lattice->GetPoint(p, x.data());
+      for (int c = 0; c < 3; ++c)
+      {
+        EXPECT_NEAR(x[c], before[p][c] + h * h * a * toward[c] / d, 8 * Epsilon * (std::abs(x[c]) + scene.Size));
+      }
+    }
+
+    dynamics->SetSpringStiffness(100);
+    dynamics->SetCoreStiffness(10);
+    ASSERT_TRUE(dynamics->Step(30));
+    Vec shift = { 0, 0, 0 };
+    for (vtkIdType p = 0; p < vtkIdType(before.size()); ++p)
+    {
+      Vec x;
+      scene.Lattice->GetPoint(p, x.data());
+      for (int c = 0; c < 3; ++c)
+      {
+        shift[c] += dynamics->GetMass(p) * (x[c] - before[p][c]);
+      }
+    }
+    const double along = ffdref::Dot(shift,
+      ffdref::Sub(centre,
+        ffdtest::Vec{ 0.5 * (bounds[0] + bounds[1]), 0.5 * (bounds[2] + bounds[3]), 0.5 * (bounds[4] + bounds[5]) }));
+    EXPECT_TRUE(mode == vtkFFDMagneticSphere::ATTRACT ? along > 0 : along < 0) << "mode " << mode;
+  }
+}
+
+//------------------------------------------------------------------------------------------------------------
+// A collider (a ground plane under the body) stops the falling lattice: every simulated point ends on or above
+// it (Newton's projection onto a plane is exact to rounding: 1e-12 of the frame), at rest on it.
+TEST(FFDLatticeDynamics, CollidersKeepPointsOut)
+{
+  Scene scene = BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::SPARSE);
+  double bounds[6];
+  scene.Lattice->GetBounds(bounds);
+  auto dynamics = MakeDynamics(scene);
+  dynamics->SetGravity(0, 0, -9.81);
+  vtkNew<vtkPlane> ground;
+  ground->SetOrigin(0, 0, bounds[4] - 0.1 * scene.Size);
+  ground->SetNormal(0, 0, 1);
+  dynamics->AddCollider(ground);
+  ASSERT_TRUE(dynamics->Step(600));
+  double lowest = VTK_DOUBLE_MAX;
+  for (vtkIdType p = 0; p < scene.Lattice->GetNumberOfPoints(); ++p)
+  {
+    lowest = std::min(lowest, scene.Lattice->GetPoint(p)[2]);
+  }
+  EXPECT_GE(lowest, ground->GetOrigin()[2] - 1e-12 * scene.Size);
+  EXPECT_LT(lowest, ground->GetOrigin()[2] + 0.05 * scene.Size); // it fell onto the plane
+}
+
+//------------------------------------------------------------------------------------------------------------
+// vtkFFDDeform downstream of a simulated lattice re-evaluates at each step without binding again, and its
+// output is the float64 reference X + sum w D of the moved lattice (within 1e-12 of the frame's diagonal).
+TEST(FFDLatticeDynamics, DeformFollowsWithoutRebinding)
+{
+  Scene scene = BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::DENSE);
+  auto dynamics = MakeDynamics(scene);
+  vtkNew<vtkFFDMagneticSphere> sphere;
+  sphere->SetCenter(scene.Lattice->GetPoint(scene.Lattice->GetNumberOfPoints() / 2));
+  sphere->SetRadius(0.2 * scene.Size);
+  sphere->SetStrength(30);
+  dynamics->AddMagneticSphere(sphere);
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(scene.Mesh);
+  deform->SetLatticeData(scene.Lattice);
+  deform->SetBackendToCPU();
+  deform->Update();
+  EXPECT_EQ(deform->GetNumberOfBindings(), 1);
+  for (int frame = 0; frame < 5; ++frame)
+  {
+    ASSERT_TRUE(dynamics->Step(5));
+    deform->Update();
+    EXPECT_EQ(deform->GetNumberOfBindings(), 1);
+    EXPECT_LE(ffdtest::MaxRelativeError(scene.Mesh, deform->GetOutput(), ffdtest::ReferenceOf(scene.Lattice)), 1e-12);
+  }
+}
+
+//------------------------------------------------------------------------------------------------------------
+// The pipeline form: the lattice at time t is the same whether t is asked at once, after an earlier time, or
+// after a later one (which starts again); t = 0 is the input.
+TEST(FFDSimulateLattice, TheLatticeAtATimeDoesNotDependOnTheRequests)
+{
+  Scene scene = BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::SPARSE);
+  vtkNew<vtkFFDSimulateLattice> simulate;
+  simulate->SetInputData(scene.Lattice);
+  simulate->SetMeshData(scene.Mesh);
+  simulate->SetEndTime(2.0);
+  vtkNew<vtkFFDMagneticSphere> sphere;
+  vtkNew<vtkPoints> path;
+  double bounds[6];
+  scene.Lattice->GetBounds(bounds);
+  for (int i = 0; i < 8; ++i)
+  {
+    const double angle = 2 * vtkMath::Pi() * i / 8;
+    path->InsertNextPoint(0.5 * (bounds[0] + bounds[1]) + 0.6 * scene.Size * std::cos(angle),
+      0.5 * (bounds[2] + bounds[3]) + 0.6 * scene.Size * std::sin(angle), 0.5 * (bounds[4] + bounds[5]));
+  }
+  sphere->SetPath(path);
+  sphere->SetPeriod(2.0);
+  sphere->SetRadius(0.1 * scene.Size);
+  sphere->SetStrength(40);
+  simulate->GetDynamics()->AddMagneticSphere(sphere);
+
+  simulate->UpdateInformation();
+  double range[2];
+  simulate->GetOutputInformation(0)->Get(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range);
+  EXPECT_EQ(range[0], 0.0);
+  EXPECT_EQ(range[1], 2.0);
+
+  auto at = [&](double t)
+  {
+    simulate->UpdateTimeStep(t);
+    EXPECT_EQ(simulate->GetOutput()->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()), t);
+    return PointsOf(vtkPointSet::SafeDownCast(simulate->GetOutput()));
+  };
+  EXPECT_EQ(at(0.0), PointsOf(scene.Lattice));
+  const std::vector<Vec> direct = at(1.0);
+  EXPECT_NE(direct, PointsOf(scene.Lattice));
+  simulate->GetDynamics()->SetTimeStep(1.0 / 59.0); // any change starts again
+  simulate->GetDynamics()->SetTimeStep(1.0 / 60.0);
+  at(0.5);
+  EXPECT_EQ(at(1.0), direct); // continued from 0.5
+  at(1.5);
+  EXPECT_EQ(at(1.0), direct); // started again
+}
+
+//------------------------------------------------------------------------------------------------------------
+// Bad input: an error message each, no crash, and nothing moved.
+TEST(FFDLatticeDynamics, BadInputGivesErrors)
+{
+  vtkNew<FFDTestErrorObserver> errors;
+  vtkNew<vtkFFDLatticeDynamics> dynamics;
+  errors->Watch(dynamics);
+  auto saw = [&](const char* what) { return errors->Errors.find(what) != std::string::npos; };
+  EXPECT_FALSE(dynamics->Step());
+  EXPECT_TRUE(saw("No lattice to simulate"));
+
+  Scene scene = BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::DENSE);
+  const std::vector<Vec> before = PointsOf(scene.Lattice);
+  dynamics->SetLattice(scene.Lattice);
+  dynamics->SetMesh(scene.Mesh);
+  vtkIdType culled = -1;
+  for (vtkIdType p = 0; p < scene.Lattice->GetNumberOfPoints() && culled < 0; ++p)
+  {
+    culled = scene.Lattice->GetPointData()->GetArray("Active")->GetComponent(p, 0) == 0 ? p : -1;
+  }
+  ASSERT_GE(culled, 0);
+  dynamics->PinPoint(culled, 0, 0, 0);
+  EXPECT_FALSE(dynamics->Step());
+  EXPECT_TRUE(saw("is pinned but is not a simulated control point"));
+  dynamics->UnpinAllPoints();
+  dynamics->ApplyImpulse(-4, 1, 0, 0);
+  EXPECT_FALSE(dynamics->Step());
+  EXPECT_TRUE(saw("not a simulated control point"));
+  EXPECT_EQ(PointsOf(scene.Lattice), before);
+
+  vtkSmartPointer<vtkDataArray> rest = scene.Lattice->GetPointData()->GetArray("RestPosition");
+  scene.Lattice->GetPointData()->RemoveArray("RestPosition");
+  EXPECT_FALSE(dynamics->Step());
+  EXPECT_TRUE(saw("no RestPosition"));
+  scene.Lattice->GetPointData()->AddArray(rest);
+  vtkNew<vtkUnsignedCharArray> active;
+  active->SetName("Active");
+  active->SetNumberOfValues(3);
+  scene.Lattice->GetPointData()->AddArray(active);
+  EXPECT_FALSE(dynamics->Step());
+  EXPECT_TRUE(saw("Active point array does not have one value per point"));
+  active->SetNumberOfValues(scene.Lattice->GetNumberOfPoints());
+  active->Fill(0);
+  EXPECT_FALSE(dynamics->Step());
+  EXPECT_TRUE(saw("no active control point"));
+  EXPECT_EQ(PointsOf(scene.Lattice), before);
+}
