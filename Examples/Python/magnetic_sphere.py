@@ -3,12 +3,12 @@
 """A magnetic sphere orbits the bear and pulls its simulated lattice: the paper's Figure 1.
 
 The bear in a 5x5x5-voxel trilinear lattice (216 control points, of which the active ones are simulated by
-vtkFFDLatticeDynamics: penalty springs to all 26 neighbours, a rigid core, masses from the mesh's points). A
-vtkFFDMagneticSphere circles the bear and pulls the control points near it; every frame advances the simulation
-by two steps and deforms the mesh. Interactive by default: a window where the lattice widget drags control
-points (pinned while dragged, the simulation pulling the rest after them; q quits); --offscreen --frames N
-writes N PNGs and a contact sheet instead. Both print the Figure 1 caption statistics and the time per frame (simulation,
-deformation, render).
+vtkFFDLatticeDynamics: penalty springs to all 26 neighbours, a rigid core, masses from the mesh's points; the
+bottom layer pinned, as the bear sits). A vtkFFDMagneticSphere circles the bear and pulls the control points
+near it; every frame advances the simulation by two steps and deforms the mesh. Interactive by default: a window
+where the lattice widget drags control points too (pinned while dragged, the simulation pulling the rest after
+them; q quits). --offscreen --frames N writes N PNGs and a contact sheet instead. Both print the Figure 1
+caption statistics and the time per frame (simulation, deformation, render).
 
 Run it with Debian's /usr/bin/python3 (which has VTK's Python), the built package on PYTHONPATH and an X server
 (Xvfb will do), as Utilities/setup.sh does:

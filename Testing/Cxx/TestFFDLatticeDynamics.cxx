@@ -122,10 +122,12 @@ const int Forms[] = { vtkFFDBuildLattice::DENSE, vtkFFDBuildLattice::SPARSE };
 // stays bit for bit where it is, on every kind of lattice.
 TEST(FFDLatticeDynamics, RestStaysRestForTenThousandSteps)
 {
-  // 10,000 steps on the paper's Figure 1 lattice, 1,000 on the others (each step computes the same zeros).
-  const std::pair<Scene, int> cases[] = { { BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::DENSE),
+  // 10,000 steps on a 3x3x3-voxel lattice, 1,000 on the paper's Figure 1 lattice, 300 on the larger others:
+  // each step computes the same zeros.
+  const std::pair<Scene, int> cases[] = { { BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::DENSE, 3),
                                             10000 },
-    { BearScene(vtkFFDBuildLattice::CUBIC_BSPLINE, vtkFFDBuildLattice::SPARSE), 1000 }, { BearTetrahedra(), 1000 } };
+    { BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::DENSE), 1000 },
+    { BearScene(vtkFFDBuildLattice::CUBIC_BSPLINE, vtkFFDBuildLattice::SPARSE), 300 }, { BearTetrahedra(), 300 } };
   for (const auto& [scene, steps] : cases)
   {
     const std::vector<Vec> before = PointsOf(scene.Lattice);
@@ -249,7 +251,7 @@ TEST(FFDLatticeDynamics, UniformFieldTranslatesTheBody)
 
 //------------------------------------------------------------------------------------------------------------
 // Without external forces, pins or colliders the springs and the core are internal: the momentum the impulses
-// gave stays. Tolerance as above: 200 steps of at most 10^3 epsilon relative: 1e-10 of the impulses' sum.
+// gave stays. Tolerance as above: 100 steps of at most 10^3 epsilon relative: 1e-10 of the impulses' sum.
 TEST(FFDLatticeDynamics, MomentumIsConservedWithoutExternalForces)
 {
   for (const int form : Forms)
@@ -275,7 +277,7 @@ TEST(FFDLatticeDynamics, MomentumIsConservedWithoutExternalForces)
         }
       }
     }
-    ASSERT_TRUE(dynamics->Step(200));
+    ASSERT_TRUE(dynamics->Step(100));
     double momentum[3];
     dynamics->GetMomentum(momentum);
     for (int c = 0; c < 3; ++c)
