@@ -22,8 +22,8 @@ double Norm(const double d[3])
 
 /**
  * The factored matrix of the free particles, P A P^T = L D L^T (Eigen's SimplicialLDLT), kept as plain arrays so
- * that a solve runs the three coordinates of a row together: the same entries of L for x, y and z (Eigen's
- * solve takes the right-hand side's columns one at a time, and took three times as long).
+ * that a solve runs the three coordinates of a row together, reading each entry of L once for x, y and z
+ * (Eigen's solve reads L once per column of the right-hand side).
  */
 struct SoftBody::Factor
 {
