@@ -22,7 +22,7 @@ import sys
 import time
 from pathlib import Path
 
-from vtkmodules.vtkCommonCore import vtkIdList, vtkPoints
+from vtkmodules.vtkCommonCore import vtkCommand, vtkIdList, vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkStructuredGrid
 from vtkmodules.vtkFiltersCore import vtkPolyDataNormals
 from vtkmodules.vtkFiltersSources import vtkSphereSource
@@ -31,6 +31,7 @@ from vtkmodules.vtkImagingCore import vtkImageResize
 from vtkmodules.vtkIOImage import vtkPNGReader, vtkPNGWriter
 from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
 from vtkmodules.vtkInteractionStyle import vtkInteractorStyleTrackballCamera
+from vtkmodules.vtkRenderingCore import vtkInteractorObserver
 from vtkmodules.vtkRenderingCore import (
     vtkActor,
     vtkPolyDataMapper,
@@ -93,6 +94,35 @@ def orbit(bounds, radius_factor=0.6):
     return path, size
 
 
+def scripted_drag(interactor, renderer, lattice, dynamics, seated, frame):
+    """Drags the top simulated control point nearest the view's centre 60 pixels right in three moves, a frame
+    of simulation after each: the point must stay where the widget put it (pinned) while the simulation runs,
+    and follow the simulation again once released."""
+    candidates = [p for p in range(lattice.GetNumberOfPoints()) if dynamics.GetMass(p) > 0 and p not in seated]
+    chosen = max(candidates, key=lambda p: lattice.GetPoint(p)[1])
+    display = [0.0, 0.0, 0.0]
+    vtkInteractorObserver.ComputeWorldToDisplay(renderer, *lattice.GetPoint(chosen), display)
+    x, y = round(display[0]), round(display[1])
+    start = lattice.GetPoint(chosen)
+    for px, event in ((x, vtkCommand.MouseMoveEvent), (x, vtkCommand.LeftButtonPressEvent)):
+        interactor.SetEventInformation(px, y, 0, 0)
+        interactor.InvokeEvent(event)
+    for move in range(1, 4):
+        interactor.SetEventInformation(x + 20 * move, y, 0, 0)
+        interactor.InvokeEvent(vtkCommand.MouseMoveEvent)
+        put = lattice.GetPoint(chosen)
+        frame()
+        if math.dist(put, lattice.GetPoint(chosen)) > 1e-12 * (1 + math.dist(put, (0, 0, 0))):
+            sys.exit(f"dragged control point {chosen} did not stay where the widget put it")
+    interactor.SetEventInformation(x + 60, y, 0, 0)
+    interactor.InvokeEvent(vtkCommand.LeftButtonReleaseEvent)
+    put = lattice.GetPoint(chosen)
+    frame()
+    if dynamics.GetNumberOfPinnedPoints() != len(seated) or lattice.GetPoint(chosen) == put:
+        sys.exit("the dragged control point stayed pinned after its release")
+    print(f"dragged control point {chosen} by {math.dist(start, put):.3g}: pinned while dragged, free after")
+
+
 def contact_sheet(pngs, output_path):
     """The frames side by side, SHEET_COLUMNS a row, each at a quarter of its size."""
     rows = []
@@ -152,11 +182,13 @@ def main():
     # The bear sits: its lowest layer of control points is pinned where it rests, so the sphere's pull squishes
     # the body instead of carrying it away.
     n_i, n_j, n_k = lattice.GetDimensions()
+    seated = {}  # the bottom layer's pins: point id -> target
     for k in range(n_k):
         for i in range(n_i):
             point = i + n_i * n_j * k  # j = 0: the bottom layer (CGAL's meshes stand along +Y)
             if dynamics.GetMass(point) > 0:
-                dynamics.PinPoint(point, lattice.GetPoint(point))
+                seated[point] = lattice.GetPoint(point)
+                dynamics.PinPoint(point, seated[point])
 
     deform = vtkffd.vtkFFDDeform()
     deform.SetInputData(mesh)
@@ -169,9 +201,6 @@ def main():
     mesh_actor.GetProperty().SetColor(0.80, 0.62, 0.42)
     mesh_actor.GetProperty().SetSpecular(0.2)
     mesh_actor.GetProperty().SetSpecularPower(20)
-    lattice_actor = vtkffd.vtkFFDLatticeActor()
-    lattice_actor.SetInputData(lattice)
-    lattice_actor.SetPointRadius(0.012 * size)
     ball = vtkSphereSource()
     ball.SetRadius(sphere.GetRadius())
     ball.SetThetaResolution(32)
@@ -183,7 +212,7 @@ def main():
     ball_actor.GetProperty().SetColor(0.15, 0.35, 0.85)
 
     renderer = vtkRenderer()
-    for actor in (mesh_actor, lattice_actor, ball_actor):
+    for actor in (mesh_actor, ball_actor):  # the lattice widget below draws the lattice
         renderer.AddActor(actor)
     renderer.GradientBackgroundOn()
     renderer.SetBackground(0.72, 0.76, 0.82)
@@ -230,6 +259,42 @@ def main():
           f"{build.GetNumberOfActiveControlPoints()} control points; {dynamics.GetNumberOfSimulatedPoints()} "
           f"simulated, {dynamics.GetNumberOfSprings()} springs")
 
+    # The lattice widget drags control points: while dragged they are pinned where the widget puts them, and the
+    # simulation pulls the rest of the body after them.
+    interactor = vtkRenderWindowInteractor()
+    interactor.SetRenderWindow(window)
+    interactor.SetInteractorStyle(vtkInteractorStyleTrackballCamera())
+    widget = vtkffd.vtkFFDLatticeWidget()
+    widget.SetInteractor(interactor)
+    widget.CreateDefaultRepresentation()
+    representation = widget.GetLatticeRepresentation()
+    representation.SetLattice(lattice)
+    representation.GetLatticeActor().SetPointRadius(0.012 * size)
+    dragged = set()
+
+    def pin_selection(*_):
+        release()
+        selected = vtkIdList()
+        representation.GetSelectedControlPoints(selected)
+        for index in range(selected.GetNumberOfIds()):
+            point = selected.GetId(index)
+            if dynamics.GetMass(point) > 0:
+                dynamics.PinPoint(point, lattice.GetPoint(point))
+                dragged.add(point)
+
+    def release(*_):
+        for point in dragged:
+            if point in seated:  # a dragged seated point stays where it was put
+                seated[point] = lattice.GetPoint(point)
+                dynamics.PinPoint(point, seated[point])
+            else:
+                dynamics.UnpinPoint(point)
+        dragged.clear()
+
+    widget.AddObserver("InteractionEvent", pin_selection)
+    widget.AddObserver("EndInteractionEvent", release)
+    widget.On()
+
     if arguments.offscreen:
         arguments.output_dir.mkdir(parents=True, exist_ok=True)
         grabber = vtkWindowToImageFilter()
@@ -247,31 +312,8 @@ def main():
         sheet = arguments.output_dir / "contact_sheet.png"
         contact_sheet(pngs[step - 1::step][:12], sheet)
         print(f"wrote {len(pngs)} frames and {sheet}")
+        scripted_drag(interactor, renderer, lattice, dynamics, seated, frame)
     else:
-        interactor = vtkRenderWindowInteractor()
-        interactor.SetRenderWindow(window)
-        interactor.SetInteractorStyle(vtkInteractorStyleTrackballCamera())
-        # Drag control points with the lattice widget: while dragged they are pinned where the widget puts them,
-        # and the simulation pulls the rest of the body after them.
-        renderer.RemoveActor(lattice_actor)  # the widget draws the lattice
-        widget = vtkffd.vtkFFDLatticeWidget()
-        widget.SetInteractor(interactor)
-        widget.CreateDefaultRepresentation()
-        representation = widget.GetLatticeRepresentation()
-        representation.SetLattice(lattice)
-        selected = vtkIdList()
-
-        def pin_selection(*_):
-            dynamics.UnpinAllPoints()
-            representation.GetSelectedControlPoints(selected)
-            for index in range(selected.GetNumberOfIds()):
-                point = selected.GetId(index)
-                if dynamics.GetMass(point) > 0:
-                    dynamics.PinPoint(point, lattice.GetPoint(point))
-
-        widget.AddObserver("InteractionEvent", pin_selection)
-        widget.AddObserver("EndInteractionEvent", lambda *_: dynamics.UnpinAllPoints())
-        widget.On()
         interactor.Initialize()
         interactor.AddObserver("TimerEvent", lambda *_: frame())
         interactor.CreateRepeatingTimer(1000 // 30)
