@@ -2,10 +2,8 @@
 #include "vtkFFDLatticeDynamics.h"
 
 #include "vtkFFDDataContract.h"
-#include "vtkFFDGridDeformer.h"
+#include "vtkFFDLatticeBody.h"
 #include "vtkFFDMagneticSphere.h"
-#include "vtkFFDSparseCells.h"
-#include "vtkFFDTetrahedralDeformer.h"
 
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
@@ -15,15 +13,12 @@
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
 #include "vtkSmartPointer.h"
-#include "vtkUnstructuredGrid.h"
 
-#include "FFDGridDeformation.h"
 #include "FFDSoftBody.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdint>
 #include <map>
 #include <new>
 #include <string>
@@ -32,144 +27,6 @@
 vtkStandardNewMacro(vtkFFDLatticeDynamics);
 vtkCxxSetObjectMacro(vtkFFDLatticeDynamics, Lattice, vtkPointSet);
 vtkCxxSetObjectMacro(vtkFFDLatticeDynamics, Mesh, vtkPointSet);
-
-namespace
-{
-using Pair = std::array<int, 2>;
-
-/// Half of the 26 lattice neighbours, by SpringNeighborhood: the 3 edges, then 6 face and 4 body diagonals.
-constexpr int Offsets[13][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 }, { 1, 1, 0 }, { 1, -1, 0 }, { 1, 0, 1 },
-  { 1, 0, -1 }, { 0, 1, 1 }, { 0, 1, -1 }, { 1, 1, 1 }, { 1, 1, -1 }, { 1, -1, 1 }, { 1, -1, -1 } };
-constexpr int OffsetCount[3] = { 3, 9, 13 };
-
-/// The springs of a dense grid lattice: neighbours both simulated.
-std::vector<Pair> DenseSprings(const int dims[3], const std::vector<int>& particleOf, int offsets)
-{
-  std::vector<Pair> springs;
-  for (int k = 0; k < dims[2]; ++k)
-  {
-    for (int j = 0; j < dims[1]; ++j)
-    {
-      for (int i = 0; i < dims[0]; ++i)
-      {
-        const int a = particleOf[i + dims[0] * (j + dims[1] * k)];
-        for (int o = 0; a >= 0 && o < offsets; ++o)
-        {
-          const int n[3] = { i + Offsets[o][0], j + Offsets[o][1], k + Offsets[o][2] };
-          if (n[0] < dims[0] && n[1] >= 0 && n[1] < dims[1] && n[2] >= 0 && n[2] < dims[2])
-          {
-            const int b = particleOf[n[0] + dims[0] * (n[1] + dims[1] * n[2])];
-            if (b >= 0)
-            {
-              springs.push_back({ a, b });
-            }
-          }
-        }
-      }
-    }
-  }
-  return springs;
-}
-
-/// The springs of a sparse lattice: neighbours within a cell's support (every neighbour pair of the lattice
-/// lies in some support), each pair once, told by its first point and offset.
-std::vector<Pair> SparseSprings(
-  const vtkFFDSparseCells& cells, int supportCount, const std::vector<int>& particleOf, int offsets)
-{
-  std::vector<Pair> springs;
-  std::vector<std::uint16_t> done(particleOf.size(), 0); // per point, a bit per offset already joined
-  const int n = supportCount;
-  const int* supports = cells.GetSupports().data();
-  for (int cell = 0; cell < cells.GetNumberOfCells(); ++cell)
-  {
-    const int* support = supports + std::size_t(cell) * std::size_t(n * n * n);
-    for (int k = 0; k < n; ++k)
-    {
-      for (int j = 0; j < n; ++j)
-      {
-        for (int i = 0; i < n; ++i)
-        {
-          const int p = support[i + n * (j + n * k)];
-          for (int o = 0; o < offsets; ++o)
-          {
-            const int m[3] = { i + Offsets[o][0], j + Offsets[o][1], k + Offsets[o][2] };
-            if (m[0] >= n || m[1] < 0 || m[1] >= n || m[2] < 0 || m[2] >= n || (done[p] >> o & 1))
-            {
-              continue;
-            }
-            done[p] |= std::uint16_t(1u << o);
-            const int a = particleOf[p], b = particleOf[support[m[0] + n * (m[1] + n * m[2])]];
-            if (a >= 0 && b >= 0)
-            {
-              springs.push_back({ a, b });
-            }
-          }
-        }
-      }
-    }
-  }
-  return springs;
-}
-
-/// The springs of a tetrahedral lattice: its edges between simulated nodes, each once.
-std::vector<Pair> TetrahedronSprings(const std::vector<vtkIdType>& nodes, const std::vector<int>& particleOf)
-{
-  std::vector<Pair> springs;
-  for (std::size_t t = 0; t + 3 < nodes.size(); t += 4)
-  {
-    for (int e = 0; e < 4; ++e)
-    {
-      for (int f = e + 1; f < 4; ++f)
-      {
-        const int a = particleOf[nodes[t + e]], b = particleOf[nodes[t + f]];
-        if (a >= 0 && b >= 0 && a != b)
-        {
-          springs.push_back({ std::min(a, b), std::max(a, b) });
-        }
-      }
-    }
-  }
-  std::sort(springs.begin(), springs.end());
-  springs.erase(std::unique(springs.begin(), springs.end()), springs.end());
-  return springs;
-}
-/**
- * TotalMass shared among the particles in proportion to `share`, none below minimumFraction of the mean: those
- * that would be are set to it and the others share the rest, until no other falls below (the largest share
- * never does). Without shares (no mesh, or no point bound), the same mass for all.
- */
-std::vector<double> ShareMass(const std::vector<double>& share, double totalMass, double minimumFraction)
-{
-  const std::size_t n = share.size();
-  const double mean = totalMass / double(n), least = minimumFraction * mean;
-  std::vector<double> masses(n, mean);
-  std::vector<unsigned char> floored(n, 0);
-  for (bool changed = true; changed;)
-  {
-    changed = false;
-    double remaining = totalMass, shared = 0;
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      remaining -= floored[i] ? least : 0.0;
-      shared += floored[i] ? 0.0 : share[i];
-    }
-    if (!(shared > 0))
-    {
-      return std::vector<double>(n, mean);
-    }
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      masses[i] = floored[i] ? least : remaining * (share[i] / shared);
-      if (masses[i] < least)
-      {
-        floored[i] = 1;
-        changed = true;
-      }
-    }
-  }
-  return masses;
-}
-} // namespace
 
 //------------------------------------------------------------------------------------------------------------
 struct vtkFFDLatticeDynamics::Internals
@@ -332,169 +189,39 @@ int vtkFFDLatticeDynamics::InitializeBody()
 {
   Internals& in = *this->Internal;
   in.Ready = false;
-  vtkPointSet* lattice = this->Lattice;
-  if (!lattice || !lattice->GetPoints() || lattice->GetNumberOfPoints() == 0)
-  {
-    vtkErrorMacro("No lattice to simulate: SetLattice() to the output of vtkFFDBuildLattice or "
-                  "vtkFFDBuildTetrahedralLattice.");
-    return 0;
-  }
-  vtkDataArray* rest = lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
-  const vtkIdType count = lattice->GetNumberOfPoints();
-  if (count > VTK_INT_MAX)
-  {
-    vtkErrorMacro(<< "The lattice has " << count << " points; at most " << VTK_INT_MAX << " can be simulated.");
-    return 0;
-  }
-  if (!rest || rest->GetNumberOfComponents() != 3 || rest->GetNumberOfTuples() != count)
-  {
-    vtkErrorMacro("The lattice has no RestPosition point array of 3 components per point.");
-    return 0;
-  }
-
-  // The lattice's kind, read and checked by vtkFFDDeform's own readers; the mesh's points bound to it.
-  const bool tetrahedral = vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice);
-  vtkFFDGridDeformer grid;
-  vtkFFDTetrahedralDeformer tetrahedra;
+  vtkFFDLatticeBody body;
   std::string why =
-    tetrahedral ? tetrahedra.SetLattice(vtkUnstructuredGrid::SafeDownCast(lattice)) : grid.SetLattice(lattice);
+    body.Read(this->Lattice, this->Mesh, this->SpringNeighborhood, this->TotalMass, this->MinimumMassFraction);
+  if (why.empty())
+  {
+    why = in.Body.SetUp(body.RestPositions, std::move(body.Masses), std::move(body.Springs));
+  }
   if (!why.empty())
   {
-    vtkErrorMacro(<< "Cannot simulate the lattice: " << why);
+    vtkErrorMacro(<< why);
     return 0;
   }
-
-  // Particles: the active control points.
-  in.ParticleOf.assign(std::size_t(count), -1);
-  in.PointOf.clear();
-  vtkDataArray* active = lattice->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName());
-  if (active && (active->GetNumberOfComponents() != 1 || active->GetNumberOfTuples() != count))
-  {
-    vtkErrorMacro("The lattice's Active point array does not have one value per point.");
-    return 0;
-  }
-  std::vector<double> restPositions;
-  for (vtkIdType p = 0; p < count; ++p)
-  {
-    if (!active || active->GetComponent(p, 0) != 0)
-    {
-      in.ParticleOf[p] = static_cast<int>(in.PointOf.size());
-      in.PointOf.push_back(p);
-      double x[3];
-      rest->GetTuple(p, x);
-      restPositions.insert(restPositions.end(), x, x + 3);
-    }
-  }
-  if (in.PointOf.empty())
-  {
-    vtkErrorMacro("The lattice has no active control point to simulate.");
-    return 0;
-  }
-
-  // Springs.
-  std::vector<Pair> springs;
-  const int offsets = OffsetCount[this->SpringNeighborhood];
-  if (tetrahedral)
-  {
-    springs = TetrahedronSprings(tetrahedra.GetNodes(), in.ParticleOf);
-  }
-  else if (const vtkFFDSparseCells* cells = grid.GetSparseCells())
-  {
-    springs = SparseSprings(*cells, ffd::CellDegree(grid.GetLattice().Basis) + 1, in.ParticleOf, offsets);
-  }
-  else
-  {
-    springs = DenseSprings(grid.GetLattice().ControlPointsPerAxis, in.ParticleOf, offsets);
-  }
-
-  // Masses: each particle's share of the mesh's points, through their weights.
-  const std::size_t particles = in.PointOf.size();
-  std::vector<double> share(particles, 0.0);
-  vtkPointSet* mesh = this->Mesh;
-  if (mesh && mesh->GetPoints() && mesh->GetNumberOfPoints() > 0)
-  {
-    vtkPoints* points = mesh->GetPoints();
-    bool rebound = false;
-    auto add = [&](vtkIdType point, double weight)
-    {
-      const int particle = in.ParticleOf[point];
-      if (particle >= 0)
-      {
-        share[particle] += weight;
-      }
-    };
-    if (tetrahedral)
-    {
-      tetrahedra.Bind(points, vtkFFDTetrahedralDeformer::KEEP_POSITION, nullptr, 0, 1, rebound);
-      const std::vector<int>& cellOf = tetrahedra.GetCellOfPoint();
-      const std::vector<vtkIdType>& nodes = tetrahedra.GetNodes();
-      for (vtkIdType p = 0; p < mesh->GetNumberOfPoints(); ++p)
-      {
-        const int t = cellOf[p];
-        if (t >= 0)
-        {
-          double x[3];
-          points->GetPoint(p, x);
-          const ffd::Vec3<double> stu = tetrahedra.GetFrames()[t].ToParametric({ x[0], x[1], x[2] });
-          const double weights[4] = { 1.0 - stu.x - stu.y - stu.z, stu.x, stu.y, stu.z };
-          for (int corner = 0; corner < 4; ++corner)
-          {
-            add(nodes[4 * std::size_t(t) + corner], weights[corner]);
-          }
-        }
-      }
-    }
-    else
-    {
-      grid.Bind(points, 0 /* KEEP_POSITION */, nullptr, 0, 1, rebound);
-      const std::vector<int>& cellOf = grid.GetCellOfPoint();
-      const vtkFFDGridLattice& view = grid.GetLattice();
-      const vtkFFDSparseCells* cells = grid.GetSparseCells();
-      ffd::WithStaticBasis(view.Basis,
-        [&](auto maxCount, auto)
-        {
-          const ffd::GridDeformation<decltype(maxCount)::value, double> deformation{ view.Basis,
-            { view.Divisions[0], view.Divisions[1], view.Divisions[2] },
-            { view.ControlPointsPerAxis[0], view.ControlPointsPerAxis[1], view.ControlPointsPerAxis[2] },
-            view.Displacements.data(), ffd::Frame<double>::FromArray(view.Frame), nullptr,
-            cells ? cells->GetVoxels().data() : nullptr, cells ? cells->GetSupports().data() : nullptr };
-          for (vtkIdType p = 0; p < mesh->GetNumberOfPoints(); ++p)
-          {
-            if (cellOf[p] >= 0)
-            {
-              double x[3];
-              points->GetPoint(p, x);
-              deformation.ForEachWeight({ x[0], x[1], x[2] }, cellOf[p], add);
-            }
-          }
-        });
-    }
-  }
-  std::vector<double> masses = ShareMass(share, this->TotalMass, this->MinimumMassFraction);
-
-  why = in.Body.SetUp(std::move(restPositions), std::move(masses), std::move(springs));
-  if (!why.empty())
-  {
-    vtkErrorMacro(<< "Cannot simulate the lattice: " << why);
-    return 0;
-  }
+  in.PointOf = std::move(body.PointOf);
+  in.ParticleOf = std::move(body.ParticleOf);
   // The state: the lattice's current points, at rest.
+  vtkPointSet* lattice = this->Lattice;
+  vtkPointSet* mesh = this->Mesh;
+  vtkDataArray* rest = lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
   std::vector<double>& u = in.Body.Displacements();
-  for (std::size_t i = 0; i < particles; ++i)
+  for (std::size_t i = 0; i < in.PointOf.size(); ++i)
   {
-    double x[3], x0[3];
+    double x[3];
     lattice->GetPoint(in.PointOf[i], x);
-    rest->GetTuple(in.PointOf[i], x0);
     for (int c = 0; c < 3; ++c)
     {
-      u[3 * i + c] = x[c] - x0[c];
+      u[3 * i + c] = x[c] - body.RestPositions[3 * i + c];
     }
   }
   in.Time = 0;
   in.Impulses.clear();
   in.Lattice = lattice;
   in.Mesh = mesh;
-  in.LatticePoints = count;
+  in.LatticePoints = lattice->GetNumberOfPoints();
   in.Rest = rest;
   in.RestTime = rest->GetMTime();
   in.MeshTime = mesh && mesh->GetPoints() ? mesh->GetPoints()->GetMTime() : 0;

@@ -1,0 +1,294 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkFFDLatticeBody.h"
+
+#include "vtkFFDDataContract.h"
+#include "vtkFFDGridDeformer.h"
+#include "vtkFFDSparseCells.h"
+#include "vtkFFDTetrahedralDeformer.h"
+
+#include "vtkDataArray.h"
+#include "vtkPointData.h"
+#include "vtkPointSet.h"
+#include "vtkPoints.h"
+#include "vtkUnstructuredGrid.h"
+
+#include "FFDGridDeformation.h"
+
+#include <algorithm>
+#include <cstdint>
+
+namespace
+{
+using Pair = std::array<int, 2>;
+
+/// Half of the 26 lattice neighbours, by SpringNeighborhood: the 3 edges, then 6 face and 4 body diagonals.
+constexpr int Offsets[13][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 }, { 1, 1, 0 }, { 1, -1, 0 }, { 1, 0, 1 },
+  { 1, 0, -1 }, { 0, 1, 1 }, { 0, 1, -1 }, { 1, 1, 1 }, { 1, 1, -1 }, { 1, -1, 1 }, { 1, -1, -1 } };
+constexpr int OffsetCount[3] = { 3, 9, 13 };
+
+/// The springs of a dense grid lattice: neighbours both simulated.
+std::vector<Pair> DenseSprings(const int dims[3], const std::vector<int>& particleOf, int offsets)
+{
+  std::vector<Pair> springs;
+  for (int k = 0; k < dims[2]; ++k)
+  {
+    for (int j = 0; j < dims[1]; ++j)
+    {
+      for (int i = 0; i < dims[0]; ++i)
+      {
+        const int a = particleOf[i + dims[0] * (j + dims[1] * k)];
+        for (int o = 0; a >= 0 && o < offsets; ++o)
+        {
+          const int n[3] = { i + Offsets[o][0], j + Offsets[o][1], k + Offsets[o][2] };
+          if (n[0] < dims[0] && n[1] >= 0 && n[1] < dims[1] && n[2] >= 0 && n[2] < dims[2])
+          {
+            const int b = particleOf[n[0] + dims[0] * (n[1] + dims[1] * n[2])];
+            if (b >= 0)
+            {
+              springs.push_back({ a, b });
+            }
+          }
+        }
+      }
+    }
+  }
+  return springs;
+}
+
+/// The springs of a sparse lattice: neighbours within a cell's support (every neighbour pair of the lattice
+/// lies in some support), each pair once, told by its first point and offset.
+std::vector<Pair> SparseSprings(
+  const vtkFFDSparseCells& cells, int supportCount, const std::vector<int>& particleOf, int offsets)
+{
+  std::vector<Pair> springs;
+  std::vector<std::uint16_t> done(particleOf.size(), 0); // per point, a bit per offset already joined
+  const int n = supportCount;
+  const int* supports = cells.GetSupports().data();
+  for (int cell = 0; cell < cells.GetNumberOfCells(); ++cell)
+  {
+    const int* support = supports + std::size_t(cell) * std::size_t(n * n * n);
+    for (int k = 0; k < n; ++k)
+    {
+      for (int j = 0; j < n; ++j)
+      {
+        for (int i = 0; i < n; ++i)
+        {
+          const int p = support[i + n * (j + n * k)];
+          for (int o = 0; o < offsets; ++o)
+          {
+            const int m[3] = { i + Offsets[o][0], j + Offsets[o][1], k + Offsets[o][2] };
+            if (m[0] >= n || m[1] < 0 || m[1] >= n || m[2] < 0 || m[2] >= n || (done[p] >> o & 1))
+            {
+              continue;
+            }
+            done[p] |= std::uint16_t(1u << o);
+            const int a = particleOf[p], b = particleOf[support[m[0] + n * (m[1] + n * m[2])]];
+            if (a >= 0 && b >= 0)
+            {
+              springs.push_back({ a, b });
+            }
+          }
+        }
+      }
+    }
+  }
+  return springs;
+}
+
+/// The springs of a tetrahedral lattice: its edges between simulated nodes, each once.
+std::vector<Pair> TetrahedronSprings(const std::vector<vtkIdType>& nodes, const std::vector<int>& particleOf)
+{
+  std::vector<Pair> springs;
+  for (std::size_t t = 0; t + 3 < nodes.size(); t += 4)
+  {
+    for (int e = 0; e < 4; ++e)
+    {
+      for (int f = e + 1; f < 4; ++f)
+      {
+        const int a = particleOf[nodes[t + e]], b = particleOf[nodes[t + f]];
+        if (a >= 0 && b >= 0 && a != b)
+        {
+          springs.push_back({ std::min(a, b), std::max(a, b) });
+        }
+      }
+    }
+  }
+  std::sort(springs.begin(), springs.end());
+  springs.erase(std::unique(springs.begin(), springs.end()), springs.end());
+  return springs;
+}
+/**
+ * TotalMass shared among the particles in proportion to `share`, none below minimumFraction of the mean: those
+ * that would be are set to it and the others share the rest, until no other falls below (the largest share
+ * never does). Without shares (no mesh, or no point bound), the same mass for all.
+ */
+std::vector<double> ShareMass(const std::vector<double>& share, double totalMass, double minimumFraction)
+{
+  const std::size_t n = share.size();
+  const double mean = totalMass / double(n), least = minimumFraction * mean;
+  std::vector<double> masses(n, mean);
+  std::vector<unsigned char> floored(n, 0);
+  for (bool changed = true; changed;)
+  {
+    changed = false;
+    double remaining = totalMass, shared = 0;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      remaining -= floored[i] ? least : 0.0;
+      shared += floored[i] ? 0.0 : share[i];
+    }
+    if (!(shared > 0))
+    {
+      return std::vector<double>(n, mean);
+    }
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      masses[i] = floored[i] ? least : remaining * (share[i] / shared);
+      if (masses[i] < least)
+      {
+        floored[i] = 1;
+        changed = true;
+      }
+    }
+  }
+  return masses;
+}
+} // namespace
+
+//------------------------------------------------------------------------------------------------------------
+std::string vtkFFDLatticeBody::Read(
+  vtkPointSet* lattice, vtkPointSet* mesh, int neighborhood, double totalMass, double minimumMassFraction)
+{
+  if (!lattice || !lattice->GetPoints() || lattice->GetNumberOfPoints() == 0)
+  {
+    return "No lattice to simulate: SetLattice() to the output of vtkFFDBuildLattice or "
+           "vtkFFDBuildTetrahedralLattice.";
+  }
+  vtkDataArray* rest = lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
+  const vtkIdType count = lattice->GetNumberOfPoints();
+  if (count > VTK_INT_MAX)
+  {
+    return "The lattice has " + std::to_string(count) + " points; at most " + std::to_string(VTK_INT_MAX) +
+      " can be simulated.";
+  }
+  if (!rest || rest->GetNumberOfComponents() != 3 || rest->GetNumberOfTuples() != count)
+  {
+    return "The lattice has no RestPosition point array of 3 components per point.";
+  }
+
+  // The lattice's kind, read and checked by vtkFFDDeform's own readers; the mesh's points bound to it.
+  const bool tetrahedral = vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice);
+  vtkFFDGridDeformer grid;
+  vtkFFDTetrahedralDeformer tetrahedra;
+  std::string why =
+    tetrahedral ? tetrahedra.SetLattice(vtkUnstructuredGrid::SafeDownCast(lattice)) : grid.SetLattice(lattice);
+  if (!why.empty())
+  {
+    return "Cannot simulate the lattice: " + why;
+  }
+
+  // Particles: the active control points.
+  this->ParticleOf.assign(std::size_t(count), -1);
+  this->PointOf.clear();
+  vtkDataArray* active = lattice->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName());
+  if (active && (active->GetNumberOfComponents() != 1 || active->GetNumberOfTuples() != count))
+  {
+    return "The lattice's Active point array does not have one value per point.";
+  }
+  this->RestPositions.clear();
+  for (vtkIdType p = 0; p < count; ++p)
+  {
+    if (!active || active->GetComponent(p, 0) != 0)
+    {
+      this->ParticleOf[p] = static_cast<int>(this->PointOf.size());
+      this->PointOf.push_back(p);
+      double x[3];
+      rest->GetTuple(p, x);
+      this->RestPositions.insert(this->RestPositions.end(), x, x + 3);
+    }
+  }
+  if (this->PointOf.empty())
+  {
+    return "The lattice has no active control point to simulate.";
+  }
+
+  // Springs.
+  const int offsets = OffsetCount[neighborhood];
+  if (tetrahedral)
+  {
+    this->Springs = TetrahedronSprings(tetrahedra.GetNodes(), this->ParticleOf);
+  }
+  else if (const vtkFFDSparseCells* cells = grid.GetSparseCells())
+  {
+    this->Springs = SparseSprings(*cells, ffd::CellDegree(grid.GetLattice().Basis) + 1, this->ParticleOf, offsets);
+  }
+  else
+  {
+    this->Springs = DenseSprings(grid.GetLattice().ControlPointsPerAxis, this->ParticleOf, offsets);
+  }
+
+  // Masses: each particle's share of the mesh's points, through their weights.
+  const std::size_t particles = this->PointOf.size();
+  std::vector<double> share(particles, 0.0);
+  if (mesh && mesh->GetPoints() && mesh->GetNumberOfPoints() > 0)
+  {
+    vtkPoints* points = mesh->GetPoints();
+    bool rebound = false;
+    auto add = [&](vtkIdType point, double weight)
+    {
+      const int particle = this->ParticleOf[point];
+      if (particle >= 0)
+      {
+        share[particle] += weight;
+      }
+    };
+    if (tetrahedral)
+    {
+      tetrahedra.Bind(points, vtkFFDTetrahedralDeformer::KEEP_POSITION, nullptr, 0, 1, rebound);
+      const std::vector<int>& cellOf = tetrahedra.GetCellOfPoint();
+      const std::vector<vtkIdType>& nodes = tetrahedra.GetNodes();
+      for (vtkIdType p = 0; p < mesh->GetNumberOfPoints(); ++p)
+      {
+        const int t = cellOf[p];
+        if (t >= 0)
+        {
+          double x[3];
+          points->GetPoint(p, x);
+          const ffd::Vec3<double> stu = tetrahedra.GetFrames()[t].ToParametric({ x[0], x[1], x[2] });
+          const double weights[4] = { 1.0 - stu.x - stu.y - stu.z, stu.x, stu.y, stu.z };
+          for (int corner = 0; corner < 4; ++corner)
+          {
+            add(nodes[4 * std::size_t(t) + corner], weights[corner]);
+          }
+        }
+      }
+    }
+    else
+    {
+      grid.Bind(points, 0 /* KEEP_POSITION */, nullptr, 0, 1, rebound);
+      const std::vector<int>& cellOf = grid.GetCellOfPoint();
+      const vtkFFDGridLattice& view = grid.GetLattice();
+      const vtkFFDSparseCells* cells = grid.GetSparseCells();
+      ffd::WithStaticBasis(view.Basis,
+        [&](auto maxCount, auto)
+        {
+          const ffd::GridDeformation<decltype(maxCount)::value, double> deformation{ view.Basis,
+            { view.Divisions[0], view.Divisions[1], view.Divisions[2] },
+            { view.ControlPointsPerAxis[0], view.ControlPointsPerAxis[1], view.ControlPointsPerAxis[2] },
+            view.Displacements.data(), ffd::Frame<double>::FromArray(view.Frame), nullptr,
+            cells ? cells->GetVoxels().data() : nullptr, cells ? cells->GetSupports().data() : nullptr };
+          for (vtkIdType p = 0; p < mesh->GetNumberOfPoints(); ++p)
+          {
+            if (cellOf[p] >= 0)
+            {
+              double x[3];
+              points->GetPoint(p, x);
+              deformation.ForEachWeight({ x[0], x[1], x[2] }, cellOf[p], add);
+            }
+          }
+        });
+    }
+  }
+  this->Masses = ShareMass(share, totalMass, minimumMassFraction);
+  return std::string();
+}
