@@ -235,6 +235,11 @@ int vtkFFDLatticeDynamics::InitializeBody()
 //------------------------------------------------------------------------------------------------------------
 int vtkFFDLatticeDynamics::Step(int steps)
 {
+  if (steps < 0)
+  {
+    vtkErrorMacro(<< "Step(" << steps << "): the number of steps cannot be negative.");
+    return 0;
+  }
   try
   {
     return this->StepBody(steps);

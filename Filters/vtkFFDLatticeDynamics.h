@@ -165,7 +165,7 @@ public:
   /// Reads the lattice and the mesh and starts at rest from the lattice's points. Returns 1, or 0 after an error.
   int Initialize();
 
-  /// Advances `steps` time steps (ProgressEvents every 5 % of them from 20 steps). Returns 1, or 0 after an
+  /// Advances `steps` (>= 0) time steps (ProgressEvents every 5 % of them from 20 steps). Returns 1, or 0 after an
   /// error.
   int Step(int steps = 1);
 

@@ -713,6 +713,8 @@ TEST(FFDLatticeDynamics, BadInputGivesErrors)
   auto saw = [&](const char* what) { return errors->Errors.find(what) != std::string::npos; };
   EXPECT_FALSE(dynamics->Step());
   EXPECT_TRUE(saw("No lattice to simulate"));
+  EXPECT_FALSE(dynamics->Step(-1));
+  EXPECT_TRUE(saw("cannot be negative"));
 
   Scene scene = BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::DENSE);
   const std::vector<Vec> before = PointsOf(scene.Lattice);
