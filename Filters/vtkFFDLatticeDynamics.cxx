@@ -52,6 +52,30 @@ struct vtkFFDLatticeDynamics::Internals
   std::map<vtkIdType, std::array<double, 3>> Impulses;
 };
 
+namespace
+{
+/// The soft body's settings from the dynamics' own.
+ffd::SoftBodySettings SettingsOf(vtkFFDLatticeDynamics& dynamics)
+{
+  ffd::SoftBodySettings settings;
+  settings.TimeStep = dynamics.GetTimeStep();
+  settings.SpringStiffness = dynamics.GetSpringStiffness();
+  settings.SpringDamping = dynamics.GetSpringDamping();
+  settings.CoreStiffness = dynamics.GetCoreStiffness();
+  settings.Iterations = dynamics.GetIterations();
+  return settings;
+}
+
+/// Particle i's position, its rest position plus its displacement in u.
+void PositionOf(const ffd::SoftBody& body, const std::vector<double>& u, std::size_t i, double x[3])
+{
+  for (int c = 0; c < 3; ++c)
+  {
+    x[c] = body.GetRestPositions()[3 * i + c] + u[3 * i + c];
+  }
+}
+} // namespace
+
 //------------------------------------------------------------------------------------------------------------
 vtkFFDLatticeDynamics::vtkFFDLatticeDynamics()
   : Lattice(nullptr)
@@ -194,7 +218,7 @@ int vtkFFDLatticeDynamics::InitializeBody()
     body.Read(this->Lattice, this->Mesh, this->SpringNeighborhood, this->TotalMass, this->MinimumMassFraction);
   if (why.empty())
   {
-    why = in.Body.SetUp(body.RestPositions, std::move(body.Masses), std::move(body.Springs));
+    why = in.Body.SetUp(std::move(body.RestPositions), std::move(body.Masses), std::move(body.Springs));
   }
   if (!why.empty())
   {
@@ -214,7 +238,7 @@ int vtkFFDLatticeDynamics::InitializeBody()
     lattice->GetPoint(in.PointOf[i], x);
     for (int c = 0; c < 3; ++c)
     {
-      u[3 * i + c] = x[c] - body.RestPositions[3 * i + c];
+      u[3 * i + c] = x[c] - in.Body.GetRestPositions()[3 * i + c];
     }
   }
   in.Time = 0;
@@ -269,16 +293,10 @@ int vtkFFDLatticeDynamics::StepBody(int steps)
   {
     return 0;
   }
-  rest = this->Lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
   ffd::SoftBody& body = in.Body;
   const std::size_t particles = in.PointOf.size();
-  ffd::SoftBodySettings settings;
-  settings.TimeStep = this->TimeStep;
-  settings.SpringStiffness = this->SpringStiffness;
-  settings.SpringDamping = this->SpringDamping;
-  settings.CoreStiffness = this->CoreStiffness;
-  settings.Iterations = this->Iterations;
-  body.SetSettings(settings);
+  const std::vector<double>& restPositions = body.GetRestPositions();
+  body.SetSettings(SettingsOf(*this));
 
   // Pins: their particles and targets (as displacements from rest).
   std::vector<unsigned char> pinned(particles, 0);
@@ -292,11 +310,9 @@ int vtkFFDLatticeDynamics::StepBody(int steps)
       return 0;
     }
     pinned[particle] = 1;
-    double x0[3];
-    rest->GetTuple(pin.first, x0);
     for (int c = 0; c < 3; ++c)
     {
-      targets[3 * particle + c] = pin.second[c] - x0[c];
+      targets[3 * particle + c] = pin.second[c] - restPositions[3 * particle + c];
     }
   }
   body.SetPinned(pinned);
@@ -311,19 +327,13 @@ int vtkFFDLatticeDynamics::StepBody(int steps)
       in.Impulses.clear();
       return 0;
     }
-    const double m = this->GetMass(impulse.first);
     for (int c = 0; c < 3; ++c)
     {
-      body.Velocities()[3 * particle + c] += impulse.second[c] / m;
+      body.Velocities()[3 * particle + c] += impulse.second[c] / body.GetMass(particle);
     }
   }
   in.Impulses.clear();
 
-  std::vector<double> restPositions(3 * particles);
-  for (std::size_t i = 0; i < particles; ++i)
-  {
-    rest->GetTuple(in.PointOf[i], &restPositions[3 * i]);
-  }
   // Colliders: a point inside one is moved onto its zero set by Newton's steps along the gradient.
   auto collide = [&](std::vector<double>& u)
   {
@@ -336,10 +346,7 @@ int vtkFFDLatticeDynamics::StepBody(int steps)
           continue;
         }
         double x[3];
-        for (int c = 0; c < 3; ++c)
-        {
-          x[c] = restPositions[3 * i + c] + u[3 * i + c];
-        }
+        PositionOf(body, u, i, x);
         for (int newton = 0; newton < 8; ++newton)
         {
           const double f = collider->FunctionValue(x);
@@ -374,17 +381,20 @@ int vtkFFDLatticeDynamics::StepBody(int steps)
     const std::vector<double>& u = body.Displacements();
     for (std::size_t i = 0; i < particles; ++i)
     {
-      double* a = &acceleration[3 * i];
-      std::copy(this->Gravity, this->Gravity + 3, a);
-      const double x[3] = { restPositions[3 * i] + u[3 * i], restPositions[3 * i + 1] + u[3 * i + 1],
-        restPositions[3 * i + 2] + u[3 * i + 2] };
-      for (const auto& sphere : in.Spheres)
+      std::copy(this->Gravity, this->Gravity + 3, &acceleration[3 * i]);
+    }
+    for (const auto& sphere : in.Spheres)
+    {
+      double center[3];
+      sphere->GetCenterAt(in.Time, center);
+      for (std::size_t i = 0; i < particles; ++i)
       {
-        double pull[3];
-        sphere->GetAcceleration(x, in.Time, pull);
+        double x[3], pull[3];
+        PositionOf(body, u, i, x);
+        sphere->GetAccelerationAround(center, x, pull);
         for (int c = 0; c < 3; ++c)
         {
-          a[c] += pull[c];
+          acceleration[3 * i + c] += pull[c];
         }
       }
     }
@@ -408,8 +418,8 @@ int vtkFFDLatticeDynamics::StepBody(int steps)
   const std::vector<double>& u = body.Displacements();
   for (std::size_t i = 0; i < particles; ++i)
   {
-    const double x[3] = { restPositions[3 * i] + u[3 * i], restPositions[3 * i + 1] + u[3 * i + 1],
-      restPositions[3 * i + 2] + u[3 * i + 2] };
+    double x[3];
+    PositionOf(body, u, i, x);
     points->SetPoint(in.PointOf[i], x);
   }
   points->Modified();
@@ -443,10 +453,7 @@ double vtkFFDLatticeDynamics::GetPotentialEnergy()
   {
     return 0.0;
   }
-  ffd::SoftBodySettings settings = this->Internal->Body.GetSettings();
-  settings.SpringStiffness = this->SpringStiffness;
-  settings.CoreStiffness = this->CoreStiffness;
-  this->Internal->Body.SetSettings(settings);
+  this->Internal->Body.SetSettings(SettingsOf(*this));
   return this->Internal->Body.SpringEnergy() + this->Internal->Body.CoreEnergy();
 }
 
@@ -473,10 +480,7 @@ double vtkFFDLatticeDynamics::GetExplicitTimeStepLimit()
   {
     return 0.0;
   }
-  ffd::SoftBodySettings settings = this->Internal->Body.GetSettings();
-  settings.SpringStiffness = this->SpringStiffness;
-  settings.CoreStiffness = this->CoreStiffness;
-  this->Internal->Body.SetSettings(settings);
+  this->Internal->Body.SetSettings(SettingsOf(*this));
   return this->Internal->Body.ExplicitTimeStepLimit();
 }
 

@@ -63,6 +63,12 @@ void vtkFFDMagneticSphere::GetAcceleration(const double x[3], double t, double a
 {
   double center[3];
   this->GetCenterAt(t, center);
+  this->GetAccelerationAround(center, x, acceleration);
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDMagneticSphere::GetAccelerationAround(const double center[3], const double x[3], double acceleration[3])
+{
   const double toward[3] = { center[0] - x[0], center[1] - x[1], center[2] - x[2] };
   const double d = std::sqrt(toward[0] * toward[0] + toward[1] * toward[1] + toward[2] * toward[2]);
   double magnitude = 0; // divided by d below: a(d) along the unit vector toward / d

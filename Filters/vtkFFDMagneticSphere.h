@@ -94,6 +94,10 @@ public:
   /// The acceleration a(d) of a point at x at time t (see above).
   void GetAcceleration(const double x[3], double t, double acceleration[3]);
 
+  /// The acceleration of a point at x with the sphere's centre at `center` (GetCenterAt()): for many points at
+  /// one time, the centre found once.
+  void GetAccelerationAround(const double center[3], const double x[3], double acceleration[3]);
+
   /// Includes the path's modification time.
   vtkMTimeType GetMTime() override;
 

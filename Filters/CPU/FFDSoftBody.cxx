@@ -314,6 +314,16 @@ SoftBody::Core SoftBody::RigidCore(const std::vector<double>& u) const
 }
 
 //------------------------------------------------------------------------------------------------------------
+void SoftBody::SpringVector(const std::vector<double>& u, std::size_t k, double d[3]) const
+{
+  const int a = this->Springs[k][0], b = this->Springs[k][1];
+  for (int c = 0; c < 3; ++c)
+  {
+    d[c] = this->RestVector[3 * k + c] + (u[3 * b + c] - u[3 * a + c]);
+  }
+}
+
+//------------------------------------------------------------------------------------------------------------
 bool SoftBody::Step(const std::vector<double>& acceleration, const std::vector<double>& targets,
   const std::function<void(std::vector<double>&)>& constrain)
 {
@@ -377,8 +387,8 @@ bool SoftBody::Step(const std::vector<double>& acceleration, const std::vector<d
     {
       const int a = this->Springs[k][0], b = this->Springs[k][1];
       const double* rest = &this->RestVector[3 * k];
-      const double d[3] = { rest[0] + (u[3 * b] - u[3 * a]), rest[1] + (u[3 * b + 1] - u[3 * a + 1]),
-        rest[2] + (u[3 * b + 2] - u[3 * a + 2]) };
+      double d[3];
+      this->SpringVector(u, k, d);
       const double length = Norm(d);
       if (!(length > 0))
       {
@@ -409,12 +419,9 @@ bool SoftBody::Step(const std::vector<double>& acceleration, const std::vector<d
         {
           continue;
         }
-        const double* q = &this->Centered[3 * i];
         for (int c = 0; c < 3; ++c)
         {
-          const double goal = core.Rotation[c][0] * q[0] + core.Rotation[c][1] * q[1] + core.Rotation[c][2] * q[2] +
-            core.Shift[c]; // g - X
-          rhs[3 * r + c] += s.CoreStiffness * this->Mass[i] * goal;
+          rhs[3 * r + c] += s.CoreStiffness * this->Mass[i] * core.Goal(&this->Centered[3 * i], c);
         }
       }
     }
@@ -458,12 +465,8 @@ double SoftBody::SpringEnergy() const
   double energy = 0;
   for (std::size_t k = 0; k < this->Springs.size(); ++k)
   {
-    const int a = this->Springs[k][0], b = this->Springs[k][1];
     double d[3];
-    for (int c = 0; c < 3; ++c)
-    {
-      d[c] = this->RestVector[3 * k + c] + (this->U[3 * b + c] - this->U[3 * a + c]);
-    }
+    this->SpringVector(this->U, k, d);
     const double stretch = Norm(d) - this->RestLength[k];
     energy += 0.5 * this->Settings.SpringStiffness * stretch * stretch;
   }
@@ -480,13 +483,10 @@ double SoftBody::CoreEnergy() const
   double energy = 0;
   for (std::size_t i = 0; i < this->Mass.size(); ++i)
   {
-    const double* q = &this->Centered[3 * i];
     double squared = 0;
     for (int c = 0; c < 3; ++c)
     {
-      const double goal =
-        core.Rotation[c][0] * q[0] + core.Rotation[c][1] * q[1] + core.Rotation[c][2] * q[2] + core.Shift[c];
-      const double off = this->U[3 * i + c] - goal;
+      const double off = this->U[3 * i + c] - core.Goal(&this->Centered[3 * i], c);
       squared += off * off;
     }
     energy += 0.5 * this->Settings.CoreStiffness * this->Mass[i] * squared;

@@ -64,6 +64,9 @@ public:
   /// Pinned particles (one flag a particle, empty: none) follow the targets given to Step().
   void SetPinned(std::vector<unsigned char> pinned);
 
+  /// The rest positions of SetUp(), 3 a particle.
+  const std::vector<double>& GetRestPositions() const { return this->Rest; }
+
   ///@{
   /// The state: displacements from rest and velocities, 3 a particle.
   std::vector<double>& Displacements() { return this->U; }
@@ -108,8 +111,16 @@ private:
   {
     double Rotation[3][3]; ///< R - I (exactly zero at rest)
     double Shift[3];       ///< c - C0: the mean displacement
+
+    /// Coordinate c of g - X, the displacement of a particle at q = X - C0 on the core.
+    double Goal(const double q[3], int c) const
+    {
+      return this->Rotation[c][0] * q[0] + this->Rotation[c][1] * q[1] + this->Rotation[c][2] * q[2] + this->Shift[c];
+    }
   };
   Core RigidCore(const std::vector<double>& u) const;
+  /// Spring k's vector x_b - x_a at displacements u, from its rest vector (exactly it at rest).
+  void SpringVector(const std::vector<double>& u, std::size_t k, double d[3]) const;
   bool Factorize();
 
   std::vector<double> Rest;
