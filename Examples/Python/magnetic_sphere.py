@@ -24,16 +24,14 @@ from pathlib import Path
 
 from vtkmodules.vtkCommonCore import vtkCommand, vtkIdList, vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkStructuredGrid
-from vtkmodules.vtkFiltersCore import vtkPolyDataNormals
 from vtkmodules.vtkFiltersSources import vtkSphereSource
 from vtkmodules.vtkFiltersCore import vtkImageAppend
 from vtkmodules.vtkImagingCore import vtkImageResize
 from vtkmodules.vtkIOImage import vtkPNGReader, vtkPNGWriter
-from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
 from vtkmodules.vtkInteractionStyle import vtkInteractorStyleTrackballCamera
-from vtkmodules.vtkRenderingCore import vtkInteractorObserver
 from vtkmodules.vtkRenderingCore import (
     vtkActor,
+    vtkInteractorObserver,
     vtkPolyDataMapper,
     vtkRenderer,
     vtkRenderWindow,
@@ -42,12 +40,9 @@ from vtkmodules.vtkRenderingCore import (
 )
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL implementations of the rendering classes)
 
-try:
-    import vtkffd
-except ImportError as error:
-    sys.exit(f"{error}: put the built package on PYTHONPATH, e.g. PYTHONPATH=build/lib/python3/dist-packages")
+# The mesh reading of the demo (this folder is on sys.path when run as a script).
+from deform_mesh import REPOSITORY, read_mesh, vtkffd
 
-REPOSITORY = Path(__file__).resolve().parents[2]
 DIVISIONS = 5  # voxels per axis: 6x6x6 = 216 control points, as in the paper's Figure 1
 PERIOD = 4.0  # seconds for one orbit of the sphere
 STEPS_PER_FRAME = 2  # simulation steps of 1/60 s per rendered frame (30 frames a second of simulated time)
@@ -66,19 +61,6 @@ def parse_arguments():
     if arguments.frames < 1:
         parser.error("--frames needs at least one frame")
     return arguments
-
-
-def read_bear():
-    path = REPOSITORY / "Testing" / "Data" / "Meshes" / "bear.vtp"
-    if not path.is_file():
-        sys.exit(f"{path} is missing: run Utilities/setup.sh to fetch the meshes")
-    reader = vtkXMLPolyDataReader()
-    reader.SetFileName(str(path))
-    normals = vtkPolyDataNormals()  # point normals for smooth shading; vtkFFDDeform transforms them
-    normals.SetInputConnection(reader.GetOutputPort())
-    normals.SplittingOff()
-    normals.Update()
-    return normals.GetOutput()
 
 
 def orbit(bounds, radius_factor=0.6):
@@ -151,7 +133,7 @@ def contact_sheet(pngs, output_path):
 
 def main():
     arguments = parse_arguments()
-    mesh = read_bear()
+    _, mesh = read_mesh("bear")  # with point normals for smooth shading; vtkFFDDeform transforms them
 
     voxelize = vtkffd.vtkFFDVoxelize()
     voxelize.SetInputData(mesh)
