@@ -91,24 +91,6 @@ vtkSmartPointer<vtkFFDLatticeDynamics> MakeDynamics(const Scene& scene)
   return dynamics;
 }
 
-/// Moves each simulated point of the lattice by up to `amplitude` per component (a start away from rest).
-void PerturbSimulated(vtkFFDLatticeDynamics* dynamics, vtkPointSet* lattice, double amplitude, unsigned seed)
-{
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> d(-amplitude, amplitude);
-  for (vtkIdType p = 0; p < lattice->GetNumberOfPoints(); ++p)
-  {
-    double x[3];
-    lattice->GetPoint(p, x);
-    const double moved[3] = { x[0] + d(rng), x[1] + d(rng), x[2] + d(rng) };
-    if (dynamics->GetMass(p) > 0)
-    {
-      lattice->GetPoints()->SetPoint(p, moved);
-    }
-  }
-  lattice->GetPoints()->Modified();
-}
-
 double Energy(vtkFFDLatticeDynamics* dynamics)
 {
   return dynamics->GetKineticEnergy() + dynamics->GetPotentialEnergy();
@@ -258,10 +240,9 @@ TEST(FFDLatticeDynamics, MomentumIsConservedWithoutExternalForces)
   {
     Scene scene = BearScene(vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, form);
     auto dynamics = MakeDynamics(scene);
-    ASSERT_TRUE(dynamics->Initialize());
-    PerturbSimulated(dynamics, scene.Lattice, 0.02 * scene.Size, 7);
+    std::mt19937 rng(7);
+    ffdtest::Perturb(scene.Lattice, rng, 0.02 * scene.Size);
     ASSERT_TRUE(dynamics->Initialize()); // starts from the perturbed points
-    std::mt19937 rng(11);
     std::uniform_real_distribution<double> d(-1.0, 1.0);
     double given[3] = { 0, 0, 0 }, scale = 0;
     for (vtkIdType p = 0; p < scene.Lattice->GetNumberOfPoints(); p += 7)
@@ -304,8 +285,8 @@ TEST(FFDLatticeDynamics, EnergyDecaysToRest)
     }
     auto dynamics = MakeDynamics(scene);
     dynamics->SetSpringDamping(damping);
-    ASSERT_TRUE(dynamics->Initialize());
-    PerturbSimulated(dynamics, scene.Lattice, 0.03 * scene.Size, 3);
+    std::mt19937 rng(3);
+    ffdtest::Perturb(scene.Lattice, rng, 0.03 * scene.Size);
     ASSERT_TRUE(dynamics->Initialize());
     const double start = Energy(dynamics);
     ASSERT_GT(start, 0.0);
@@ -426,7 +407,8 @@ TEST(FFDLatticeDynamics, StableAtTenTimesTheExplicitLimit)
 
   dynamics->SetTimeStep(10 * limit);
   dynamics->SetSpringDamping(1.0);
-  PerturbSimulated(dynamics, scene.Lattice, 0.03 * scene.Size, 9);
+  std::mt19937 rng(9);
+  ffdtest::Perturb(scene.Lattice, rng, 0.03 * scene.Size);
   ASSERT_TRUE(dynamics->Initialize());
   const double start = Energy(dynamics);
   double highest = 0;

@@ -30,6 +30,7 @@
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkSmartPointer.h"
+#include "vtkSphereSource.h"
 #include "vtkStructuredGrid.h"
 #include "vtkTesting.h"
 #include "vtkUnstructuredGrid.h"
@@ -185,6 +186,23 @@ inline vtkFFDLatticeActor* AddDeformedScene(
   renderer->AddActor(latticeActor);
   renderer->SetBackground(1.0, 1.0, 1.0);
   return latticeActor; // the renderer holds it
+}
+
+/// The magnetic sphere of the Figure 1 scenes: a blue sphere of `radius` at `centre`, added to `renderer`.
+inline void AddMagnetSphere(vtkRenderer* renderer, const double centre[3], double radius)
+{
+  vtkNew<vtkSphereSource> sphere;
+  sphere->SetCenter(centre[0], centre[1], centre[2]);
+  sphere->SetRadius(radius);
+  sphere->SetThetaResolution(32);
+  sphere->SetPhiResolution(24);
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputConnection(sphere->GetOutputPort());
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetColor(0.2, 0.3, 0.6);
+  actor->GetProperty()->SetSpecular(0.5);
+  renderer->AddActor(actor);
 }
 
 /// The image tests' window: off-screen, `width` x `height` pixels, without multisampling (it differs between GL

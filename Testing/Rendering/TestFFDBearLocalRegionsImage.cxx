@@ -14,7 +14,6 @@
 #include "vtkMath.h"
 #include "vtkRegressionTestImage.h"
 #include "vtkRenderWindow.h"
-#include "vtkSphereSource.h"
 #include "vtkTesting.h"
 
 #include <cmath>
@@ -139,18 +138,7 @@ int TestFFDBearLocalRegionsImage(int argc, char* argv[])
   latticeActor->GetEdgeProperty()->SetLineWidth(1.0);
   latticeActor->GetVoxelProperty()->SetLineWidth(2.0);
 
-  vtkNew<vtkSphereSource> magnet;
-  magnet->SetCenter(centre);
-  magnet->SetRadius(0.08);
-  magnet->SetThetaResolution(32);
-  magnet->SetPhiResolution(24);
-  vtkNew<vtkPolyDataMapper> magnetMapper;
-  magnetMapper->SetInputConnection(magnet->GetOutputPort());
-  vtkNew<vtkActor> magnetActor;
-  magnetActor->SetMapper(magnetMapper);
-  magnetActor->GetProperty()->SetColor(0.2, 0.3, 0.6);
-  magnetActor->GetProperty()->SetSpecular(0.5);
-  renderer->AddActor(magnetActor);
+  AddMagnetSphere(renderer, centre, 0.08);
 
   vtkSmartPointer<vtkRenderWindow> window = NewTestRenderWindow(500, 500);
   window->AddRenderer(renderer);

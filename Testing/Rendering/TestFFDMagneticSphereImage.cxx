@@ -14,7 +14,6 @@
 #include "vtkFFDMagneticSphere.h"
 #include "vtkMath.h"
 #include "vtkRenderWindow.h"
-#include "vtkSphereSource.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -123,18 +122,7 @@ int TestFFDMagneticSphereImage(int argc, char* argv[])
   latticeActor->GetEdgeProperty()->SetColor(0.55, 0.55, 0.55);
   latticeActor->GetEdgeProperty()->SetLineWidth(1.0);
 
-  vtkNew<vtkSphereSource> ball;
-  ball->SetCenter(centre);
-  ball->SetRadius(sphere->GetRadius());
-  ball->SetThetaResolution(32);
-  ball->SetPhiResolution(24);
-  vtkNew<vtkPolyDataMapper> ballMapper;
-  ballMapper->SetInputConnection(ball->GetOutputPort());
-  vtkNew<vtkActor> ballActor;
-  ballActor->SetMapper(ballMapper);
-  ballActor->GetProperty()->SetColor(0.2, 0.3, 0.6);
-  ballActor->GetProperty()->SetSpecular(0.5);
-  renderer->AddActor(ballActor);
+  AddMagnetSphere(renderer, centre, sphere->GetRadius());
 
   vtkSmartPointer<vtkRenderWindow> window = NewTestRenderWindow(500, 500);
   window->AddRenderer(renderer);
