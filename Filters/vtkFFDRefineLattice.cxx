@@ -1,0 +1,381 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkFFDRefineLattice.h"
+
+#include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkFFDBuildLattice.h"
+#include "vtkFFDDataContract.h"
+#include "vtkFFDGridDeformer.h"
+#include "vtkFFDMemory.h"
+#include "vtkFFDSparseLattice.h"
+#include "vtkFFDTetrahedralDeformer.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkIntArray.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkSMPTools.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkStructuredGrid.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkUnstructuredGrid.h"
+
+#include "FFDRefinement.h"
+
+#include <algorithm>
+#include <sstream>
+
+vtkStandardNewMacro(vtkFFDRefineLattice);
+
+namespace
+{
+/// sum_abc Wz Wy Wx D[id(a, b, c)], in increasing a, b, c whatever the caller, so that a fine point comes out the
+/// same from a dense lattice and from any sparse cell that holds it.
+template <typename Id>
+void Combine(const ffd::RefinementRow rows[3], const double* displacements, Id&& id, double out[3])
+{
+  out[0] = out[1] = out[2] = 0;
+  for (int c = 0; c < rows[2].Count; ++c)
+  {
+    for (int b = 0; b < rows[1].Count; ++b)
+    {
+      const double wzy = rows[2].W[c] * rows[1].W[b];
+      for (int a = 0; a < rows[0].Count; ++a)
+      {
+        const double w = wzy * rows[0].W[a];
+        const double* d = displacements + 3 * std::size_t(id(rows[0].First + a, rows[1].First + b, rows[2].First + c));
+        out[0] += w * d[0];
+        out[1] += w * d[1];
+        out[2] += w * d[2];
+      }
+    }
+  }
+}
+
+/// The flat index i + n0 (j + n1 k) of a voxel or control point.
+vtkTypeInt64 Key(const int ijk[3], const int dims[3])
+{
+  return ijk[0] + vtkTypeInt64(dims[0]) * (ijk[1] + vtkTypeInt64(dims[1]) * ijk[2]);
+}
+
+/// The voxels of a dense lattice whose whole support is active (all of them without `Active`).
+std::vector<int> LiveVoxels(const vtkFFDGridLattice& lattice, vtkDataArray* active)
+{
+  std::vector<int> voxels;
+  const int* n = lattice.Divisions;
+  const int* dims = lattice.ControlPointsPerAxis;
+  for (int k = 0; k < n[2]; ++k)
+  {
+    for (int j = 0; j < n[1]; ++j)
+    {
+      for (int i = 0; i < n[0]; ++i)
+      {
+        const int voxel[3] = { i, j, k };
+        int first[3], count[3];
+        for (int a = 0; a < 3; ++a)
+        {
+          ffd::VoxelSupport(lattice.Basis, n[a], voxel[a], first[a], count[a]);
+        }
+        bool live = true;
+        for (int c = first[2]; live && active && c < first[2] + count[2]; ++c)
+        {
+          for (int b = first[1]; live && b < first[1] + count[1]; ++b)
+          {
+            for (int a = first[0]; live && a < first[0] + count[0]; ++a)
+            {
+              live = active->GetComponent(a + vtkIdType(dims[0]) * (b + vtkIdType(dims[1]) * c), 0) != 0;
+            }
+          }
+        }
+        if (live)
+        {
+          voxels.insert(voxels.end(), voxel, voxel + 3);
+        }
+      }
+    }
+  }
+  return voxels;
+}
+} // namespace
+
+//------------------------------------------------------------------------------------------------------------
+vtkFFDRefineLattice::vtkFFDRefineLattice()
+  : Levels(1)
+{
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDRefineLattice::ExecuteInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  outputVector->GetInformationObject(0)->Remove(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT());
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDRefineLattice::ComputeInputUpdateExtent(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
+{
+  // Every refined control point may depend on any of the input's: ask for the whole lattice.
+  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
+  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
+  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
+  if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+  {
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
+      inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkTypeBool vtkFFDRefineLattice::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  return vtkFFDCatchAllocationFailure(
+    this, outputVector, [&] { return this->Superclass::ProcessRequest(request, inputVector, outputVector); });
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDRefineLattice::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPointSet* input = vtkPointSet::GetData(inputVector[0]);
+  vtkPointSet* output = vtkPointSet::GetData(outputVector);
+  if (!input || input->GetNumberOfPoints() == 0)
+  {
+    return 1;
+  }
+  if (vtkFFDTetrahedralDeformer::IsTetrahedralLattice(input))
+  {
+    vtkErrorMacro(<< "The input is a tetrahedral lattice: refine it with vtkFFDBuildTetrahedralLattice's "
+                     "SubdivisionLevels. This filter refines the grid lattices of vtkFFDBuildLattice.");
+    return 0;
+  }
+  vtkSmartPointer<vtkPointSet> lattice = input;
+  for (int level = 0; level < this->Levels; ++level)
+  {
+    lattice = this->RefineOnce(lattice);
+    if (!lattice)
+    {
+      return 0;
+    }
+    this->UpdateProgress(double(level + 1) / this->Levels);
+    if (this->GetAbortExecute())
+    {
+      return 1;
+    }
+  }
+  if (output->GetDataObjectType() != lattice->GetDataObjectType())
+  {
+    vtkErrorMacro(<< "The output is a " << output->GetClassName() << " but the lattice a " << lattice->GetClassName());
+    return 0;
+  }
+  output->ShallowCopy(lattice);
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkSmartPointer<vtkPointSet> vtkFFDRefineLattice::RefineOnce(vtkPointSet* coarse)
+{
+  vtkFFDGridDeformer reader;
+  const std::string why = reader.SetLattice(coarse);
+  if (!why.empty())
+  {
+    vtkErrorMacro(<< "Cannot refine the input: " << why);
+    return nullptr;
+  }
+  const vtkFFDGridLattice& lattice = reader.GetLattice();
+  const vtkFFDSparseCells* cells = reader.GetSparseCells();
+  const ffd::GridBasis basis = lattice.Basis;
+  const int* n = lattice.Divisions;
+  int fine[3], finePoints[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    if (n[a] > VTK_INT_MAX / 2)
+    {
+      vtkErrorMacro(<< "Cannot refine " << n[a] << " divisions along axis " << a << ": twice that is not an int.");
+      return nullptr;
+    }
+    fine[a] = 2 * n[a];
+  }
+  std::string tooLarge;
+  const int form = cells ? vtkFFDBuildLattice::SPARSE : vtkFFDBuildLattice::DENSE;
+  if (!vtkFFDBuildLattice::GetControlPointsPerAxis(int(basis), fine, finePoints, tooLarge, form))
+  {
+    vtkErrorMacro(<< "Cannot refine the lattice to " << fine[0] << "x" << fine[1] << "x" << fine[2]
+                  << " divisions: " << tooLarge);
+    return nullptr;
+  }
+
+  // The fine voxels: the halves of the coarse active region's voxels, in increasing order.
+  std::vector<int> parents = cells
+    ? cells->GetVoxels()
+    : LiveVoxels(lattice, coarse->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName()));
+  std::ostringstream what;
+  what << "The " << vtkFFDBuildLattice::GetBasisAsString(int(basis)) << " lattice refined to " << fine[0] << "x"
+       << fine[1] << "x" << fine[2] << " divisions (" << 8 * (parents.size() / 3) << " voxels)";
+  if (!vtkFFDCheckMemory(this, what.str(), 8.0 * 8.0 * double(parents.size() / 3)))
+  {
+    return nullptr;
+  }
+  std::vector<vtkTypeInt64> keys;
+  keys.reserve(8 * (parents.size() / 3));
+  for (std::size_t v = 0; v < parents.size(); v += 3)
+  {
+    for (int child = 0; child < 8; ++child)
+    {
+      const int ijk[3] = { 2 * parents[v] + (child & 1), 2 * parents[v + 1] + (child >> 1 & 1),
+        2 * parents[v + 2] + (child >> 2) };
+      keys.push_back(Key(ijk, fine));
+    }
+  }
+  parents = std::vector<int>();
+  std::sort(keys.begin(), keys.end());
+  vtkSmartPointer<vtkIntArray> voxelIndex = vtkFFDMakeVoxelIndex(keys, fine);
+  keys = std::vector<vtkTypeInt64>();
+
+  // The refined lattice at rest, as vtkFFDBuildLattice makes it over those voxels.
+  vtkSmartPointer<vtkPointSet> refined;
+  if (cells)
+  {
+    auto sparse = vtkSmartPointer<vtkUnstructuredGrid>::New();
+    if (!vtkFFDMakeSparseLattice(this, lattice.Frame, basis, fine, voxelIndex, what.str(), sparse))
+    {
+      return nullptr;
+    }
+    refined = sparse;
+  }
+  else
+  {
+    vtkNew<vtkUnstructuredGrid> voxelGrid;
+    if (!vtkFFDMakeVoxelGrid(this, lattice.Frame, fine, voxelIndex, what.str(), voxelGrid))
+    {
+      return nullptr;
+    }
+    vtkNew<vtkFFDBuildLattice> build;
+    build->SetBasis(int(basis));
+    build->SetLatticeFormToDense();
+    build->SetInputData(voxelGrid);
+    build->Update();
+    refined = build->GetOutput();
+    if (refined->GetNumberOfPoints() == 0)
+    {
+      vtkErrorMacro(<< "Could not build the refined lattice (see the error above).");
+      return nullptr;
+    }
+  }
+  if (this->GetAbortExecute())
+  {
+    return refined;
+  }
+
+  // Each fine control point's displacement from the coarse ones (ffd::RefineRow); points stay at rest where
+  // they are not active.
+  const vtkIdType count = refined->GetNumberOfPoints();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->DeepCopy(refined->GetPoints());
+  double* x = vtkDoubleArray::SafeDownCast(points->GetData())->GetPointer(0);
+  const double* d = lattice.Displacements.data();
+  if (cells)
+  {
+    // Each fine point from the first fine cell that holds it, through that cell's parent's support.
+    vtkFFDSparseCells fineCells;
+    const std::string unread = fineCells.Read(vtkUnstructuredGrid::SafeDownCast(refined), basis, fine);
+    if (!unread.empty())
+    {
+      vtkErrorMacro(<< "Internal error reading the refined lattice: " << unread);
+      return nullptr;
+    }
+    const int m = ffd::SupportSize(basis, n[0]), m3 = m * m * m; // a local basis: the same along every axis
+    std::vector<int> owner(std::size_t(count), -1);
+    for (int c = fineCells.GetNumberOfCells() - 1; c >= 0; --c)
+    {
+      for (int s = 0; s < m3; ++s)
+      {
+        owner[fineCells.GetSupports()[std::size_t(c) * m3 + s]] = c;
+      }
+    }
+    const int* coarseSupports = cells->GetSupports().data();
+    vtkSMPTools::For(0, fineCells.GetNumberOfCells(),
+      [&](int begin, int end)
+      {
+        for (int c = begin; c < end; ++c)
+        {
+          const int* voxel = fineCells.GetVoxels().data() + 3 * std::size_t(c);
+          const int parent[3] = { voxel[0] / 2, voxel[1] / 2, voxel[2] / 2 };
+          const int* support = coarseSupports + std::size_t(cells->Find(Key(parent, n))) * m3;
+          int first[3], unused;
+          for (int a = 0; a < 3; ++a)
+          {
+            ffd::VoxelSupport(basis, fine[a], voxel[a], first[a], unused);
+          }
+          for (int s = 0; s < m3; ++s)
+          {
+            const int p = fineCells.GetSupports()[std::size_t(c) * m3 + s];
+            if (owner[p] != c)
+            {
+              continue;
+            }
+            const int local[3] = { s % m, s / m % m, s / (m * m) };
+            ffd::RefinementRow rows[3];
+            for (int a = 0; a < 3; ++a)
+            {
+              ffd::LocalRefinementRow(basis, n[a], voxel[a], first[a] + local[a], rows[a]);
+            }
+            double delta[3];
+            Combine(
+              rows, d, [&](int i, int j, int k) { return support[i + m * (j + m * k)]; }, delta);
+            for (int a = 0; a < 3; ++a)
+            {
+              x[3 * p + a] += delta[a];
+            }
+          }
+        }
+      });
+  }
+  else
+  {
+    vtkDataArray* active = refined->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName());
+    const int* coarseDims = lattice.ControlPointsPerAxis;
+    vtkSMPTools::For(0, count,
+      [&](vtkIdType begin, vtkIdType end)
+      {
+        for (vtkIdType p = begin; p < end; ++p)
+        {
+          if (active->GetComponent(p, 0) == 0)
+          {
+            continue;
+          }
+          const int index[3] = { int(p % finePoints[0]), int(p / finePoints[0] % finePoints[1]),
+            int(p / finePoints[0] / finePoints[1]) };
+          ffd::RefinementRow rows[3];
+          for (int a = 0; a < 3; ++a)
+          {
+            rows[a] = ffd::RefineRow(basis, n[a], index[a]);
+          }
+          double delta[3];
+          Combine(
+            rows, d,
+            [&](int i, int j, int k) { return i + vtkIdType(coarseDims[0]) * (j + vtkIdType(coarseDims[1]) * k); },
+            delta);
+          for (int a = 0; a < 3; ++a)
+          {
+            x[3 * p + a] += delta[a];
+          }
+        }
+      });
+  }
+  refined->SetPoints(points);
+  return refined;
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDRefineLattice::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Levels: " << this->Levels << "\n";
+}
