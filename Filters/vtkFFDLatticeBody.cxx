@@ -3,6 +3,7 @@
 
 #include "vtkFFDDataContract.h"
 #include "vtkFFDGridDeformer.h"
+#include "vtkFFDGridWeights.h"
 #include "vtkFFDSparseCells.h"
 #include "vtkFFDTetrahedralDeformer.h"
 
@@ -12,7 +13,7 @@
 #include "vtkPoints.h"
 #include "vtkUnstructuredGrid.h"
 
-#include "FFDGridDeformation.h"
+#include "FFDGridBasis.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -220,7 +221,8 @@ std::string vtkFFDLatticeBody::Read(
   }
   else if (const vtkFFDSparseCells* cells = grid.GetSparseCells())
   {
-    this->Springs = SparseSprings(*cells, ffd::CellDegree(grid.GetLattice().Basis) + 1, this->ParticleOf, offsets);
+    this->Springs = SparseSprings(
+      *cells, ffd::SupportSize(grid.GetLattice().Basis, grid.GetLattice().Divisions[0]), this->ParticleOf, offsets);
   }
   else
   {
@@ -266,27 +268,8 @@ std::string vtkFFDLatticeBody::Read(
     else
     {
       grid.Bind(points, 0 /* KEEP_POSITION */, nullptr, 0, 1, rebound);
-      const std::vector<int>& cellOf = grid.GetCellOfPoint();
-      const vtkFFDGridLattice& view = grid.GetLattice();
-      const vtkFFDSparseCells* cells = grid.GetSparseCells();
-      ffd::WithStaticBasis(view.Basis,
-        [&](auto maxCount, auto)
-        {
-          const ffd::GridDeformation<decltype(maxCount)::value, double> deformation{ view.Basis,
-            { view.Divisions[0], view.Divisions[1], view.Divisions[2] },
-            { view.ControlPointsPerAxis[0], view.ControlPointsPerAxis[1], view.ControlPointsPerAxis[2] },
-            view.Displacements.data(), ffd::Frame<double>::FromArray(view.Frame), nullptr,
-            cells ? cells->GetVoxels().data() : nullptr, cells ? cells->GetSupports().data() : nullptr };
-          for (vtkIdType p = 0; p < mesh->GetNumberOfPoints(); ++p)
-          {
-            if (cellOf[p] >= 0)
-            {
-              double x[3];
-              points->GetPoint(p, x);
-              deformation.ForEachWeight({ x[0], x[1], x[2] }, cellOf[p], add);
-            }
-          }
-        });
+      vtkFFDForEachGridWeight(grid, points, 0, mesh->GetNumberOfPoints(),
+        [&](vtkIdType, vtkIdType controlPoint, double weight) { add(controlPoint, weight); });
     }
   }
   this->Masses = ShareMass(share, totalMass, minimumMassFraction);

@@ -1,0 +1,293 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkFFDCoarsenLattice.h"
+
+#include "vtkDoubleArray.h"
+#include "vtkFFDBuildLattice.h"
+#include "vtkFFDDataContract.h"
+#include "vtkFFDDeform.h"
+#include "vtkFFDGridDeformer.h"
+#include "vtkFFDGridWeights.h"
+#include "vtkFFDMemory.h"
+#include "vtkFFDTetrahedralDeformer.h"
+#include "vtkFFDVoxelize.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPointSet.h"
+#include "vtkPoints.h"
+#include "vtkSMPTools.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include "FFDLeastSquares.h"
+
+#include <cmath>
+#include <sstream>
+
+vtkStandardNewMacro(vtkFFDCoarsenLattice);
+
+//------------------------------------------------------------------------------------------------------------
+vtkFFDCoarsenLattice::vtkFFDCoarsenLattice()
+  : Divisions{ 0, 0, 0 }
+  , Basis(-1)
+  , Regularization(1e-8)
+  , ResidualRMS(0)
+  , MaximumResidual(0)
+{
+  this->SetNumberOfInputPorts(2);
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDCoarsenLattice::FillInputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPointSet");
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDCoarsenLattice::ExecuteInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  outputVector->GetInformationObject(0)->Remove(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT());
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDCoarsenLattice::ComputeInputUpdateExtent(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
+{
+  // The fit needs the whole lattice and every point of the mesh.
+  for (int port = 0; port < 2; ++port)
+  {
+    if (vtkInformation* inInfo = inputVector[port]->GetInformationObject(0))
+    {
+      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
+      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
+      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
+      if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+      {
+        inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
+          inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
+      }
+    }
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkTypeBool vtkFFDCoarsenLattice::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  return vtkFFDCatchAllocationFailure(
+    this, outputVector, [&] { return this->Superclass::ProcessRequest(request, inputVector, outputVector); });
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDCoarsenLattice::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPointSet* input = vtkPointSet::GetData(inputVector[0]);
+  vtkPointSet* mesh = vtkPointSet::GetData(inputVector[1]);
+  vtkPointSet* output = vtkPointSet::GetData(outputVector);
+  this->ResidualRMS = this->MaximumResidual = 0;
+  if (!input || input->GetNumberOfPoints() == 0)
+  {
+    return 1;
+  }
+  if (vtkFFDTetrahedralDeformer::IsTetrahedralLattice(input))
+  {
+    vtkErrorMacro(<< "The input is a tetrahedral lattice: this filter coarsens the grid lattices of "
+                     "vtkFFDBuildLattice.");
+    return 0;
+  }
+  if (!mesh || !mesh->GetPoints() || mesh->GetNumberOfPoints() == 0)
+  {
+    vtkErrorMacro(<< "No mesh points to fit the deformation on: SetMeshConnection() (input 1) to the mesh the "
+                     "lattice deforms.");
+    return 0;
+  }
+  vtkFFDGridDeformer reader;
+  std::string why = reader.SetLattice(input);
+  if (!why.empty())
+  {
+    vtkErrorMacro(<< "Cannot coarsen the input: " << why);
+    return 0;
+  }
+  const vtkFFDGridLattice& fine = reader.GetLattice();
+  int divisions[3];
+  const bool halve = this->Divisions[0] < 1 || this->Divisions[1] < 1 || this->Divisions[2] < 1;
+  for (int a = 0; a < 3; ++a)
+  {
+    divisions[a] = halve ? (fine.Divisions[a] + 1) / 2 : this->Divisions[a];
+  }
+  const int basis = this->Basis < 0 ? int(fine.Basis) : this->Basis;
+  if (fine.Sparse && basis == vtkFFDBuildLattice::BERNSTEIN)
+  {
+    vtkErrorMacro(<< "The input is sparse and a BERNSTEIN lattice cannot be: coarsen a dense lattice into the "
+                     "BERNSTEIN basis, or choose a local basis.");
+    return 0;
+  }
+
+  // The deformation to reproduce: the input lattice's displacement of each mesh point.
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(mesh);
+  deform->SetLatticeData(input);
+  deform->SetTransformNormals(false);
+  deform->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
+  deform->Update();
+  vtkPointSet* target = vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0));
+  if (!target || target->GetNumberOfPoints() != mesh->GetNumberOfPoints())
+  {
+    vtkErrorMacro(<< "Could not deform the mesh by the input lattice (see the error above).");
+    return 0;
+  }
+  this->UpdateProgress(0.1);
+
+  // The coarse lattice at rest over the mesh's voxels, in the same frame.
+  vtkNew<vtkFFDVoxelize> voxelize;
+  voxelize->SetInputData(mesh);
+  voxelize->SetFrame(fine.Frame, fine.Frame + 3, fine.Frame + 6, fine.Frame + 9);
+  voxelize->SetDivisions(divisions);
+  vtkNew<vtkFFDBuildLattice> build;
+  build->SetInputConnection(voxelize->GetOutputPort());
+  build->SetBasis(basis);
+  build->SetLatticeForm(fine.Sparse ? vtkFFDBuildLattice::SPARSE : vtkFFDBuildLattice::DENSE);
+  build->Update();
+  vtkPointSet* coarse = vtkPointSet::SafeDownCast(build->GetOutputDataObject(0));
+  if (!coarse || coarse->GetNumberOfPoints() == 0)
+  {
+    vtkErrorMacro(<< "Could not build the coarse lattice (see the error above).");
+    return 0;
+  }
+  if (output->GetDataObjectType() != coarse->GetDataObjectType())
+  {
+    vtkErrorMacro(<< "The output is a " << output->GetClassName() << " but the lattice a " << coarse->GetClassName());
+    return 0;
+  }
+  vtkFFDGridDeformer coarseReader;
+  why = coarseReader.SetLattice(coarse);
+  bool rebound = false;
+  vtkPoints* points = mesh->GetPoints();
+  if (!why.empty() || !coarseReader.Bind(points, vtkFFDDeform::KEEP_POSITION, this, 0.1, 0.2, rebound))
+  {
+    vtkErrorMacro(<< "Could not bind the mesh to the coarse lattice. " << why);
+    return 0;
+  }
+
+  // W: a row of weights per bound mesh point, over every control point of the coarse lattice (culled ones get
+  // no weight and stay at rest).
+  const vtkIdType numPoints = mesh->GetNumberOfPoints();
+  const std::vector<int>& cellOf = coarseReader.GetCellOfPoint();
+  std::vector<vtkIdType> rowPoint;
+  for (vtkIdType p = 0; p < numPoints; ++p)
+  {
+    if (cellOf[p] >= 0)
+    {
+      rowPoint.push_back(p);
+    }
+  }
+  const double perPoint = vtkFFDGridWeightsPerPoint(coarseReader);
+  const double entries = perPoint * double(rowPoint.size());
+  std::ostringstream request;
+  request << "A least-squares fit of " << rowPoint.size() << " points with " << perPoint << " weights each";
+  if (entries >= double(VTK_INT_MAX))
+  {
+    vtkErrorMacro(<< request.str() << " has more than 2^31 - 1 weights: fit fewer points or a coarser basis.");
+    return 0;
+  }
+  // W, W^T and W^T W (at most perPoint^2 / 8 entries a point, sorted by Eigen's sparse product).
+  if (!vtkFFDCheckMemory(this, request.str(), 3.0 * 12.0 * entries + 12.0 * entries * perPoint / 8.0))
+  {
+    return 0;
+  }
+  std::vector<int> rowStart(rowPoint.size() + 1);
+  for (std::size_t r = 0; r <= rowPoint.size(); ++r)
+  {
+    rowStart[r] = int(r * std::size_t(perPoint));
+  }
+  std::vector<int> columns(static_cast<std::size_t>(entries));
+  std::vector<double> weights(static_cast<std::size_t>(entries));
+  std::vector<double> b(3 * rowPoint.size());
+  vtkSMPTools::For(0, vtkIdType(rowPoint.size()),
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType r = begin; r < end; ++r)
+      {
+        std::size_t slot = std::size_t(rowStart[r]);
+        const vtkIdType p = rowPoint[r];
+        vtkFFDForEachGridWeight(coarseReader, points, p, p + 1,
+          [&](vtkIdType, vtkIdType controlPoint, double weight)
+          {
+            columns[slot] = int(controlPoint);
+            weights[slot++] = weight;
+          });
+        double x[3], y[3];
+        points->GetPoint(p, x);
+        target->GetPoint(p, y);
+        for (int c = 0; c < 3; ++c)
+        {
+          b[3 * r + c] = y[c] - x[c];
+        }
+      }
+    });
+  const ffd::LeastSquares fit(
+    int(coarse->GetNumberOfPoints()), std::move(rowStart), std::move(columns), std::move(weights));
+  this->UpdateProgress(0.3);
+  std::vector<double> x;
+  if (!fit.Solve(b, this->Regularization, x).Solved)
+  {
+    vtkErrorMacro(<< "The mesh's points leave some combination of the coarse lattice's control points "
+                     "undetermined and Regularization is 0: set it above 0 (1e-8, the default, keeps those at rest).");
+    return 0;
+  }
+  this->UpdateProgress(0.9);
+
+  // The output: the coarse lattice moved by X; the residual over every mesh point (those outside the coarse
+  // lattice keep their place).
+  vtkNew<vtkPoints> moved;
+  moved->SetDataTypeToDouble();
+  moved->DeepCopy(coarse->GetPoints());
+  double* position = vtkDoubleArray::SafeDownCast(moved->GetData())->GetPointer(0);
+  for (std::size_t i = 0; i < x.size(); ++i)
+  {
+    position[i] += x[i];
+  }
+  std::vector<double> fitted;
+  fit.Apply(x, fitted);
+  double sum = 0, worst = 0;
+  std::size_t r = 0;
+  for (vtkIdType p = 0; p < numPoints; ++p)
+  {
+    double from[3], to[3], e2 = 0;
+    points->GetPoint(p, from);
+    target->GetPoint(p, to);
+    const bool bound = cellOf[p] >= 0;
+    for (int c = 0; c < 3; ++c)
+    {
+      const double e = (to[c] - from[c]) - (bound ? fitted[3 * r + c] : 0.0);
+      e2 += e * e;
+    }
+    r += bound;
+    sum += e2;
+    worst = std::max(worst, e2);
+  }
+  this->ResidualRMS = std::sqrt(sum / double(numPoints));
+  this->MaximumResidual = std::sqrt(worst);
+
+  output->ShallowCopy(coarse);
+  output->SetPoints(moved);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDCoarsenLattice::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Divisions: " << this->Divisions[0] << " " << this->Divisions[1] << " " << this->Divisions[2] << "\n";
+  os << indent << "Basis: " << this->Basis << "\n";
+  os << indent << "Regularization: " << this->Regularization << "\n";
+  os << indent << "ResidualRMS: " << this->ResidualRMS << "\n";
+  os << indent << "MaximumResidual: " << this->MaximumResidual << "\n";
+}

@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkFFDCoarsenLattice
+ * @brief   a coarser lattice that best reproduces a lattice's deformation over a mesh's points
+ *
+ * Input 0 is a grid lattice of vtkFFDBuildLattice (dense or sparse, deformed), input 1 the mesh whose points the
+ * deformation is measured on. The output is a lattice of the same frame over `Divisions` voxels (default: half the
+ * input's, rounded up), of the input's basis or of `Basis`, in the input's form, at rest where the mesh has no
+ * points (culled as vtkFFDBuildLattice culls over the mesh's voxels), whose control points minimise
+ *
+ *     sum over the mesh's points p of |D(x_p) - d_p|^2,
+ *
+ * with d_p the input lattice's displacement of point p and D the output's
+ (ffd::LeastSquares, Filters/CPU/FFDLeastSquares.h: a sparse factorisation of the normal equations in
+ * Jacobi-scaled unknowns with iterated Tikhonov refinement; combinations of control points that the points do not
+ * determine, those whose scaled eigenvalue is below about `Regularization`, stay near rest). Where the input is an
+ * exact refinement of a coarser lattice (vtkFFDRefineLattice) and the points determine every control point, the
+ * output is that coarser lattice. The residual of the fit is reported (GetResidualRMS(), GetMaximumResidual()).
+ * The normal matrix costs (support size)^2 per mesh point to form: 4096 for the cubic bases, (n+1)^6 for a global
+ * Bernstein lattice of degree n.
+ *
+ * @sa vtkFFDRefineLattice vtkFFDBuildLattice
+ */
+#ifndef vtkFFDCoarsenLattice_h
+#define vtkFFDCoarsenLattice_h
+
+#include "vtkFFDFiltersModule.h" // For export macro
+#include "vtkPointSetAlgorithm.h"
+
+class VTKFFDFILTERS_EXPORT vtkFFDCoarsenLattice : public vtkPointSetAlgorithm
+{
+public:
+  static vtkFFDCoarsenLattice* New();
+  vtkTypeMacro(vtkFFDCoarsenLattice, vtkPointSetAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// The mesh whose points the fit runs over (input 1, required).
+  void SetMeshConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(1, output); }
+  void SetMeshData(vtkDataObject* mesh) { this->SetInputData(1, mesh); }
+
+  ///@{
+  /// Voxels per axis of the output; any value below 1 (the default 0, 0, 0) takes half the input's, rounded up.
+  vtkSetVector3Macro(Divisions, int);
+  vtkGetVector3Macro(Divisions, int);
+  ///@}
+
+  ///@{
+  /// The output's basis (vtkFFDBuildLattice::Bases); -1, the default, keeps the input's.
+  vtkSetClampMacro(Basis, int, -1, 4);
+  vtkGetMacro(Basis, int);
+  ///@}
+
+  ///@{
+  /// lambda of the scaled normal equations (default 1e-8): the eigenvalue, relative to the diagonal's, below which
+  /// a combination of control points counts as undetermined. 0 asks for the exact solution of a determined
+  /// problem (an error where the points leave some combination undetermined).
+  vtkSetClampMacro(Regularization, double, 0.0, 1.0);
+  vtkGetMacro(Regularization, double);
+  ///@}
+
+  ///@{
+  /// The last fit: the root mean square and the largest distance, over the mesh's points, between the output's
+  /// deformation and the input's (world units).
+  vtkGetMacro(ResidualRMS, double);
+  vtkGetMacro(MaximumResidual, double);
+  ///@}
+
+protected:
+  vtkFFDCoarsenLattice();
+  ~vtkFFDCoarsenLattice() override = default;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int ExecuteInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int ComputeInputUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  vtkTypeBool ProcessRequest(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  int Divisions[3];
+  int Basis;
+  double Regularization;
+  double ResidualRMS;
+  double MaximumResidual;
+
+private:
+  vtkFFDCoarsenLattice(const vtkFFDCoarsenLattice&) = delete;
+  void operator=(const vtkFFDCoarsenLattice&) = delete;
+};
+
+#endif
