@@ -9,6 +9,7 @@
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
+#include "vtkFieldData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkObjectFactory.h"
@@ -164,6 +165,7 @@ int vtkFFDDeform::RequestData(vtkInformation*, vtkInformationVector** inputVecto
     output->CopyStructure(input);
     output->GetPointData()->PassData(input->GetPointData());
     output->GetCellData()->PassData(input->GetCellData());
+    output->GetFieldData()->PassData(input->GetFieldData());
     return 1;
   }
 
@@ -356,6 +358,8 @@ void vtkFFDDeform::FillOutput(vtkPointSet* input, vtkPointSet* output)
   output->SetPoints(outPoints);
   output->GetPointData()->PassData(input->GetPointData());
   output->GetCellData()->PassData(input->GetCellData());
+  // Field data too: a lattice deformed by a coarser one (hierarchical FFD) keeps its frame and divisions.
+  output->GetFieldData()->PassData(input->GetFieldData());
   if (internals.Normals)
   {
     output->GetPointData()->SetNormals(internals.Normals);
