@@ -6,7 +6,7 @@
 #include "vtkFFDDataContract.h"
 #include "vtkFFDDeform.h"
 #include "vtkFFDGridDeformer.h"
-#include "vtkFFDGridWeights.h"
+#include "vtkFFDGridQueries.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkFFDVoxelize.h"

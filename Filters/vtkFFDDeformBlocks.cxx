@@ -110,7 +110,12 @@ int vtkFFDDeformBlocks::RequestData(
   for (int b = 0; b < count; ++b)
   {
     vtkPointSet* lattice = vtkPointSet::GetData(inputVector[1], b);
-    double frame[12];
+    double frame[12] = { 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1 };
+    if (lattice && lattice->GetNumberOfPoints() == 0)
+    {
+      frames.push_back(ffd::Frame<double>::FromArray(frame));
+      continue; // an empty lattice (a detail lattice over no voxel) moves nothing
+    }
     if (this->Composition == BLEND)
     {
       if (!lattice || vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice))
@@ -161,7 +166,7 @@ int vtkFFDDeformBlocks::RequestData(
   {
     for (int b = 0; b < count; ++b)
     {
-      movedNormals[b] = moved[b]->GetPointData()->GetNormals();
+      movedNormals[b] = moved[b] ? moved[b]->GetPointData()->GetNormals() : nullptr;
     }
     outNormals = vtkSmartPointer<vtkDataArray>::Take(inNormals->NewInstance());
     outNormals->SetName(inNormals->GetName());
@@ -181,11 +186,12 @@ int vtkFFDDeformBlocks::RequestData(
         int holders = 0;
         for (int b = 0; b < count; ++b)
         {
-          weights[b] = blend ? Bump(frames[b].ToParametric({ x[0], x[1], x[2] })) : 1.0;
+          weights[b] = !moved[b] ? -1.0 : (blend ? Bump(frames[b].ToParametric({ x[0], x[1], x[2] })) : 1.0);
           holders += weights[b] >= 0;
           total += std::max(weights[b], 0.0);
         }
-        double sum[3] = { 0, 0, 0 }, normal[3] = { 0, 0, 0 }, n0[3] = { 0, 0, 0 };
+        double sum[3] = { 0, 0, 0 }, normal[3] = { 0, 0, 0 }, n0[3] = { 0, 0, 0 }, only[3] = { 0, 0, 0 };
+        int movers = 0, onlyWeighsOne = 0;
         if (outNormals)
         {
           inNormals->GetTuple(p, n0);
@@ -197,12 +203,18 @@ int vtkFFDDeformBlocks::RequestData(
           {
             w = w < 0 ? 0.0 : (total > 0 ? w / total : 1.0 / holders);
           }
-          if (w == 0)
+          if (w <= 0)
           {
             continue;
           }
           double y[3];
           moved[b]->GetPoint(p, y);
+          if (y[0] != x[0] || y[1] != x[1] || y[2] != x[2])
+          {
+            ++movers;
+            onlyWeighsOne = w == 1;
+            std::copy(y, y + 3, only);
+          }
           for (int c = 0; c < 3; ++c)
           {
             sum[c] += w * (y[c] - x[c]);
@@ -217,7 +229,15 @@ int vtkFFDDeformBlocks::RequestData(
             }
           }
         }
-        outPoints->SetPoint(p, x[0] + sum[0], x[1] + sum[1], x[2] + sum[2]);
+        // One lattice alone moving the point with all its weight: its result as it is (x + (y - x) may round).
+        if (movers == 1 && onlyWeighsOne)
+        {
+          outPoints->SetPoint(p, only);
+        }
+        else
+        {
+          outPoints->SetPoint(p, x[0] + sum[0], x[1] + sum[1], x[2] + sum[2]);
+        }
         if (outNormals)
         {
           if (blend && holders == 0)

@@ -3,7 +3,7 @@
 
 #include "vtkFFDDataContract.h"
 #include "vtkFFDGridDeformer.h"
-#include "vtkFFDGridWeights.h"
+#include "vtkFFDGridQueries.h"
 #include "vtkFFDSparseCells.h"
 #include "vtkFFDTetrahedralDeformer.h"
 

@@ -6,6 +6,7 @@
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDGridDeformer.h"
+#include "vtkFFDGridQueries.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDSparseLattice.h"
 #include "vtkFFDTetrahedralDeformer.h"
@@ -60,44 +61,6 @@ vtkTypeInt64 Key(const int ijk[3], const int dims[3])
   return ijk[0] + vtkTypeInt64(dims[0]) * (ijk[1] + vtkTypeInt64(dims[1]) * ijk[2]);
 }
 
-/// The voxels of a dense lattice whose whole support is active (all of them without `Active`).
-std::vector<int> LiveVoxels(const vtkFFDGridLattice& lattice, vtkDataArray* active)
-{
-  std::vector<int> voxels;
-  const int* n = lattice.Divisions;
-  const int* dims = lattice.ControlPointsPerAxis;
-  for (int k = 0; k < n[2]; ++k)
-  {
-    for (int j = 0; j < n[1]; ++j)
-    {
-      for (int i = 0; i < n[0]; ++i)
-      {
-        const int voxel[3] = { i, j, k };
-        int first[3], count[3];
-        for (int a = 0; a < 3; ++a)
-        {
-          ffd::VoxelSupport(lattice.Basis, n[a], voxel[a], first[a], count[a]);
-        }
-        bool live = true;
-        for (int c = first[2]; live && active && c < first[2] + count[2]; ++c)
-        {
-          for (int b = first[1]; live && b < first[1] + count[1]; ++b)
-          {
-            for (int a = first[0]; live && a < first[0] + count[0]; ++a)
-            {
-              live = active->GetComponent(a + vtkIdType(dims[0]) * (b + vtkIdType(dims[1]) * c), 0) != 0;
-            }
-          }
-        }
-        if (live)
-        {
-          voxels.insert(voxels.end(), voxel, voxel + 3);
-        }
-      }
-    }
-  }
-  return voxels;
-}
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -211,9 +174,7 @@ vtkSmartPointer<vtkPointSet> vtkFFDRefineLattice::RefineOnce(vtkPointSet* coarse
   }
 
   // The fine voxels: the halves of the coarse active region's voxels, in increasing order.
-  std::vector<int> parents = cells
-    ? cells->GetVoxels()
-    : LiveVoxels(lattice, coarse->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName()));
+  std::vector<int> parents = vtkFFDCoveredVoxels(reader, coarse);
   std::ostringstream what;
   what << "The " << vtkFFDBuildLattice::GetBasisAsString(int(basis)) << " lattice refined to " << fine[0] << "x"
        << fine[1] << "x" << fine[2] << " divisions (" << 8 * (parents.size() / 3) << " voxels)";

@@ -1,0 +1,329 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkFFDBuildDetailLattice.h"
+
+#include "vtkDataSetAttributes.h"
+#include "vtkFFDBuildLattice.h"
+#include "vtkFFDDataContract.h"
+#include "vtkFFDGridDeformer.h"
+#include "vtkFFDGridQueries.h"
+#include "vtkFFDMemory.h"
+#include "vtkFFDSparseLattice.h"
+#include "vtkFFDTetrahedralDeformer.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkIntArray.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPointSet.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkUnstructuredGrid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+vtkStandardNewMacro(vtkFFDBuildDetailLattice);
+
+namespace
+{
+vtkTypeInt64 Key(int i, int j, int k, const int dims[3])
+{
+  return i + vtkTypeInt64(dims[0]) * (j + vtkTypeInt64(dims[1]) * k);
+}
+
+int FloorDiv(int a, int b)
+{
+  return a >= 0 ? a / b : -((-a + b - 1) / b);
+}
+
+/// The voxels [first, first + count) along an axis of `voxels` voxels whose support holds control point j.
+void Influence(ffd::GridBasis basis, int voxels, int j, int& first, int& count)
+{
+  const int step = basis == ffd::GridBasis::CubicBSpline ? 1 : ffd::BezierDegree(basis);
+  const int size = ffd::SupportSize(basis, voxels);
+  first = std::max(0, -FloorDiv(-(j - size + 1), step)); // ceil((j - size + 1) / step)
+  count = std::min(FloorDiv(j, step), voxels - 1) - first + 1;
+}
+
+/**
+ * The largest second difference (pure or mixed) of the displacements at the control points of `voxel`'s support,
+ * each over the product of the spacings along its axes; neighbours outside the lattice are skipped.
+ */
+double SecondDifference(
+  const vtkFFDGridLattice& lattice, const vtkFFDControlPointIndex& index, const double h[3], const int voxel[3])
+{
+  int first[3], count[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    ffd::VoxelSupport(lattice.Basis, lattice.Divisions[a], voxel[a], first[a], count[a]);
+  }
+  const double* d = lattice.Displacements.data();
+  auto at = [&](const int p[3], int da, int a, int db, int b) -> vtkIdType
+  {
+    int q[3] = { p[0], p[1], p[2] };
+    q[a] += da;
+    q[b] += db;
+    return index.Find(q[0], q[1], q[2]);
+  };
+  auto norm = [&](vtkIdType a, vtkIdType b, vtkIdType c, vtkIdType e, double ca, double cb, double cc, double ce)
+  {
+    double sum = 0;
+    for (int x = 0; x < 3; ++x)
+    {
+      const double v = ca * d[3 * a + x] + cb * d[3 * b + x] + cc * d[3 * c + x] + ce * d[3 * e + x];
+      sum += v * v;
+    }
+    return std::sqrt(sum);
+  };
+  double worst = 0;
+  for (int k = first[2]; k < first[2] + count[2]; ++k)
+  {
+    for (int j = first[1]; j < first[1] + count[1]; ++j)
+    {
+      for (int i = first[0]; i < first[0] + count[0]; ++i)
+      {
+        const int p[3] = { i, j, k };
+        const vtkIdType centre = index.Find(i, j, k);
+        if (centre < 0)
+        {
+          continue;
+        }
+        for (int a = 0; a < 3; ++a)
+        {
+          const vtkIdType minus = at(p, -1, a, 0, a), plus = at(p, 1, a, 0, a);
+          if (minus >= 0 && plus >= 0)
+          {
+            worst = std::max(worst, norm(plus, centre, minus, centre, 1, -2, 1, 0) / (h[a] * h[a]));
+          }
+          for (int b = a + 1; b < 3; ++b)
+          {
+            const vtkIdType pa = at(p, 1, a, 0, b), pb = at(p, 0, a, 1, b), pab = at(p, 1, a, 1, b);
+            if (pa >= 0 && pb >= 0 && pab >= 0)
+            {
+              worst = std::max(worst, norm(pab, pa, pb, centre, 1, -1, -1, 1) / (h[a] * h[b]));
+            }
+          }
+        }
+      }
+    }
+  }
+  return worst;
+}
+} // namespace
+
+//------------------------------------------------------------------------------------------------------------
+vtkFFDBuildDetailLattice::vtkFFDBuildDetailLattice()
+  : SecondDerivativeThreshold(0)
+  , NumberOfRefinedVoxels(0)
+{
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkFFDBuildDetailLattice::~vtkFFDBuildDetailLattice() = default;
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDBuildDetailLattice::SetSelectedVoxels(vtkIntArray* voxels)
+{
+  if (this->SelectedVoxels != voxels)
+  {
+    this->SelectedVoxels = voxels;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkIntArray* vtkFFDBuildDetailLattice::GetSelectedVoxels()
+{
+  return this->SelectedVoxels;
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDBuildDetailLattice::FillInputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPointSet");
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkTypeBool vtkFFDBuildDetailLattice::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  return vtkFFDCatchAllocationFailure(
+    this, outputVector, [&] { return this->Superclass::ProcessRequest(request, inputVector, outputVector); });
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDBuildDetailLattice::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPointSet* input = vtkPointSet::GetData(inputVector[0]);
+  vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector);
+  this->NumberOfRefinedVoxels = 0;
+  if (!input || input->GetNumberOfPoints() == 0)
+  {
+    return 1;
+  }
+  if (vtkFFDTetrahedralDeformer::IsTetrahedralLattice(input))
+  {
+    vtkErrorMacro(<< "The input is a tetrahedral lattice: refine it with vtkFFDBuildTetrahedralLattice's "
+                     "SubdivisionLevels. This filter refines the grid lattices of vtkFFDBuildLattice.");
+    return 0;
+  }
+  vtkFFDGridDeformer reader;
+  const std::string why = reader.SetLattice(input);
+  if (!why.empty())
+  {
+    vtkErrorMacro(<< "Cannot refine the input: " << why);
+    return 0;
+  }
+  const vtkFFDGridLattice& lattice = reader.GetLattice();
+  const ffd::GridBasis basis = lattice.Basis;
+  if (basis == ffd::GridBasis::Bernstein)
+  {
+    vtkErrorMacro(<< "The global BERNSTEIN basis has no local refinement (each control point moves every voxel): "
+                     "refine the whole lattice with vtkFFDRefineLattice, or use a local basis.");
+    return 0;
+  }
+  const int* n = lattice.Divisions;
+  int fine[3], finePoints[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    if (n[a] > VTK_INT_MAX / 2)
+    {
+      vtkErrorMacro(<< "Cannot refine " << n[a] << " divisions along axis " << a << ": twice that is not an int.");
+      return 0;
+    }
+    fine[a] = 2 * n[a];
+  }
+  std::string tooLarge;
+  if (!vtkFFDBuildLattice::GetControlPointsPerAxis(int(basis), fine, finePoints, tooLarge, vtkFFDBuildLattice::SPARSE))
+  {
+    vtkErrorMacro(<< "Cannot refine the lattice: " << tooLarge);
+    return 0;
+  }
+
+  // The input voxels to refine: the selected ones, and those that bend more than the threshold.
+  std::vector<vtkTypeInt64> selected;
+  if (this->SelectedVoxels)
+  {
+    vtkIntArray* voxels = this->SelectedVoxels;
+    if (voxels->GetNumberOfComponents() != 3)
+    {
+      vtkErrorMacro(<< "SelectedVoxels has " << voxels->GetNumberOfComponents()
+                    << " components: give 3 ints (i, j, k) a voxel.");
+      return 0;
+    }
+    for (vtkIdType v = 0; v < voxels->GetNumberOfTuples(); ++v)
+    {
+      const int* ijk = voxels->GetPointer(3 * v);
+      if (ijk[0] < 0 || ijk[1] < 0 || ijk[2] < 0 || ijk[0] >= n[0] || ijk[1] >= n[1] || ijk[2] >= n[2])
+      {
+        vtkErrorMacro(<< "Selected voxel " << v << ", (" << ijk[0] << ", " << ijk[1] << ", " << ijk[2]
+                      << "), lies outside the lattice's " << n[0] << "x" << n[1] << "x" << n[2] << " divisions.");
+        return 0;
+      }
+      selected.push_back(Key(ijk[0], ijk[1], ijk[2], n));
+    }
+  }
+  if (this->SecondDerivativeThreshold > 0)
+  {
+    const vtkFFDControlPointIndex index(reader, input);
+    double h[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      const double* axis = lattice.Frame + 3 * (a + 1);
+      h[a] = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]) *
+        (ffd::RestParameter(basis, n[a], 1) - ffd::RestParameter(basis, n[a], 0));
+    }
+    const std::vector<int> covered = vtkFFDCoveredVoxels(reader, input);
+    for (std::size_t v = 0; v < covered.size(); v += 3)
+    {
+      if (SecondDifference(lattice, index, h, &covered[v]) > this->SecondDerivativeThreshold)
+      {
+        selected.push_back(Key(covered[v], covered[v + 1], covered[v + 2], n));
+      }
+    }
+  }
+  std::sort(selected.begin(), selected.end());
+  selected.erase(std::unique(selected.begin(), selected.end()), selected.end());
+  this->NumberOfRefinedVoxels = vtkIdType(selected.size());
+  if (selected.empty())
+  {
+    return 1; // nothing to refine: an empty lattice, which moves nothing
+  }
+  this->UpdateProgress(0.2);
+
+  // M: the fine control points of the selected voxels' halves (movable); C: every fine voxel they influence.
+  std::vector<int> halves;
+  halves.reserve(24 * selected.size());
+  for (vtkTypeInt64 key : selected)
+  {
+    const int v[3] = { int(key % n[0]), int(key / n[0] % n[1]), int(key / n[0] / n[1]) };
+    for (int child = 0; child < 8; ++child)
+    {
+      halves.push_back(2 * v[0] + (child & 1));
+      halves.push_back(2 * v[1] + (child >> 1 & 1));
+      halves.push_back(2 * v[2] + (child >> 2));
+    }
+  }
+  vtkFFDActiveSet movableSet;
+  vtkFFDSparseLattice::MarkSupports(movableSet, basis, fine, halves.data(), vtkIdType(halves.size() / 3));
+  const vtkTypeInt64 pointDims[3] = { finePoints[0], finePoints[1], finePoints[2] };
+  const std::vector<vtkTypeInt64> movable = movableSet.TakeSortedIndices(pointDims);
+  vtkFFDActiveSet cellSet;
+  cellSet.Mark(vtkIdType(movable.size()),
+    [&](vtkIdType begin, vtkIdType end, vtkFFDBoxMarker& marker)
+    {
+      for (vtkIdType m = begin; m < end; ++m)
+      {
+        const vtkTypeInt64 key = movable[m];
+        const int p[3] = { int(key % pointDims[0]), int(key / pointDims[0] % pointDims[1]),
+          int(key / pointDims[0] / pointDims[1]) };
+        int first[3], count[3];
+        for (int a = 0; a < 3; ++a)
+        {
+          Influence(basis, fine[a], p[a], first[a], count[a]);
+        }
+        marker.Mark(first, count);
+      }
+    });
+  const vtkTypeInt64 voxelDims[3] = { fine[0], fine[1], fine[2] };
+  vtkSmartPointer<vtkIntArray> voxelIndex = vtkFFDMakeVoxelIndex(cellSet.TakeSortedIndices(voxelDims), fine);
+  std::ostringstream what;
+  what << "A detail lattice over " << voxelIndex->GetNumberOfTuples() << " voxels of " << fine[0] << "x" << fine[1]
+       << "x" << fine[2];
+  if (!vtkFFDMakeSparseLattice(this, lattice.Frame, basis, fine, voxelIndex, what.str(), output))
+  {
+    return 0;
+  }
+
+  // Active: the movable points; the ring that closes the region is hidden.
+  vtkIntArray* latticeIndex =
+    vtkIntArray::SafeDownCast(output->GetPointData()->GetArray(vtkFFDDataContract::LatticeIndexArrayName()));
+  vtkUnsignedCharArray* active =
+    vtkUnsignedCharArray::SafeDownCast(output->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName()));
+  vtkNew<vtkUnsignedCharArray> ghosts;
+  ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
+  ghosts->SetNumberOfValues(output->GetNumberOfPoints());
+  for (vtkIdType p = 0; p < output->GetNumberOfPoints(); ++p)
+  {
+    const int* ijk = latticeIndex->GetPointer(3 * p);
+    const bool isMovable =
+      std::binary_search(movable.begin(), movable.end(), ijk[0] + pointDims[0] * (ijk[1] + pointDims[1] * ijk[2]));
+    active->SetValue(p, isMovable ? 1 : 0);
+    ghosts->SetValue(p, isMovable ? 0 : vtkDataSetAttributes::HIDDENPOINT);
+  }
+  output->GetPointData()->AddArray(ghosts);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDBuildDetailLattice::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "SelectedVoxels: " << (this->SelectedVoxels ? this->SelectedVoxels->GetNumberOfTuples() : 0)
+     << " voxels\n";
+  os << indent << "SecondDerivativeThreshold: " << this->SecondDerivativeThreshold << "\n";
+  os << indent << "NumberOfRefinedVoxels: " << this->NumberOfRefinedVoxels << "\n";
+}

@@ -1,0 +1,135 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkFFDGridQueries.h"
+
+#include "vtkDataArray.h"
+#include "vtkFFDDataContract.h"
+#include "vtkFFDGridDeformer.h"
+#include "vtkPointData.h"
+#include "vtkPointSet.h"
+#include "vtkPoints.h"
+
+#include "FFDGridDeformation.h"
+
+#include <algorithm>
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDForEachGridWeight(const vtkFFDGridDeformer& deformer, vtkPoints* points, vtkIdType begin, vtkIdType end,
+  const std::function<void(vtkIdType, vtkIdType, double)>& add)
+{
+  const std::vector<int>& cellOf = deformer.GetCellOfPoint();
+  const vtkFFDGridLattice& view = deformer.GetLattice();
+  const vtkFFDSparseCells* cells = deformer.GetSparseCells();
+  ffd::WithStaticBasis(view.Basis,
+    [&](auto maxCount, auto)
+    {
+      const ffd::GridDeformation<decltype(maxCount)::value, double> deformation{ view.Basis,
+        { view.Divisions[0], view.Divisions[1], view.Divisions[2] },
+        { view.ControlPointsPerAxis[0], view.ControlPointsPerAxis[1], view.ControlPointsPerAxis[2] },
+        view.Displacements.data(), ffd::Frame<double>::FromArray(view.Frame), nullptr,
+        cells ? cells->GetVoxels().data() : nullptr, cells ? cells->GetSupports().data() : nullptr };
+      for (vtkIdType p = begin; p < end; ++p)
+      {
+        if (cellOf[p] >= 0)
+        {
+          double x[3];
+          points->GetPoint(p, x);
+          deformation.ForEachWeight(
+            { x[0], x[1], x[2] }, cellOf[p], [&](int controlPoint, double weight) { add(p, controlPoint, weight); });
+        }
+      }
+    });
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDGridWeightsPerPoint(const vtkFFDGridDeformer& deformer)
+{
+  const vtkFFDGridLattice& view = deformer.GetLattice();
+  int count = 1;
+  for (int a = 0; a < 3; ++a)
+  {
+    count *= ffd::SupportSize(view.Basis, view.Divisions[a]);
+  }
+  return count;
+}
+
+//------------------------------------------------------------------------------------------------------------
+std::vector<int> vtkFFDCoveredVoxels(const vtkFFDGridDeformer& deformer, vtkPointSet* lattice)
+{
+  if (const vtkFFDSparseCells* cells = deformer.GetSparseCells())
+  {
+    return cells->GetVoxels();
+  }
+  const vtkFFDGridLattice& view = deformer.GetLattice();
+  vtkDataArray* active = lattice->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName());
+  const int* n = view.Divisions;
+  const int* dims = view.ControlPointsPerAxis;
+  std::vector<int> voxels;
+  for (int k = 0; k < n[2]; ++k)
+  {
+    for (int j = 0; j < n[1]; ++j)
+    {
+      for (int i = 0; i < n[0]; ++i)
+      {
+        const int voxel[3] = { i, j, k };
+        int first[3], count[3];
+        for (int a = 0; a < 3; ++a)
+        {
+          ffd::VoxelSupport(view.Basis, n[a], voxel[a], first[a], count[a]);
+        }
+        bool covered = true;
+        for (int c = first[2]; covered && active && c < first[2] + count[2]; ++c)
+        {
+          for (int b = first[1]; covered && b < first[1] + count[1]; ++b)
+          {
+            for (int a = first[0]; covered && a < first[0] + count[0]; ++a)
+            {
+              covered = active->GetComponent(a + vtkIdType(dims[0]) * (b + vtkIdType(dims[1]) * c), 0) != 0;
+            }
+          }
+        }
+        if (covered)
+        {
+          voxels.insert(voxels.end(), voxel, voxel + 3);
+        }
+      }
+    }
+  }
+  return voxels;
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkFFDControlPointIndex::vtkFFDControlPointIndex(const vtkFFDGridDeformer& deformer, vtkPointSet* lattice)
+  : Dense(!deformer.GetLattice().Sparse)
+{
+  std::copy(deformer.GetLattice().ControlPointsPerAxis, deformer.GetLattice().ControlPointsPerAxis + 3, this->Dims);
+  if (this->Dense)
+  {
+    return;
+  }
+  // The deformer has checked that every point has a LatticeIndex within the lattice.
+  vtkDataArray* index = lattice->GetPointData()->GetArray(vtkFFDDataContract::LatticeIndexArrayName());
+  this->Sorted.resize(std::size_t(lattice->GetNumberOfPoints()));
+  for (vtkIdType p = 0; p < lattice->GetNumberOfPoints(); ++p)
+  {
+    const vtkTypeInt64 i = vtkTypeInt64(index->GetComponent(p, 0)), j = vtkTypeInt64(index->GetComponent(p, 1)),
+                       k = vtkTypeInt64(index->GetComponent(p, 2));
+    this->Sorted[std::size_t(p)] = { i + this->Dims[0] * (j + vtkTypeInt64(this->Dims[1]) * k), p };
+  }
+  std::sort(this->Sorted.begin(), this->Sorted.end());
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkIdType vtkFFDControlPointIndex::Find(int i, int j, int k) const
+{
+  if (i < 0 || j < 0 || k < 0 || i >= this->Dims[0] || j >= this->Dims[1] || k >= this->Dims[2])
+  {
+    return -1;
+  }
+  const vtkTypeInt64 key = i + this->Dims[0] * (j + vtkTypeInt64(this->Dims[1]) * k);
+  if (this->Dense)
+  {
+    return vtkIdType(key);
+  }
+  const auto it = std::lower_bound(this->Sorted.begin(), this->Sorted.end(), std::make_pair(key, vtkIdType(-1)));
+  return it != this->Sorted.end() && it->first == key ? it->second : -1;
+}

@@ -1,0 +1,57 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file vtkFFDGridQueries.h
+ * @brief What the level-of-detail and dynamics filters ask of a grid lattice that vtkFFDGridDeformer has read
+ * (private to the Filters module).
+ *
+ * - The weights of its control points at bound points: the transpose of the deformation (ffd::GridDeformation::
+ *   ForEachWeight), the same numbers the evaluation sums: the lattice's masses (vtkFFDLatticeBody) and
+ *   least-squares fits (vtkFFDCoarsenLattice) are made of them.
+ * - The voxels it covers: a sparse lattice's cells; for a dense lattice, the voxels whose whole support is
+ *   `Active` (all of them without that array).
+ * - Its control points by lattice index (i, j, k), dense or sparse alike.
+ */
+#ifndef vtkFFDGridQueries_h
+#define vtkFFDGridQueries_h
+
+#include "vtkType.h"
+
+#include <functional>
+#include <utility>
+#include <vector>
+
+class vtkFFDGridDeformer;
+class vtkPoints;
+class vtkPointSet;
+
+/**
+ * Calls add(point, controlPoint, weight) for every weight of each point of [begin, end) of `points` that the last
+ * Bind() of `deformer` bound to a cell (those it did not are skipped); controlPoint is the lattice's point id. Safe
+ * to call from several threads on disjoint ranges.
+ */
+void vtkFFDForEachGridWeight(const vtkFFDGridDeformer& deformer, vtkPoints* points, vtkIdType begin, vtkIdType end,
+  const std::function<void(vtkIdType, vtkIdType, double)>& add);
+
+/// How many control points weigh on a bound point: the support's size (64 for the cubic bases).
+int vtkFFDGridWeightsPerPoint(const vtkFFDGridDeformer& deformer);
+
+/// The voxels (i, j, k, in increasing order) that `lattice`, read by `deformer`, covers.
+std::vector<int> vtkFFDCoveredVoxels(const vtkFFDGridDeformer& deformer, vtkPointSet* lattice);
+
+/// A lattice's control points found by (i, j, k).
+class vtkFFDControlPointIndex
+{
+public:
+  /// For `lattice`, read by `deformer`: every point of a dense lattice, a sparse one's by their `LatticeIndex`.
+  vtkFFDControlPointIndex(const vtkFFDGridDeformer& deformer, vtkPointSet* lattice);
+
+  /// The point id of (i, j, k), or -1 where the lattice has no such point.
+  vtkIdType Find(int i, int j, int k) const;
+
+private:
+  int Dims[3];
+  bool Dense;
+  std::vector<std::pair<vtkTypeInt64, vtkIdType>> Sorted; // a sparse lattice's keys i + nI (j + nJ k) and ids
+};
+
+#endif
