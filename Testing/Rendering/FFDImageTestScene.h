@@ -110,19 +110,15 @@ inline bool ReadMeshAndBuildTestLattice(const char* name, const int divisions[3]
   return mesh && BuildTestLattice(mesh, divisions, basis, expectedDims, lattice);
 }
 
-/// `mesh` deformed by `lattice`, with a `Displacement` point array: the distance each point moved.
-inline vtkSmartPointer<vtkPolyData> DeformWithDisplacement(vtkPolyData* mesh, vtkPointSet* lattice)
+/// A copy of `deformed` (a deformation of `mesh`) with a `Displacement` point array: the distance each point moved.
+inline vtkSmartPointer<vtkPolyData> WithDisplacement(vtkPolyData* mesh, vtkPolyData* deformed)
 {
-  vtkNew<vtkFFDDeform> deform;
-  deform->SetInputData(mesh);
-  deform->SetLatticeData(lattice);
-  deform->Update();
-  auto deformed = vtkSmartPointer<vtkPolyData>::New();
-  deformed->ShallowCopy(deform->GetOutput());
-  if (deformed->GetNumberOfPoints() != mesh->GetNumberOfPoints())
+  if (!deformed || deformed->GetNumberOfPoints() != mesh->GetNumberOfPoints())
   {
     return nullptr;
   }
+  auto copy = vtkSmartPointer<vtkPolyData>::New();
+  copy->ShallowCopy(deformed);
   vtkNew<vtkFloatArray> distance;
   distance->SetName("Displacement");
   distance->SetNumberOfTuples(mesh->GetNumberOfPoints());
@@ -130,12 +126,22 @@ inline vtkSmartPointer<vtkPolyData> DeformWithDisplacement(vtkPolyData* mesh, vt
   {
     double x[3], y[3];
     mesh->GetPoint(p, x);
-    deformed->GetPoint(p, y);
+    copy->GetPoint(p, y);
     distance->SetValue(p,
       float(std::sqrt((y[0] - x[0]) * (y[0] - x[0]) + (y[1] - x[1]) * (y[1] - x[1]) + (y[2] - x[2]) * (y[2] - x[2]))));
   }
-  deformed->GetPointData()->SetScalars(distance);
-  return deformed;
+  copy->GetPointData()->SetScalars(distance);
+  return copy;
+}
+
+/// `mesh` deformed by `lattice`, with a `Displacement` point array: the distance each point moved.
+inline vtkSmartPointer<vtkPolyData> DeformWithDisplacement(vtkPolyData* mesh, vtkPointSet* lattice)
+{
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(mesh);
+  deform->SetLatticeData(lattice);
+  deform->Update();
+  return WithDisplacement(mesh, vtkPolyData::SafeDownCast(deform->GetOutputDataObject(0)));
 }
 
 /// Points of a DeformWithDisplacement() result that moved by more than `tolerance`.
