@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkFFDCoarsenLattice.h"
 
+#include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDataContract.h"
@@ -27,21 +28,70 @@
 
 vtkStandardNewMacro(vtkFFDCoarsenLattice);
 
+namespace
+{
+/// Iterated Tikhonov steps (ffd::LeastSquares): a direction whose eigenvalue is 10 lambda keeps 0.1^8 of the
+/// regularisation's bias.
+constexpr int SolveSteps = 8;
+
+/// The smoothness of the lattice's control net: x_a - 2 x_b + x_c for every active control point b whose two
+/// neighbours a, c along an axis are active too.
+std::vector<int> SecondDifferences(const vtkFFDGridDeformer& reader, vtkPointSet* lattice)
+{
+  const vtkFFDControlPointIndex index(reader, lattice);
+  const int* dims = reader.GetLattice().ControlPointsPerAxis;
+  vtkDataArray* active = lattice->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName());
+  vtkDataArray* latticeIndex = lattice->GetPointData()->GetArray(vtkFFDDataContract::LatticeIndexArrayName());
+  auto isActive = [&](vtkIdType p) { return p >= 0 && (!active || active->GetComponent(p, 0) != 0); };
+  std::vector<int> triples;
+  for (vtkIdType p = 0; p < lattice->GetNumberOfPoints(); ++p)
+  {
+    if (!isActive(p))
+    {
+      continue;
+    }
+    int ijk[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      ijk[a] = reader.GetSparseCells()
+        ? int(latticeIndex->GetComponent(p, a))
+        : int(a == 0 ? p % dims[0] : (a == 1 ? p / dims[0] % dims[1] : p / dims[0] / dims[1]));
+    }
+    for (int a = 0; a < 3; ++a)
+    {
+      int before[3] = { ijk[0], ijk[1], ijk[2] }, after[3] = { ijk[0], ijk[1], ijk[2] };
+      --before[a];
+      ++after[a];
+      const vtkIdType q = index.Find(before[0], before[1], before[2]), r = index.Find(after[0], after[1], after[2]);
+      if (isActive(q) && isActive(r))
+      {
+        triples.insert(triples.end(), { int(q), int(p), int(r) });
+      }
+    }
+  }
+  return triples;
+}
+} // namespace
+
 //------------------------------------------------------------------------------------------------------------
 vtkFFDCoarsenLattice::vtkFFDCoarsenLattice()
   : Divisions{ 0, 0, 0 }
   , Basis(-1)
-  , Regularization(1e-8)
+  , Regularization(1e-6)
   , ResidualRMS(0)
   , MaximumResidual(0)
 {
-  this->SetNumberOfInputPorts(2);
+  this->SetNumberOfInputPorts(3);
 }
 
 //------------------------------------------------------------------------------------------------------------
-int vtkFFDCoarsenLattice::FillInputPortInformation(int, vtkInformation* info)
+int vtkFFDCoarsenLattice::FillInputPortInformation(int port, vtkInformation* info)
 {
   info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPointSet");
+  if (port == 2)
+  {
+    info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  }
   return 1;
 }
 
@@ -58,7 +108,7 @@ int vtkFFDCoarsenLattice::ComputeInputUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
 {
   // The fit needs the whole lattice and every point of the mesh.
-  for (int port = 0; port < 2; ++port)
+  for (int port = 0; port < 3; ++port)
   {
     if (vtkInformation* inInfo = inputVector[port]->GetInformationObject(0))
     {
@@ -129,18 +179,28 @@ int vtkFFDCoarsenLattice::RequestData(
     return 0;
   }
 
-  // The deformation to reproduce: the input lattice's displacement of each mesh point.
+  // The deformation to reproduce: input 2's, or the input lattice's displacement of each mesh point.
+  vtkPointSet* target = vtkPointSet::GetData(inputVector[2]);
   vtkNew<vtkFFDDeform> deform;
-  deform->SetInputData(mesh);
-  deform->SetLatticeData(input);
-  deform->SetTransformNormals(false);
-  deform->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
-  deform->Update();
-  vtkPointSet* target = vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0));
-  if (!target || target->GetNumberOfPoints() != mesh->GetNumberOfPoints())
+  if (target && target->GetNumberOfPoints() != mesh->GetNumberOfPoints())
   {
-    vtkErrorMacro(<< "Could not deform the mesh by the input lattice (see the error above).");
+    vtkErrorMacro(<< "The deformed mesh (input 2) has " << target->GetNumberOfPoints() << " points, the mesh "
+                  << mesh->GetNumberOfPoints() << ": give the same points, deformed, in the same order.");
     return 0;
+  }
+  if (!target)
+  {
+    deform->SetInputData(mesh);
+    deform->SetLatticeData(input);
+    deform->SetTransformNormals(false);
+    deform->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
+    deform->Update();
+    target = vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0));
+    if (!target || target->GetNumberOfPoints() != mesh->GetNumberOfPoints())
+    {
+      vtkErrorMacro(<< "Could not deform the mesh by the input lattice (see the error above).");
+      return 0;
+    }
   }
   this->UpdateProgress(0.1);
 
@@ -231,14 +291,14 @@ int vtkFFDCoarsenLattice::RequestData(
         }
       }
     });
-  const ffd::LeastSquares fit(
-    int(coarse->GetNumberOfPoints()), std::move(rowStart), std::move(columns), std::move(weights));
+  ffd::LeastSquares fit(int(coarse->GetNumberOfPoints()), std::move(rowStart), std::move(columns), std::move(weights));
+  fit.SetSecondDifferences(SecondDifferences(coarseReader, coarse));
   this->UpdateProgress(0.3);
   std::vector<double> x;
-  if (!fit.Solve(b, this->Regularization, x).Solved)
+  if (!fit.Solve(b, this->Regularization, SolveSteps, x).Solved)
   {
     vtkErrorMacro(<< "The mesh's points leave some combination of the coarse lattice's control points "
-                     "undetermined and Regularization is 0: set it above 0 (1e-8, the default, keeps those at rest).");
+                     "undetermined and Regularization is 0: set it above 0 (the default 1e-6 keeps those smooth).");
     return 0;
   }
   this->UpdateProgress(0.9);

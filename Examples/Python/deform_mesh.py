@@ -23,8 +23,9 @@ from pathlib import Path
 import numpy as np
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkCommonDataModel import vtkStructuredGrid
-from vtkmodules.vtkFiltersCore import vtkPolyDataNormals
-from vtkmodules.vtkIOImage import vtkPNGWriter
+from vtkmodules.vtkFiltersCore import vtkImageAppend, vtkPolyDataNormals
+from vtkmodules.vtkImagingCore import vtkImageResize
+from vtkmodules.vtkIOImage import vtkPNGReader, vtkPNGWriter
 from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
 from vtkmodules.vtkRenderingCore import (
     vtkActor,
@@ -119,7 +120,7 @@ def deform_lattice(lattice):
     lattice.GetPoints().Modified()  # numpy wrote behind VTK's back: tell the pipeline
 
 
-def render(output_path, size, mesh, lattice, camera_bounds, point_radius=None):
+def render(output_path, size, mesh, lattice, camera_bounds, point_radius=None, azimuth=30.0):
     mesh_mapper = vtkPolyDataMapper()
     mesh_mapper.SetInputData(mesh)
     mesh_actor = vtkActor()
@@ -144,7 +145,7 @@ def render(output_path, size, mesh, lattice, camera_bounds, point_radius=None):
     camera.SetFocalPoint(0.0, 0.0, 0.0)
     camera.SetPosition(0.0, 0.0, 1.0)
     camera.SetViewUp(0.0, 1.0, 0.0)
-    camera.Azimuth(30.0)
+    camera.Azimuth(azimuth)
     camera.Elevation(15.0)
     renderer.ResetCamera(camera_bounds)  # the same framing before and after
     camera.Zoom(1.25)  # ResetCamera fits the bounding sphere, which leaves wide margins around a box
@@ -163,6 +164,32 @@ def write_png(renderer, size, output_path):
     grabber.SetInput(window)
     writer = vtkPNGWriter()
     writer.SetInputConnection(grabber.GetOutputPort())
+    writer.SetFileName(str(output_path))
+    writer.Write()
+
+
+def contact_sheet(pngs, output_path, columns):
+    """The PNGs side by side, `columns` a row, each at half its width and height, written as one PNG."""
+    rows = []
+    for start in range(0, len(pngs), columns):
+        row = vtkImageAppend()
+        row.SetAppendAxis(0)
+        for png in pngs[start:start + columns]:
+            reader = vtkPNGReader()
+            reader.SetFileName(str(png))
+            shrink = vtkImageResize()
+            shrink.SetInputConnection(reader.GetOutputPort())
+            shrink.SetMagnificationFactors(0.5, 0.5, 1)
+            shrink.SetResizeMethodToMagnificationFactors()
+            row.AddInputConnection(shrink.GetOutputPort())
+        rows.append(row)
+    sheet = vtkImageAppend()
+    sheet.SetAppendAxis(1)
+    sheet.PreserveExtentsOff()
+    for row in reversed(rows):  # images grow upwards: the first row on top
+        sheet.AddInputConnection(row.GetOutputPort())
+    writer = vtkPNGWriter()
+    writer.SetInputConnection(sheet.GetOutputPort())
     writer.SetFileName(str(output_path))
     writer.Write()
 

@@ -25,9 +25,7 @@ from pathlib import Path
 from vtkmodules.vtkCommonCore import vtkCommand, vtkIdList, vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkStructuredGrid
 from vtkmodules.vtkFiltersSources import vtkSphereSource
-from vtkmodules.vtkFiltersCore import vtkImageAppend
-from vtkmodules.vtkImagingCore import vtkImageResize
-from vtkmodules.vtkIOImage import vtkPNGReader, vtkPNGWriter
+from vtkmodules.vtkIOImage import vtkPNGWriter
 from vtkmodules.vtkInteractionStyle import vtkInteractorStyleTrackballCamera
 from vtkmodules.vtkRenderingCore import (
     vtkActor,
@@ -41,7 +39,7 @@ from vtkmodules.vtkRenderingCore import (
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL implementations of the rendering classes)
 
 # The mesh reading of the demo (this folder is on sys.path when run as a script).
-from deform_mesh import REPOSITORY, read_mesh, vtkffd
+from deform_mesh import REPOSITORY, contact_sheet, read_mesh, vtkffd
 
 DIVISIONS = 5  # voxels per axis: 6x6x6 = 216 control points, as in the paper's Figure 1
 PERIOD = 4.0  # seconds for one orbit of the sphere
@@ -103,32 +101,6 @@ def scripted_drag(interactor, renderer, lattice, dynamics, seated, frame):
     if dynamics.GetNumberOfPinnedPoints() != len(seated) or lattice.GetPoint(chosen) == put:
         sys.exit("the dragged control point stayed pinned after its release")
     print(f"dragged control point {chosen} by {math.dist(start, put):.3g}: pinned while dragged, free after")
-
-
-def contact_sheet(pngs, output_path):
-    """The frames side by side, SHEET_COLUMNS a row, each at a quarter of its size."""
-    rows = []
-    for start in range(0, len(pngs), SHEET_COLUMNS):
-        row = vtkImageAppend()
-        row.SetAppendAxis(0)
-        for png in pngs[start:start + SHEET_COLUMNS]:
-            reader = vtkPNGReader()
-            reader.SetFileName(str(png))
-            shrink = vtkImageResize()
-            shrink.SetInputConnection(reader.GetOutputPort())
-            shrink.SetMagnificationFactors(0.5, 0.5, 1)
-            shrink.SetResizeMethodToMagnificationFactors()
-            row.AddInputConnection(shrink.GetOutputPort())
-        rows.append(row)
-    sheet = vtkImageAppend()
-    sheet.SetAppendAxis(1)
-    sheet.PreserveExtentsOff()
-    for row in reversed(rows):  # images grow upwards: the first row on top
-        sheet.AddInputConnection(row.GetOutputPort())
-    writer = vtkPNGWriter()
-    writer.SetInputConnection(sheet.GetOutputPort())
-    writer.SetFileName(str(output_path))
-    writer.Write()
 
 
 def main():
@@ -292,7 +264,7 @@ def main():
             writer.Write()
         step = max(1, len(pngs) // 12)
         sheet = arguments.output_dir / "contact_sheet.png"
-        contact_sheet(pngs[step - 1::step][:12], sheet)
+        contact_sheet(pngs[step - 1::step][:12], sheet, SHEET_COLUMNS)
         print(f"wrote {len(pngs)} frames and {sheet}")
         scripted_drag(interactor, renderer, lattice, dynamics, seated, frame)
     else:

@@ -14,7 +14,6 @@ namespace
 {
 using RowMajorMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 using ThreeColumns = Eigen::Matrix<double, Eigen::Dynamic, 3>;
-constexpr int RefinementSteps = 3;
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -45,7 +44,7 @@ void LeastSquares::Apply(const std::vector<double>& x, std::vector<double>& out)
 
 //------------------------------------------------------------------------------------------------------------
 LeastSquares::Result LeastSquares::Solve(
-  const std::vector<double>& b, double regularization, std::vector<double>& x) const
+  const std::vector<double>& b, double regularization, int steps, std::vector<double>& x) const
 {
   Result result;
   const int rows = this->GetNumberOfRows(), n = this->Unknowns;
@@ -54,43 +53,52 @@ LeastSquares::Result LeastSquares::Solve(
     rows, n, this->RowStart.back(), this->RowStart.data(), this->Columns.data(), this->Weights.data());
   const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> rhs(b.data(), rows, 3);
 
-  // The scaled normal equations: A_s = S A S with S = D^(-1/2), the right-hand side S W^T B.
-  Eigen::SparseMatrix<double> scaled = Eigen::SparseMatrix<double>(w.transpose()) * w;
-  Eigen::VectorXd s = scaled.diagonal();
-  for (int i = 0; i < n; ++i)
+  // A, lambda R, and the Jacobi scaling S = D^(-1/2) of their sum (1 for an unknown with neither).
+  Eigen::SparseMatrix<double> a = Eigen::SparseMatrix<double>(w.transpose()) * w;
+  const double mean = a.diagonal().sum() / std::max(1, n);
+  const double lambda = regularization * (mean > 0 ? mean : 1.0);
+  std::vector<Eigen::Triplet<double>> entries;
+  const int stencil[3] = { 1, -2, 1 };
+  for (std::size_t t = 0; t + 2 < this->Triples.size(); t += 3)
   {
-    s[i] = s[i] > 0 ? 1.0 / std::sqrt(s[i]) : 0.0;
-  }
-  for (int k = 0; k < scaled.outerSize(); ++k)
-  {
-    for (Eigen::SparseMatrix<double>::InnerIterator it(scaled, k); it; ++it)
+    for (int r = 0; r < 3; ++r)
     {
-      it.valueRef() *= s[it.row()] * s[it.col()];
+      for (int c = 0; c < 3; ++c)
+      {
+        entries.emplace_back(this->Triples[t + r], this->Triples[t + c], lambda * stencil[r] * stencil[c]);
+      }
     }
   }
-  const ThreeColumns target = s.asDiagonal() * (w.transpose() * rhs);
-
-  // lambda I, and I alone for the unknowns no point weighs (they stay zero).
-  Eigen::SparseMatrix<double> shifted = scaled;
   for (int i = 0; i < n; ++i)
   {
-    shifted.coeffRef(i, i) += s[i] > 0 ? regularization : 1.0;
+    entries.emplace_back(i, i, 1e-6 * lambda);
   }
-  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(shifted);
+  Eigen::SparseMatrix<double> m(n, n);
+  m.setFromTriplets(entries.begin(), entries.end());
+  m += a;
+  Eigen::VectorXd s = m.diagonal();
+  for (int i = 0; i < n; ++i)
+  {
+    s[i] = s[i] > 0 ? 1.0 / std::sqrt(s[i]) : 1.0;
+  }
+  const Eigen::SparseMatrix<double> scaledA = s.asDiagonal() * a * s.asDiagonal();
+  const Eigen::SparseMatrix<double> scaledM = s.asDiagonal() * m * s.asDiagonal();
+  const ThreeColumns target = s.asDiagonal() * (w.transpose() * rhs);
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(scaledM);
   if (ldlt.info() != Eigen::Success)
   {
     return result;
   }
-  ThreeColumns y = ldlt.solve(target);
-  for (int step = 0; step < RefinementSteps; ++step)
+  ThreeColumns y = ThreeColumns::Zero(n, 3);
+  for (int step = 0; step < steps; ++step)
   {
-    y += ldlt.solve(ThreeColumns(target - scaled * y));
+    y += ldlt.solve(ThreeColumns(target - scaledA * y));
   }
   if (!y.allFinite())
   {
     return result;
   }
-  const ThreeColumns residual = target - scaled * y;
+  const ThreeColumns residual = target - scaledA * y;
   for (int c = 0; c < 3; ++c)
   {
     const double norm = target.col(c).norm();

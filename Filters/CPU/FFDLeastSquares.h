@@ -5,12 +5,15 @@
  *
  * W is sparse, one row per sample point holding the weights of the control points that move it (a lattice's
  * basis at that point); X and B have three columns (x, y, z). The normal equations A X = W^T B, A = W^T W, are
- * solved in Jacobi-scaled unknowns y = D^(1/2) x (D = diag A), where A's rows are alike whatever the basis or the
- * points' density, by a sparse LDL^T factorisation (Eigen's SimplicialLDLT) of D^(-1/2) A D^(-1/2) + lambda I
- * followed by three steps of iterated Tikhonov refinement y += (...)^(-1) (r) with the unregularised residual r:
- * determined directions (scaled eigenvalue sigma^2 >> lambda) converge to the least-squares solution, as far as
- * rounding allows (about cond(D^(-1/2) A D^(-1/2)) eps); directions the points do not determine (sigma^2 <~
- * lambda) stay near zero, the minimum-norm choice. Unknowns that no point weighs are zero. VTK-free.
+ * solved by iterated Tikhonov regularisation: X_0 = 0, X_{k+1} = X_k + M^(-1) (W^T B - A X_k) with
+ * M = A + lambda R, factored once (Eigen's SimplicialLDLT, in Jacobi-scaled unknowns so that its pivots are alike
+ * whatever the basis or the points' density). R is the smoothness of the control net: the sum of the squared
+ * second differences x_a - 2 x_b + x_c along the lattice's axes, plus 1e-6 I so that M is definite. Directions
+ * that the points determine (eigenvalue sigma^2 >> lambda) converge to the least-squares solution by a factor
+ * lambda / (sigma^2 + lambda) a step, as far as rounding allows (about cond(A) eps); directions they do not
+ * determine, or barely (sigma^2 <~ lambda), keep the smoothest values, those the net's neighbours extend to them.
+ * lambda = Regularization times the mean of diag(A). Unknowns that no point weighs and no difference joins are
+ * zero. VTK-free.
  */
 #ifndef FFDLeastSquares_h
 #define FFDLeastSquares_h
@@ -38,8 +41,11 @@ public:
 
   int GetNumberOfRows() const { return int(this->RowStart.size()) - 1; }
 
-  /// X (3 per unknown) for B (3 per row), with lambda = `regularization` (default of the filters: 1e-8).
-  Result Solve(const std::vector<double>& b, double regularization, std::vector<double>& x) const;
+  /// The second differences x[a] - 2 x[b] + x[c] of the smoothness R, 3 unknowns a difference (none by default).
+  void SetSecondDifferences(std::vector<int> triples) { this->Triples = std::move(triples); }
+
+  /// X (3 per unknown) for B (3 per row), with lambda = `regularization` times mean(diag A), in `steps` steps.
+  Result Solve(const std::vector<double>& b, double regularization, int steps, std::vector<double>& x) const;
 
   /// W X (3 per row).
   void Apply(const std::vector<double>& x, std::vector<double>& out) const;
@@ -49,6 +55,7 @@ private:
   std::vector<int> RowStart;
   std::vector<int> Columns;
   std::vector<double> Weights;
+  std::vector<int> Triples;
 };
 
 } // namespace ffd

@@ -70,8 +70,9 @@ class TestLevelOfDetail(unittest.TestCase):
             self.assertLessEqual(error, 1e-12 * self.diagonal, Build.GetBasisAsString(basis))
 
     def test_coarsening_a_refined_lattice_returns_it(self):
-        # Points filling the frame determine every control point. For the trilinear basis the scaled normal
-        # matrix's condition number kappa is about 60 over such points (TestFFDCoarsenLattice computes it), so the
+        # Points filling the frame determine every control point, and Regularization 1e-12 asks for the
+        # least-squares fit. For the trilinear basis the scaled normal matrix's condition number kappa is about 60
+        # over such points and the regularisation's bias below 1e-20 (TestFFDCoarsenLattice computes both), so the
         # solution is within kappa 1000 eps (1.3e-11) of the original, relative: 1e-9 leaves room for the sample.
         box = cloud(self.rng.uniform(0, 1, (5000, 3)) * (1.0, 0.6, 0.4))
         _, _, original = build_lattice(box, (3, 2, 2), Build.TRILINEAR)
@@ -81,6 +82,7 @@ class TestLevelOfDetail(unittest.TestCase):
         coarsen = vtkffd.vtkFFDCoarsenLattice()
         coarsen.SetInputConnection(refine.GetOutputPort())
         coarsen.SetMeshData(box)
+        coarsen.SetRegularization(1e-12)
         coarsen.Update()
         want = points_of(original) - vtk_to_numpy(original.GetPointData().GetArray("RestPosition"))
         got = points_of(coarsen.GetOutput()) - vtk_to_numpy(coarsen.GetOutput().GetPointData().GetArray("RestPosition"))
