@@ -186,17 +186,8 @@ int vtkFFDBuildDetailLattice::RequestData(
   }
   const int* n = lattice.Divisions;
   int fine[3], finePoints[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    if (n[a] > VTK_INT_MAX / 2)
-    {
-      vtkErrorMacro(<< "Cannot refine " << n[a] << " divisions along axis " << a << ": twice that is not an int.");
-      return 0;
-    }
-    fine[a] = 2 * n[a];
-  }
-  std::string tooLarge;
-  if (!vtkFFDBuildLattice::GetControlPointsPerAxis(int(basis), fine, finePoints, tooLarge, vtkFFDBuildLattice::SPARSE))
+  const std::string tooLarge = vtkFFDDoubledDivisions(basis, n, vtkFFDBuildLattice::SPARSE, fine, finePoints);
+  if (!tooLarge.empty())
   {
     vtkErrorMacro(<< "Cannot refine the lattice: " << tooLarge);
     return 0;

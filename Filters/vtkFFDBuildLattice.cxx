@@ -8,6 +8,7 @@
 #include "vtkFFDDataContract.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDSparseLattice.h"
+#include "vtkFFDWholeInput.h"
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -186,15 +187,7 @@ int vtkFFDBuildLattice::ComputeInputUpdateExtent(
   // Every control point depends on the whole voxel grid through the culling and the supports: ask for all of it,
   // one piece without ghost levels (and the whole extent of a structured one) rather than a share of the
   // lattice's request.
-  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
-  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
-  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
-  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
-  if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
-  {
-    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
-      inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
-  }
+  vtkFFDRequestWholeInput(inputVector[0]->GetInformationObject(0));
   return 1;
 }
 

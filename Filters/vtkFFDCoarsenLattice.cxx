@@ -11,6 +11,7 @@
 #include "vtkFFDMemory.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkFFDVoxelize.h"
+#include "vtkFFDWholeInput.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkNew.h"
@@ -110,17 +111,7 @@ int vtkFFDCoarsenLattice::ComputeInputUpdateExtent(
   // The fit needs the whole lattice and every point of the mesh.
   for (int port = 0; port < 3; ++port)
   {
-    if (vtkInformation* inInfo = inputVector[port]->GetInformationObject(0))
-    {
-      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
-      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
-      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
-      if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
-      {
-        inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
-          inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
-      }
-    }
+    vtkFFDRequestWholeInput(inputVector[port]->GetInformationObject(0));
   }
   return 1;
 }

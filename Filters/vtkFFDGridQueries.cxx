@@ -2,6 +2,7 @@
 #include "vtkFFDGridQueries.h"
 
 #include "vtkDataArray.h"
+#include "vtkFFDBuildLattice.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDGridDeformer.h"
 #include "vtkPointData.h"
@@ -50,6 +51,24 @@ int vtkFFDGridWeightsPerPoint(const vtkFFDGridDeformer& deformer)
     count *= ffd::SupportSize(view.Basis, view.Divisions[a]);
   }
   return count;
+}
+
+//------------------------------------------------------------------------------------------------------------
+std::string vtkFFDDoubledDivisions(
+  ffd::GridBasis basis, const int divisions[3], int form, int doubled[3], int points[3])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    if (divisions[a] > VTK_INT_MAX / 2)
+    {
+      return "twice the " + std::to_string(divisions[a]) + " divisions along axis " + std::to_string(a) +
+        " is not an int.";
+    }
+    doubled[a] = 2 * divisions[a];
+  }
+  std::string why;
+  vtkFFDBuildLattice::GetControlPointsPerAxis(int(basis), doubled, points, why, form);
+  return why;
 }
 
 //------------------------------------------------------------------------------------------------------------

@@ -16,7 +16,10 @@
 
 #include "vtkType.h"
 
+#include "FFDGridBasis.h"
+
 #include <functional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -34,6 +37,13 @@ void vtkFFDForEachGridWeight(const vtkFFDGridDeformer& deformer, vtkPoints* poin
 
 /// How many control points weigh on a bound point: the support's size (64 for the cubic bases).
 int vtkFFDGridWeightsPerPoint(const vtkFFDGridDeformer& deformer);
+
+/**
+ * The divisions twice `divisions` and the control points per axis of `basis` over them in `form`
+ * (vtkFFDBuildLattice::LatticeForms): an empty string, or why a lattice cannot have them.
+ */
+std::string vtkFFDDoubledDivisions(
+  ffd::GridBasis basis, const int divisions[3], int form, int doubled[3], int points[3]);
 
 /// The voxels (i, j, k, in increasing order) that `lattice`, read by `deformer`, covers.
 std::vector<int> vtkFFDCoveredVoxels(const vtkFFDGridDeformer& deformer, vtkPointSet* lattice);

@@ -10,6 +10,7 @@
 #include "vtkFFDMemory.h"
 #include "vtkFFDSparseLattice.h"
 #include "vtkFFDTetrahedralDeformer.h"
+#include "vtkFFDWholeInput.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
@@ -81,15 +82,7 @@ int vtkFFDRefineLattice::ComputeInputUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
 {
   // Every refined control point may depend on any of the input's: ask for the whole lattice.
-  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
-  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
-  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
-  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
-  if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
-  {
-    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
-      inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
-  }
+  vtkFFDRequestWholeInput(inputVector[0]->GetInformationObject(0));
   return 1;
 }
 
@@ -155,21 +148,11 @@ vtkSmartPointer<vtkPointSet> vtkFFDRefineLattice::RefineOnce(vtkPointSet* coarse
   const ffd::GridBasis basis = lattice.Basis;
   const int* n = lattice.Divisions;
   int fine[3], finePoints[3];
-  for (int a = 0; a < 3; ++a)
+  const std::string tooLarge =
+    vtkFFDDoubledDivisions(basis, n, cells ? vtkFFDBuildLattice::SPARSE : vtkFFDBuildLattice::DENSE, fine, finePoints);
+  if (!tooLarge.empty())
   {
-    if (n[a] > VTK_INT_MAX / 2)
-    {
-      vtkErrorMacro(<< "Cannot refine " << n[a] << " divisions along axis " << a << ": twice that is not an int.");
-      return nullptr;
-    }
-    fine[a] = 2 * n[a];
-  }
-  std::string tooLarge;
-  const int form = cells ? vtkFFDBuildLattice::SPARSE : vtkFFDBuildLattice::DENSE;
-  if (!vtkFFDBuildLattice::GetControlPointsPerAxis(int(basis), fine, finePoints, tooLarge, form))
-  {
-    vtkErrorMacro(<< "Cannot refine the lattice to " << fine[0] << "x" << fine[1] << "x" << fine[2]
-                  << " divisions: " << tooLarge);
+    vtkErrorMacro(<< "Cannot refine the lattice: " << tooLarge);
     return nullptr;
   }
 

@@ -180,6 +180,36 @@ inline vtkSmartPointer<vtkStructuredGrid> MakeLattice(const ffdref::Frame& f, in
   return lattice;
 }
 
+/// A lattice of `basis` over `mesh` (vtkFFDVoxelize, axis-aligned frame) in `form`, its active control points
+/// moved at random by up to `amplitude` of the frame's diagonal per component.
+inline vtkSmartPointer<vtkPointSet> MovedLattice(
+  vtkPointSet* mesh, int basis, const int n[3], int form, std::mt19937& rng, double amplitude = 0.05)
+{
+  vtkNew<vtkFFDVoxelize> voxelize;
+  voxelize->SetInputData(mesh);
+  voxelize->SetDivisions(n[0], n[1], n[2]);
+  vtkNew<vtkFFDBuildLattice> build;
+  build->SetInputConnection(voxelize->GetOutputPort());
+  build->SetBasis(basis);
+  build->SetLatticeForm(form);
+  build->Update();
+  vtkSmartPointer<vtkPointSet> lattice = vtkSmartPointer<vtkPointSet>::Take(build->GetOutput()->NewInstance());
+  lattice->DeepCopy(build->GetOutput());
+  const double size = ffdtest::Diagonal(ffdtest::FrameOf(lattice));
+  std::uniform_real_distribution<double> move(-amplitude * size, amplitude * size);
+  vtkDataArray* active = lattice->GetPointData()->GetArray("Active");
+  for (vtkIdType p = 0; p < lattice->GetNumberOfPoints(); ++p)
+  {
+    if (active->GetComponent(p, 0) != 0)
+    {
+      double x[3];
+      lattice->GetPoint(p, x);
+      lattice->GetPoints()->SetPoint(p, x[0] + move(rng), x[1] + move(rng), x[2] + move(rng));
+    }
+  }
+  return lattice;
+}
+
 // Moves every lattice point by a random vector of up to `amplitude` per component.
 inline void Perturb(vtkPointSet* lattice, std::mt19937& rng, double amplitude)
 {

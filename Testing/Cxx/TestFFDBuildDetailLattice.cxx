@@ -22,19 +22,12 @@
 
 namespace
 {
+/// A lattice of `basis` over `mesh` at rest, n voxels along each axis.
 vtkSmartPointer<vtkPointSet> Lattice(vtkPointSet* mesh, int basis, int n, int form)
 {
-  vtkNew<vtkFFDVoxelize> voxelize;
-  voxelize->SetInputData(mesh);
-  voxelize->SetDivisions(n, n, n);
-  vtkNew<vtkFFDBuildLattice> build;
-  build->SetInputConnection(voxelize->GetOutputPort());
-  build->SetBasis(basis);
-  build->SetLatticeForm(form);
-  build->Update();
-  vtkSmartPointer<vtkPointSet> lattice = vtkSmartPointer<vtkPointSet>::Take(build->GetOutput()->NewInstance());
-  lattice->DeepCopy(build->GetOutput());
-  return lattice;
+  std::mt19937 unused(0);
+  const int divisions[3] = { n, n, n };
+  return ffdtest::MovedLattice(mesh, basis, divisions, form, unused, 0.0);
 }
 
 vtkSmartPointer<vtkUnstructuredGrid> Detail(vtkPointSet* lattice, const std::vector<std::array<int, 3>>& voxels)

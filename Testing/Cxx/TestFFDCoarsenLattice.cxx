@@ -21,39 +21,12 @@
 
 namespace
 {
+using ffdtest::MovedLattice;
 using ffdtest::Vec;
 constexpr double Eps = std::numeric_limits<double>::epsilon();
 
 const int Bases[] = { vtkFFDBuildLattice::BERNSTEIN, vtkFFDBuildLattice::TRILINEAR,
   vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, vtkFFDBuildLattice::TRICUBIC_BEZIER, vtkFFDBuildLattice::CUBIC_BSPLINE };
-
-vtkSmartPointer<vtkPointSet> MovedLattice(
-  vtkPointSet* mesh, int basis, const int n[3], int form, std::mt19937& rng, double amplitude = 0.05)
-{
-  vtkNew<vtkFFDVoxelize> voxelize;
-  voxelize->SetInputData(mesh);
-  voxelize->SetDivisions(n[0], n[1], n[2]);
-  vtkNew<vtkFFDBuildLattice> build;
-  build->SetInputConnection(voxelize->GetOutputPort());
-  build->SetBasis(basis);
-  build->SetLatticeForm(form);
-  build->Update();
-  vtkSmartPointer<vtkPointSet> lattice = vtkSmartPointer<vtkPointSet>::Take(build->GetOutput()->NewInstance());
-  lattice->DeepCopy(build->GetOutput());
-  const double size = ffdtest::Diagonal(ffdtest::FrameOf(lattice));
-  std::uniform_real_distribution<double> move(-amplitude * size, amplitude * size);
-  vtkDataArray* active = lattice->GetPointData()->GetArray("Active");
-  for (vtkIdType p = 0; p < lattice->GetNumberOfPoints(); ++p)
-  {
-    if (active->GetComponent(p, 0) != 0)
-    {
-      double x[3];
-      lattice->GetPoint(p, x);
-      lattice->GetPoints()->SetPoint(p, x[0] + move(rng), x[1] + move(rng), x[2] + move(rng));
-    }
-  }
-  return lattice;
-}
 
 /// W: the reference's weight of every control point of a dense lattice at every point of `mesh` inside it.
 Eigen::MatrixXd ReferenceWeights(const ffdtest::Reference& lattice, vtkPointSet* mesh)
