@@ -5,7 +5,7 @@
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDGridDeformer.h"
-#include "vtkFFDGridQueries.h"
+#include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDSparseLattice.h"
 #include "vtkFFDTetrahedralDeformer.h"

@@ -7,7 +7,7 @@
 #include "vtkFFDDataContract.h"
 #include "vtkFFDDeform.h"
 #include "vtkFFDGridDeformer.h"
-#include "vtkFFDGridQueries.h"
+#include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkFFDVoxelize.h"

@@ -3,7 +3,7 @@
 
 #include "vtkFFDDataContract.h"
 #include "vtkFFDGridDeformer.h"
-#include "vtkFFDGridQueries.h"
+#include "vtkFFDLatticeQueries.h"
 #include "vtkFFDSparseCells.h"
 #include "vtkFFDTetrahedralDeformer.h"
 
@@ -247,23 +247,8 @@ std::string vtkFFDLatticeBody::Read(
     if (tetrahedral)
     {
       tetrahedra.Bind(points, vtkFFDTetrahedralDeformer::KEEP_POSITION, nullptr, 0, 1, rebound);
-      const std::vector<int>& cellOf = tetrahedra.GetCellOfPoint();
-      const std::vector<vtkIdType>& nodes = tetrahedra.GetNodes();
-      for (vtkIdType p = 0; p < mesh->GetNumberOfPoints(); ++p)
-      {
-        const int t = cellOf[p];
-        if (t >= 0)
-        {
-          double x[3];
-          points->GetPoint(p, x);
-          const ffd::Vec3<double> stu = tetrahedra.GetFrames()[t].ToParametric({ x[0], x[1], x[2] });
-          const double weights[4] = { 1.0 - stu.x - stu.y - stu.z, stu.x, stu.y, stu.z };
-          for (int corner = 0; corner < 4; ++corner)
-          {
-            add(nodes[4 * std::size_t(t) + corner], weights[corner]);
-          }
-        }
-      }
+      vtkFFDForEachTetrahedronWeight(tetrahedra, points, 0, mesh->GetNumberOfPoints(),
+        [&](vtkIdType, vtkIdType node, double weight) { add(node, weight); });
     }
     else
     {

@@ -1,18 +1,19 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
- * @file vtkFFDGridQueries.h
- * @brief What the level-of-detail and dynamics filters ask of a grid lattice that vtkFFDGridDeformer has read
- * (private to the Filters module).
+ * @file vtkFFDLatticeQueries.h
+ * @brief What the level-of-detail, dynamics and direct-manipulation filters ask of a lattice that
+ * vtkFFDGridDeformer or vtkFFDTetrahedralDeformer has read (private to the Filters module).
  *
  * - The weights of its control points at bound points: the transpose of the deformation (ffd::GridDeformation::
- *   ForEachWeight), the same numbers the evaluation sums: the lattice's masses (vtkFFDLatticeBody) and
- *   least-squares fits (vtkFFDCoarsenLattice) are made of them.
+ *   ForEachWeight, a tetrahedron's barycentric weights), the same numbers the evaluation sums: the lattice's
+ *   masses (vtkFFDLatticeBody), least-squares fits (vtkFFDCoarsenLattice) and direct manipulation
+ *   (vtkFFDDirectManipulation) are made of them.
  * - The voxels it covers: a sparse lattice's cells; for a dense lattice, the voxels whose whole support is
  *   `Active` (all of them without that array).
  * - Its control points by lattice index (i, j, k), dense or sparse alike.
  */
-#ifndef vtkFFDGridQueries_h
-#define vtkFFDGridQueries_h
+#ifndef vtkFFDLatticeQueries_h
+#define vtkFFDLatticeQueries_h
 
 #include "vtkType.h"
 
@@ -24,6 +25,7 @@
 #include <vector>
 
 class vtkFFDGridDeformer;
+class vtkFFDTetrahedralDeformer;
 class vtkPoints;
 class vtkPointSet;
 
@@ -34,6 +36,10 @@ class vtkPointSet;
  */
 void vtkFFDForEachGridWeight(const vtkFFDGridDeformer& deformer, vtkPoints* points, vtkIdType begin, vtkIdType end,
   const std::function<void(vtkIdType, vtkIdType, double)>& add);
+
+/// vtkFFDForEachGridWeight() for a tetrahedral lattice: the four nodes of each bound point's tetrahedron.
+void vtkFFDForEachTetrahedronWeight(const vtkFFDTetrahedralDeformer& deformer, vtkPoints* points, vtkIdType begin,
+  vtkIdType end, const std::function<void(vtkIdType, vtkIdType, double)>& add);
 
 /// How many control points weigh on a bound point: the support's size (64 for the cubic bases).
 int vtkFFDGridWeightsPerPoint(const vtkFFDGridDeformer& deformer);

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "vtkFFDGridQueries.h"
+#include "vtkFFDLatticeQueries.h"
 
 #include "vtkDataArray.h"
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDGridDeformer.h"
+#include "vtkFFDTetrahedralDeformer.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
@@ -39,6 +40,29 @@ void vtkFFDForEachGridWeight(const vtkFFDGridDeformer& deformer, vtkPoints* poin
         }
       }
     });
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDForEachTetrahedronWeight(const vtkFFDTetrahedralDeformer& deformer, vtkPoints* points, vtkIdType begin,
+  vtkIdType end, const std::function<void(vtkIdType, vtkIdType, double)>& add)
+{
+  const std::vector<int>& cellOf = deformer.GetCellOfPoint();
+  const std::vector<vtkIdType>& nodes = deformer.GetNodes();
+  for (vtkIdType p = begin; p < end; ++p)
+  {
+    const int t = cellOf[p];
+    if (t >= 0)
+    {
+      double x[3];
+      points->GetPoint(p, x);
+      const ffd::Vec3<double> stu = deformer.GetFrames()[t].ToParametric({ x[0], x[1], x[2] });
+      const double weights[4] = { 1.0 - stu.x - stu.y - stu.z, stu.x, stu.y, stu.z };
+      for (int corner = 0; corner < 4; ++corner)
+      {
+        add(p, nodes[4 * std::size_t(t) + corner], weights[corner]);
+      }
+    }
+  }
 }
 
 //------------------------------------------------------------------------------------------------------------

@@ -1,0 +1,311 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkFFDDirectManipulation.h"
+
+#include "vtkDoubleArray.h"
+#include "vtkFFDDeform.h"
+#include "vtkFFDGridDeformer.h"
+#include "vtkFFDLatticeQueries.h"
+#include "vtkFFDMemory.h"
+#include "vtkFFDTetrahedralDeformer.h"
+#include "vtkIdTypeArray.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkMath.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointSet.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkUnstructuredGrid.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+vtkStandardNewMacro(vtkFFDDirectManipulation);
+
+//------------------------------------------------------------------------------------------------------------
+vtkFFDDirectManipulation::vtkFFDDirectManipulation()
+  : Regularization(0)
+  , NumberOfMovedControlPoints(0)
+  , MaximumTargetDistance(0)
+{
+  this->SetNumberOfInputPorts(2);
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkFFDDirectManipulation::~vtkFFDDirectManipulation() = default;
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDDirectManipulation::SetTargetPointIds(vtkIdTypeArray* ids)
+{
+  if (this->TargetPointIds != ids)
+  {
+    this->TargetPointIds = ids;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkIdTypeArray* vtkFFDDirectManipulation::GetTargetPointIds()
+{
+  return this->TargetPointIds;
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDDirectManipulation::SetTargetPositions(vtkPoints* positions)
+{
+  if (this->TargetPositions != positions)
+  {
+    this->TargetPositions = positions;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkPoints* vtkFFDDirectManipulation::GetTargetPositions()
+{
+  return this->TargetPositions;
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkMTimeType vtkFFDDirectManipulation::GetMTime()
+{
+  vtkMTimeType time = this->Superclass::GetMTime();
+  if (this->TargetPointIds)
+  {
+    time = std::max(time, this->TargetPointIds->GetMTime());
+  }
+  if (this->TargetPositions)
+  {
+    time = std::max(time, this->TargetPositions->GetMTime());
+  }
+  return time;
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDDirectManipulation::FillInputPortInformation(int port, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPointSet");
+  if (port == 1)
+  {
+    info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1); // needed only with targets; RequestData says so
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkTypeBool vtkFFDDirectManipulation::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  return vtkFFDCatchAllocationFailure(
+    this, outputVector, [&] { return this->Superclass::ProcessRequest(request, inputVector, outputVector); });
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDDirectManipulation::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPointSet* lattice = vtkPointSet::GetData(inputVector[0]);
+  vtkPointSet* mesh = vtkPointSet::GetData(inputVector[1]);
+  vtkPointSet* output = vtkPointSet::GetData(outputVector);
+  this->NumberOfMovedControlPoints = 0;
+  this->MaximumTargetDistance = 0;
+  if (!lattice || lattice->GetNumberOfPoints() == 0)
+  {
+    return 1;
+  }
+  output->ShallowCopy(lattice);
+  const vtkIdType count = this->TargetPointIds ? this->TargetPointIds->GetNumberOfValues() : 0;
+  if (count == 0)
+  {
+    return 1; // nothing asked: the lattice as it is
+  }
+  if (!mesh || !mesh->GetPoints())
+  {
+    vtkErrorMacro(<< "No mesh: SetMeshConnection() (input 1) to the mesh at rest that the lattice deforms.");
+    output->Initialize();
+    return 0;
+  }
+  if (!this->TargetPositions || this->TargetPositions->GetNumberOfPoints() != count)
+  {
+    vtkErrorMacro(<< "There are " << count << " target point ids but "
+                  << (this->TargetPositions ? this->TargetPositions->GetNumberOfPoints() : 0)
+                  << " target positions: give one position per id.");
+    output->Initialize();
+    return 0;
+  }
+
+  // The targets' rest points, and where the lattice takes them now.
+  vtkNew<vtkPoints> rest;
+  rest->SetDataTypeToDouble();
+  rest->SetNumberOfPoints(count);
+  for (vtkIdType t = 0; t < count; ++t)
+  {
+    const vtkIdType id = this->TargetPointIds->GetValue(t);
+    if (id < 0 || id >= mesh->GetNumberOfPoints())
+    {
+      vtkErrorMacro(<< "Target " << t << " names mesh point " << id << "; the mesh has " << mesh->GetNumberOfPoints()
+                    << " points.");
+      output->Initialize();
+      return 0;
+    }
+    rest->SetPoint(t, mesh->GetPoint(id));
+  }
+  vtkNew<vtkPolyData> targets;
+  targets->SetPoints(rest);
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(targets);
+  deform->SetLatticeData(lattice);
+  deform->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
+  deform->Update();
+  vtkPointSet* now = vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0));
+  if (!now || now->GetNumberOfPoints() != count)
+  {
+    vtkErrorMacro(<< "Could not deform the targets by the lattice (see the error above).");
+    output->Initialize();
+    return 0;
+  }
+
+  // W: each target's weights, over the control points that move some target.
+  std::vector<std::array<double, 3>> entries; // (target, control point, weight)
+  auto add = [&](vtkIdType target, vtkIdType controlPoint, double weight)
+  {
+    if (weight != 0)
+    {
+      entries.push_back({ double(target), double(controlPoint), weight });
+    }
+  };
+  bool rebound = false;
+  std::vector<int> cellOf;
+  if (vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice))
+  {
+    vtkFFDTetrahedralDeformer tetrahedra;
+    const std::string why = tetrahedra.SetLattice(vtkUnstructuredGrid::SafeDownCast(lattice));
+    if (!why.empty() || !tetrahedra.Bind(rest, vtkFFDTetrahedralDeformer::KEEP_POSITION, nullptr, 0, 1, rebound))
+    {
+      vtkErrorMacro(<< "Cannot bind the targets to the lattice. " << why);
+      output->Initialize();
+      return 0;
+    }
+    cellOf = tetrahedra.GetCellOfPoint();
+    vtkFFDForEachTetrahedronWeight(tetrahedra, rest, 0, count, add);
+  }
+  else
+  {
+    vtkFFDGridDeformer grid;
+    const std::string why = grid.SetLattice(lattice);
+    if (!why.empty() || !grid.Bind(rest, vtkFFDDeform::KEEP_POSITION, nullptr, 0, 1, rebound))
+    {
+      vtkErrorMacro(<< "Cannot bind the targets to the lattice. " << why);
+      output->Initialize();
+      return 0;
+    }
+    cellOf = grid.GetCellOfPoint();
+    vtkFFDForEachGridWeight(grid, rest, 0, count, add);
+  }
+  const vtkIdType outside = std::count(cellOf.begin(), cellOf.end(), -1);
+  if (outside > 0)
+  {
+    vtkWarningMacro(<< outside << " of the " << count << " targets lie outside the lattice: they cannot be moved.");
+  }
+  std::map<vtkIdType, Eigen::Index> column;
+  for (const auto& e : entries)
+  {
+    column.emplace(vtkIdType(e[1]), 0);
+  }
+  std::vector<vtkIdType> controlPoints;
+  for (auto& c : column)
+  {
+    c.second = Eigen::Index(controlPoints.size());
+    controlPoints.push_back(c.first);
+  }
+  std::ostringstream request;
+  request << "Direct manipulation of " << count << " targets over " << controlPoints.size() << " control points";
+  if (!vtkFFDCheckMemory(this, request.str(), 8.0 * double(count) * double(controlPoints.size() + count + 6)))
+  {
+    output->Initialize();
+    return 0;
+  }
+  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(count, Eigen::Index(controlPoints.size()));
+  for (const auto& e : entries)
+  {
+    w(Eigen::Index(e[0]), column[vtkIdType(e[1])]) = e[2];
+  }
+  Eigen::MatrixXd change(count, 3);
+  for (vtkIdType t = 0; t < count; ++t)
+  {
+    double target[3], at[3];
+    this->TargetPositions->GetPoint(t, target);
+    now->GetPoint(t, at);
+    for (int c = 0; c < 3; ++c)
+    {
+      change(t, c) = cellOf[t] >= 0 ? target[c] - at[c] : 0.0;
+    }
+  }
+
+  // dP = W^+ (T - F), or W^T (W W^T + lambda I)^-1 (T - F).
+  Eigen::MatrixXd move;
+  if (this->Regularization > 0)
+  {
+    Eigen::MatrixXd gram = w * w.transpose();
+    const double lambda = this->Regularization * gram.diagonal().mean();
+    gram.diagonal().array() += lambda > 0 ? lambda : this->Regularization;
+    move = w.transpose() * gram.ldlt().solve(change);
+  }
+  else
+  {
+    move = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(w).solve(change);
+  }
+  if (!move.allFinite())
+  {
+    vtkErrorMacro(<< "The solve failed: set a Regularization above 0.");
+    output->Initialize();
+    return 0;
+  }
+
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->DeepCopy(lattice->GetPoints());
+  for (std::size_t c = 0; c < controlPoints.size(); ++c)
+  {
+    double x[3];
+    points->GetPoint(controlPoints[c], x);
+    for (int a = 0; a < 3; ++a)
+    {
+      x[a] += move(Eigen::Index(c), a);
+    }
+    points->SetPoint(controlPoints[c], x);
+    this->NumberOfMovedControlPoints += move.row(Eigen::Index(c)).squaredNorm() > 0;
+  }
+  output->SetPoints(points);
+  const Eigen::MatrixXd missed = change - w * move;
+  for (vtkIdType t = 0; t < count; ++t)
+  {
+    double distance = missed.row(t).norm();
+    if (cellOf[t] < 0)
+    {
+      double target[3], at[3];
+      this->TargetPositions->GetPoint(t, target);
+      now->GetPoint(t, at);
+      distance = std::sqrt(vtkMath::Distance2BetweenPoints(target, at));
+    }
+    this->MaximumTargetDistance = std::max(this->MaximumTargetDistance, distance);
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDDirectManipulation::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "TargetPointIds: " << (this->TargetPointIds ? this->TargetPointIds->GetNumberOfValues() : 0)
+     << " ids\n";
+  os << indent << "Regularization: " << this->Regularization << "\n";
+  os << indent << "NumberOfMovedControlPoints: " << this->NumberOfMovedControlPoints << "\n";
+  os << indent << "MaximumTargetDistance: " << this->MaximumTargetDistance << "\n";
+}
