@@ -26,11 +26,6 @@ vtkStandardNewMacro(vtkFFDBuildDetailLattice);
 
 namespace
 {
-vtkTypeInt64 Key(int i, int j, int k, const int dims[3])
-{
-  return i + vtkTypeInt64(dims[0]) * (j + vtkTypeInt64(dims[1]) * k);
-}
-
 int FloorDiv(int a, int b)
 {
   return a >= 0 ? a / b : -((-a + b - 1) / b);
@@ -213,7 +208,7 @@ int vtkFFDBuildDetailLattice::RequestData(
                       << "), lies outside the lattice's " << n[0] << "x" << n[1] << "x" << n[2] << " divisions.");
         return 0;
       }
-      selected.push_back(Key(ijk[0], ijk[1], ijk[2], n));
+      selected.push_back(vtkFFDFlatIndex(ijk[0], ijk[1], ijk[2], n));
     }
   }
   if (this->SecondDerivativeThreshold > 0)
@@ -231,7 +226,7 @@ int vtkFFDBuildDetailLattice::RequestData(
     {
       if (SecondDifference(lattice, index, h, &covered[v]) > this->SecondDerivativeThreshold)
       {
-        selected.push_back(Key(covered[v], covered[v + 1], covered[v + 2], n));
+        selected.push_back(vtkFFDFlatIndex(covered[v], covered[v + 1], covered[v + 2], n));
       }
     }
   }
@@ -300,7 +295,7 @@ int vtkFFDBuildDetailLattice::RequestData(
   {
     const int* ijk = latticeIndex->GetPointer(3 * p);
     const bool isMovable =
-      std::binary_search(movable.begin(), movable.end(), ijk[0] + pointDims[0] * (ijk[1] + pointDims[1] * ijk[2]));
+      std::binary_search(movable.begin(), movable.end(), vtkFFDFlatIndex(ijk[0], ijk[1], ijk[2], finePoints));
     active->SetValue(p, isMovable ? 1 : 0);
     ghosts->SetValue(p, isMovable ? 0 : vtkDataSetAttributes::HIDDENPOINT);
   }

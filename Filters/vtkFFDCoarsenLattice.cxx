@@ -286,7 +286,7 @@ int vtkFFDCoarsenLattice::RequestData(
   fit.SetSecondDifferences(SecondDifferences(coarseReader, coarse));
   this->UpdateProgress(0.3);
   std::vector<double> x;
-  if (!fit.Solve(b, this->Regularization, SolveSteps, x).Solved)
+  if (!fit.Solve(b, this->Regularization, SolveSteps, x))
   {
     vtkErrorMacro(<< "The mesh's points leave some combination of the coarse lattice's control points "
                      "undetermined and Regularization is 0: set it above 0 (the default 1e-6 keeps those smooth).");

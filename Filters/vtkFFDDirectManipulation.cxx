@@ -21,7 +21,6 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -172,12 +171,18 @@ int vtkFFDDirectManipulation::RequestData(
   }
 
   // W: each target's weights, over the control points that move some target.
-  std::vector<std::array<double, 3>> entries; // (target, control point, weight)
+  struct Entry
+  {
+    vtkIdType Target;
+    vtkIdType ControlPoint;
+    double Weight;
+  };
+  std::vector<Entry> entries;
   auto add = [&](vtkIdType target, vtkIdType controlPoint, double weight)
   {
     if (weight != 0)
     {
-      entries.push_back({ double(target), double(controlPoint), weight });
+      entries.push_back({ target, controlPoint, weight });
     }
   };
   bool rebound = false;
@@ -214,9 +219,9 @@ int vtkFFDDirectManipulation::RequestData(
     vtkWarningMacro(<< outside << " of the " << count << " targets lie outside the lattice: they cannot be moved.");
   }
   std::map<vtkIdType, Eigen::Index> column;
-  for (const auto& e : entries)
+  for (const Entry& e : entries)
   {
-    column.emplace(vtkIdType(e[1]), 0);
+    column.emplace(e.ControlPoint, 0);
   }
   std::vector<vtkIdType> controlPoints;
   for (auto& c : column)
@@ -232,9 +237,9 @@ int vtkFFDDirectManipulation::RequestData(
     return 0;
   }
   Eigen::MatrixXd w = Eigen::MatrixXd::Zero(count, Eigen::Index(controlPoints.size()));
-  for (const auto& e : entries)
+  for (const Entry& e : entries)
   {
-    w(Eigen::Index(e[0]), column[vtkIdType(e[1])]) = e[2];
+    w(Eigen::Index(e.Target), column[e.ControlPoint]) = e.Weight;
   }
   Eigen::MatrixXd change(count, 3);
   for (vtkIdType t = 0; t < count; ++t)

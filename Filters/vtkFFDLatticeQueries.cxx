@@ -5,6 +5,7 @@
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDGridDeformer.h"
+#include "vtkFFDSparseLattice.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
@@ -154,9 +155,9 @@ vtkFFDControlPointIndex::vtkFFDControlPointIndex(const vtkFFDGridDeformer& defor
   this->Sorted.resize(std::size_t(lattice->GetNumberOfPoints()));
   for (vtkIdType p = 0; p < lattice->GetNumberOfPoints(); ++p)
   {
-    const vtkTypeInt64 i = vtkTypeInt64(index->GetComponent(p, 0)), j = vtkTypeInt64(index->GetComponent(p, 1)),
-                       k = vtkTypeInt64(index->GetComponent(p, 2));
-    this->Sorted[std::size_t(p)] = { i + this->Dims[0] * (j + vtkTypeInt64(this->Dims[1]) * k), p };
+    this->Sorted[std::size_t(p)] = { vtkFFDFlatIndex(int(index->GetComponent(p, 0)), int(index->GetComponent(p, 1)),
+                                       int(index->GetComponent(p, 2)), this->Dims),
+      p };
   }
   std::sort(this->Sorted.begin(), this->Sorted.end());
 }
@@ -168,7 +169,7 @@ vtkIdType vtkFFDControlPointIndex::Find(int i, int j, int k) const
   {
     return -1;
   }
-  const vtkTypeInt64 key = i + this->Dims[0] * (j + vtkTypeInt64(this->Dims[1]) * k);
+  const vtkTypeInt64 key = vtkFFDFlatIndex(i, j, k, this->Dims);
   if (this->Dense)
   {
     return vtkIdType(key);

@@ -56,12 +56,6 @@ void Combine(const ffd::RefinementRow rows[3], const double* displacements, Id&&
   }
 }
 
-/// The flat index i + n0 (j + n1 k) of a voxel or control point.
-vtkTypeInt64 Key(const int ijk[3], const int dims[3])
-{
-  return ijk[0] + vtkTypeInt64(dims[0]) * (ijk[1] + vtkTypeInt64(dims[1]) * ijk[2]);
-}
-
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -171,9 +165,8 @@ vtkSmartPointer<vtkPointSet> vtkFFDRefineLattice::RefineOnce(vtkPointSet* coarse
   {
     for (int child = 0; child < 8; ++child)
     {
-      const int ijk[3] = { 2 * parents[v] + (child & 1), 2 * parents[v + 1] + (child >> 1 & 1),
-        2 * parents[v + 2] + (child >> 2) };
-      keys.push_back(Key(ijk, fine));
+      keys.push_back(vtkFFDFlatIndex(
+        2 * parents[v] + (child & 1), 2 * parents[v + 1] + (child >> 1 & 1), 2 * parents[v + 2] + (child >> 2), fine));
     }
   }
   parents = std::vector<int>();
@@ -250,8 +243,8 @@ vtkSmartPointer<vtkPointSet> vtkFFDRefineLattice::RefineOnce(vtkPointSet* coarse
         for (int c = begin; c < end; ++c)
         {
           const int* voxel = fineCells.GetVoxels().data() + 3 * std::size_t(c);
-          const int parent[3] = { voxel[0] / 2, voxel[1] / 2, voxel[2] / 2 };
-          const int* support = coarseSupports + std::size_t(cells->Find(Key(parent, n))) * m3;
+          const int* support = coarseSupports +
+            std::size_t(cells->Find(vtkFFDFlatIndex(voxel[0] / 2, voxel[1] / 2, voxel[2] / 2, n))) * m3;
           int first[3], unused;
           for (int a = 0; a < 3; ++a)
           {

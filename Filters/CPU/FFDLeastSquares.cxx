@@ -43,10 +43,8 @@ void LeastSquares::Apply(const std::vector<double>& x, std::vector<double>& out)
 }
 
 //------------------------------------------------------------------------------------------------------------
-LeastSquares::Result LeastSquares::Solve(
-  const std::vector<double>& b, double regularization, int steps, std::vector<double>& x) const
+bool LeastSquares::Solve(const std::vector<double>& b, double regularization, int steps, std::vector<double>& x) const
 {
-  Result result;
   const int rows = this->GetNumberOfRows(), n = this->Unknowns;
   x.assign(3 * std::size_t(n), 0.0);
   const Eigen::Map<const RowMajorMatrix> w(
@@ -87,7 +85,7 @@ LeastSquares::Result LeastSquares::Solve(
   const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(scaledM);
   if (ldlt.info() != Eigen::Success)
   {
-    return result;
+    return false;
   }
   ThreeColumns y = ThreeColumns::Zero(n, 3);
   for (int step = 0; step < steps; ++step)
@@ -96,13 +94,7 @@ LeastSquares::Result LeastSquares::Solve(
   }
   if (!y.allFinite())
   {
-    return result;
-  }
-  const ThreeColumns residual = target - scaledA * y;
-  for (int c = 0; c < 3; ++c)
-  {
-    const double norm = target.col(c).norm();
-    result.RelativeResidual = std::max(result.RelativeResidual, norm > 0 ? residual.col(c).norm() / norm : 0.0);
+    return false;
   }
   for (int i = 0; i < n; ++i)
   {
@@ -111,8 +103,7 @@ LeastSquares::Result LeastSquares::Solve(
       x[3 * std::size_t(i) + c] = s[i] * y(i, c);
     }
   }
-  result.Solved = true;
-  return result;
+  return true;
 }
 
 } // namespace ffd

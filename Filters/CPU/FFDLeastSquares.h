@@ -27,12 +27,6 @@ namespace ffd
 class LeastSquares
 {
 public:
-  struct Result
-  {
-    bool Solved = false;         ///< false when the factorisation failed (lambda 0 and A singular)
-    double RelativeResidual = 0; ///< the largest column's |D^(-1/2) (W^T B - A X)| / |D^(-1/2) W^T B|
-  };
-
   /**
    * W of `unknowns` columns in compressed rows: row r's entries are columns[rowStart[r] .. rowStart[r + 1]) with
    * those weights (a column at most once per row; fewer than 2^31 entries in all).
@@ -44,8 +38,11 @@ public:
   /// The second differences x[a] - 2 x[b] + x[c] of the smoothness R, 3 unknowns a difference (none by default).
   void SetSecondDifferences(std::vector<int> triples) { this->Triples = std::move(triples); }
 
-  /// X (3 per unknown) for B (3 per row), with lambda = `regularization` times mean(diag A), in `steps` steps.
-  Result Solve(const std::vector<double>& b, double regularization, int steps, std::vector<double>& x) const;
+  /**
+   * X (3 per unknown) for B (3 per row), with lambda = `regularization` times mean(diag A), in `steps` steps.
+   * False when the factorisation failed (lambda 0 and A singular).
+   */
+  bool Solve(const std::vector<double>& b, double regularization, int steps, std::vector<double>& x) const;
 
   /// W X (3 per row).
   void Apply(const std::vector<double>& x, std::vector<double>& out) const;
