@@ -123,6 +123,25 @@ struct BindSettings
   const vtkFFDSparseCells* SparseCells; // null for a dense lattice
 };
 
+BindSettings SettingsOf(const vtkFFDGridLattice& lattice, const vtkFFDSparseCells* sparse, bool clampOutside)
+{
+  return { ffd::Frame<double>::FromArray(lattice.Frame), lattice.Basis,
+    { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] }, clampOutside, sparse };
+}
+
+int BindOne(const BindSettings& s, const ffd::Vec3<double>& p)
+{
+  if (!s.SparseCells)
+  {
+    return ffd::BindToGrid(s.Frame, s.Basis, s.Voxels, p, s.ClampOutside);
+  }
+  // A sparse lattice's cell of the point's voxel, -1 where it has none.
+  int v[3];
+  return ffd::BindToCells(s.Frame, s.Voxels, p, s.ClampOutside, v)
+    ? s.SparseCells->Find(v[0] + std::int64_t(s.Voxels[0]) * (v[1] + std::int64_t(s.Voxels[1]) * v[2]))
+    : -1;
+}
+
 template <typename PointArrayT>
 struct BindFunctor
 {
@@ -134,20 +153,9 @@ struct BindFunctor
   {
     const auto points = vtk::DataArrayTupleRange<3>(this->Points, begin, end);
     int* cell = this->CellOfPoint + begin;
-    const BindSettings& s = this->Settings;
     for (const auto x : points)
     {
-      const ffd::Vec3<double> p{ double(x[0]), double(x[1]), double(x[2]) };
-      if (!s.SparseCells)
-      {
-        *cell++ = ffd::BindToGrid(s.Frame, s.Basis, s.Voxels, p, s.ClampOutside);
-        continue;
-      }
-      // A sparse lattice's cell of the point's voxel, -1 where it has none.
-      int v[3];
-      *cell++ = ffd::BindToCells(s.Frame, s.Voxels, p, s.ClampOutside, v)
-        ? s.SparseCells->Find(v[0] + std::int64_t(s.Voxels[0]) * (v[1] + std::int64_t(s.Voxels[1]) * v[2]))
-        : -1;
+      *cell++ = BindOne(this->Settings, { double(x[0]), double(x[1]), double(x[2]) });
     }
   }
 };
@@ -414,6 +422,13 @@ vtkFFDBindingKey vtkFFDGridDeformer::KeyOf(vtkPoints* points, int outsidePolicy)
 }
 
 //------------------------------------------------------------------------------------------------------------
+int vtkFFDGridDeformer::BindPoint(const double x[3], int outsidePolicy) const
+{
+  return BindOne(SettingsOf(this->Lattice, this->GetSparseCells(), outsidePolicy == vtkFFDDeform::CLAMP_TO_EDGE),
+    ffd::Vec3<double>::From(x));
+}
+
+//------------------------------------------------------------------------------------------------------------
 bool vtkFFDGridDeformer::Bind(
   vtkPoints* points, int outsidePolicy, vtkAlgorithm* self, double progressBegin, double progressEnd, bool& rebound)
 {
@@ -429,8 +444,7 @@ bool vtkFFDGridDeformer::Bind(
   const vtkIdType n = points->GetNumberOfPoints();
   binding.CellOfPoint.resize(n);
   const vtkFFDSparseCells* sparse = this->GetSparseCells();
-  const BindSettings settings{ ffd::Frame<double>::FromArray(lattice.Frame), lattice.Basis,
-    { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] }, key.ClampsOutside(), sparse };
+  const BindSettings settings = SettingsOf(lattice, sparse, key.ClampsOutside());
   bool completed = false;
   BindWorker bind;
   if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(

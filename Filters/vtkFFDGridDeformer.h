@@ -75,6 +75,9 @@ public:
   bool Bind(
     vtkPoints* points, int outsidePolicy, vtkAlgorithm* self, double progressBegin, double progressEnd, bool& rebound);
 
+  /// The cell Bind() gives the point x under `outsidePolicy` (-1: it keeps its position).
+  int BindPoint(const double x[3], int outsidePolicy) const;
+
   /**
    * Deforms the bound points into outPoints (a float or double AOS array of their count), with the normals
    * (3 components, may be null) transformed into outNormals and det J into outDeterminants (of outPoints' type)

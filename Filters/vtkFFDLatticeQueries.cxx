@@ -20,16 +20,9 @@ void vtkFFDForEachGridWeight(const vtkFFDGridDeformer& deformer, vtkPoints* poin
   const std::function<void(vtkIdType, vtkIdType, double)>& add)
 {
   const std::vector<int>& cellOf = deformer.GetCellOfPoint();
-  const vtkFFDGridLattice& view = deformer.GetLattice();
-  const vtkFFDSparseCells* cells = deformer.GetSparseCells();
-  ffd::WithStaticBasis(view.Basis,
-    [&](auto maxCount, auto)
+  vtkFFDWithGridDeformation(deformer,
+    [&](const auto& deformation)
     {
-      const ffd::GridDeformation<decltype(maxCount)::value, double> deformation{ view.Basis,
-        { view.Divisions[0], view.Divisions[1], view.Divisions[2] },
-        { view.ControlPointsPerAxis[0], view.ControlPointsPerAxis[1], view.ControlPointsPerAxis[2] },
-        view.Displacements.data(), ffd::Frame<double>::FromArray(view.Frame), nullptr,
-        cells ? cells->GetVoxels().data() : nullptr, cells ? cells->GetSupports().data() : nullptr };
       for (vtkIdType p = begin; p < end; ++p)
       {
         if (cellOf[p] >= 0)

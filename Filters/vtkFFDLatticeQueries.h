@@ -15,19 +15,39 @@
 #ifndef vtkFFDLatticeQueries_h
 #define vtkFFDLatticeQueries_h
 
+#include "vtkFFDGridDeformer.h"
 #include "vtkType.h"
 
-#include "FFDGridBasis.h"
+#include "FFDGridDeformation.h"
 
 #include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
-class vtkFFDGridDeformer;
 class vtkFFDTetrahedralDeformer;
 class vtkPoints;
 class vtkPointSet;
+
+/**
+ * Calls f(deformation) with the float64 ffd::GridDeformation of the lattice that `deformer` read (its support's
+ * size as a template argument, as the evaluation has it).
+ */
+template <typename F>
+void vtkFFDWithGridDeformation(const vtkFFDGridDeformer& deformer, F&& f)
+{
+  const vtkFFDGridLattice& view = deformer.GetLattice();
+  const vtkFFDSparseCells* cells = deformer.GetSparseCells();
+  ffd::WithStaticBasis(view.Basis,
+    [&](auto maxCount, auto)
+    {
+      f(ffd::GridDeformation<decltype(maxCount)::value, double>{ view.Basis,
+        { view.Divisions[0], view.Divisions[1], view.Divisions[2] },
+        { view.ControlPointsPerAxis[0], view.ControlPointsPerAxis[1], view.ControlPointsPerAxis[2] },
+        view.Displacements.data(), ffd::Frame<double>::FromArray(view.Frame), nullptr,
+        cells ? cells->GetVoxels().data() : nullptr, cells ? cells->GetSupports().data() : nullptr });
+    });
+}
 
 /**
  * Calls add(point, controlPoint, weight) for every weight of each point of [begin, end) of `points` that the last
