@@ -5,9 +5,12 @@
 #include "vtkCellArray.h"
 #include "vtkDataArray.h"
 #include "vtkFFDDataContract.h"
+#include "vtkFFDDeform.h"
+#include "vtkFFDDirectManipulation.h"
 #include "vtkFFDLatticeActor.h"
 #include "vtkGlyph3DMapper.h"
 #include "vtkIdList.h"
+#include "vtkIdTypeArray.h"
 #include "vtkInteractorObserver.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
@@ -20,6 +23,7 @@
 #include "vtkRenderer.h"
 #include "vtkSphereSource.h"
 
+#include <functional>
 #include <set>
 
 vtkStandardNewMacro(vtkFFDLatticeRepresentation);
@@ -34,7 +38,59 @@ struct vtkFFDLatticeRepresentation::vtkInternals
   vtkNew<vtkSphereSource> SelectedSphere;
   vtkNew<vtkGlyph3DMapper> SelectedMapper;
   vtkNew<vtkActor> SelectedActor;
+
+  // Direct manipulation: the mesh deformed (for picking), the solve, and the drag's start: the lattice then,
+  // the mesh point and where it was.
+  vtkNew<vtkFFDDeform> Deform;
+  vtkNew<vtkFFDDirectManipulation> Manipulate;
+  vtkSmartPointer<vtkPointSet> DragStartLattice;
+  vtkIdType DraggedMeshPoint = -1;
+  double DragStartPoint[3] = { 0.0, 0.0, 0.0 };
+  double DragStartWorld[3] = { 0.0, 0.0, 0.0 };
 };
+
+namespace
+{
+/**
+ * The point of `points` nearest the display position (X, Y) within `tolerance` pixels and inside the clipping
+ * range, among those `pickable`; among points within a pixel of each other (a lattice row seen end-on), the
+ * nearest to the camera. -1 when none.
+ */
+vtkIdType NearestOnScreen(
+  vtkRenderer* renderer, vtkPoints* points, int X, int Y, int tolerance, const std::function<bool(vtkIdType)>& pickable)
+{
+  const double tolerance2 = double(tolerance) * tolerance;
+  double bestDistance2 = VTK_DOUBLE_MAX;
+  double bestDepth = VTK_DOUBLE_MAX;
+  vtkIdType best = -1;
+  for (vtkIdType id = 0; id < points->GetNumberOfPoints(); ++id)
+  {
+    if (!pickable(id))
+    {
+      continue;
+    }
+    double x[3], display[3];
+    points->GetPoint(id, x);
+    vtkInteractorObserver::ComputeWorldToDisplay(renderer, x[0], x[1], x[2], display);
+    const double dx = display[0] - X;
+    const double dy = display[1] - Y;
+    const double distance2 = dx * dx + dy * dy;
+    if (distance2 > tolerance2 || display[2] < 0.0 || display[2] > 1.0) // beyond the clipping range
+    {
+      continue;
+    }
+    const bool nearer = distance2 < bestDistance2 - 1.0;
+    const bool asNearAndInFront = distance2 <= bestDistance2 + 1.0 && display[2] < bestDepth;
+    if (nearer || asNearAndInFront)
+    {
+      bestDistance2 = distance2;
+      bestDepth = display[2];
+      best = id;
+    }
+  }
+  return best;
+}
+} // namespace
 
 //------------------------------------------------------------------------------
 vtkFFDLatticeRepresentation::vtkFFDLatticeRepresentation()
@@ -57,6 +113,7 @@ vtkFFDLatticeRepresentation::vtkFFDLatticeRepresentation()
 vtkFFDLatticeRepresentation::~vtkFFDLatticeRepresentation()
 {
   this->SetLattice(nullptr);
+  this->SetMesh(nullptr);
 }
 
 //------------------------------------------------------------------------------
@@ -76,9 +133,90 @@ void vtkFFDLatticeRepresentation::SetLattice(vtkPointSet* lattice)
     this->Lattice->Register(this);
   }
   this->Internals->LatticeActor->SetInputData(lattice);
+  this->Internals->Deform->SetLatticeData(lattice);
   this->Internals->Selection.clear();
   this->HoveredControlPoint = -1;
+  this->HoveredMeshPoint = -1;
   this->Modified();
+}
+
+//------------------------------------------------------------------------------
+void vtkFFDLatticeRepresentation::SetMesh(vtkPointSet* mesh)
+{
+  if (this->Mesh == mesh)
+  {
+    return;
+  }
+  if (this->Mesh)
+  {
+    this->Mesh->UnRegister(this);
+  }
+  this->Mesh = mesh;
+  if (this->Mesh)
+  {
+    this->Mesh->Register(this);
+  }
+  this->Internals->Deform->SetInputData(mesh);
+  this->HoveredMeshPoint = -1;
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+vtkPointSet* vtkFFDLatticeRepresentation::GetDeformedMesh()
+{
+  if (!this->Lattice || !this->Mesh)
+  {
+    return nullptr;
+  }
+  vtkFFDDeform* deform = this->Internals->Deform;
+  deform->Update(); // re-executes only when the lattice moved, with its binding kept
+  return deform->GetOutput();
+}
+
+//------------------------------------------------------------------------------
+bool vtkFFDLatticeRepresentation::SolveMeshPoint(vtkPointSet* from, vtkIdType id, const double target[3])
+{
+  vtkFFDDirectManipulation* manipulate = this->Internals->Manipulate;
+  vtkNew<vtkIdTypeArray> ids;
+  ids->InsertNextValue(id);
+  vtkNew<vtkPoints> targets;
+  targets->SetDataTypeToDouble();
+  targets->InsertNextPoint(target);
+  manipulate->SetInputData(from);
+  manipulate->SetMeshData(this->Mesh);
+  manipulate->SetTargetPointIds(ids);
+  manipulate->SetTargetPositions(targets);
+  manipulate->Update();
+  vtkPointSet* moved = manipulate->GetOutput();
+  if (!moved->GetPoints() || moved->GetNumberOfPoints() != this->Lattice->GetNumberOfPoints())
+  {
+    return false; // the filter reported why
+  }
+  this->Lattice->GetPoints()->DeepCopy(moved->GetPoints());
+  this->Lattice->GetPoints()->Modified();
+  this->Modified();
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkFFDLatticeRepresentation::MoveMeshPoint(vtkIdType id, const double target[3])
+{
+  if (!this->Lattice || !this->Lattice->GetPoints() || !this->Mesh)
+  {
+    vtkErrorMacro("Moving a mesh point needs the lattice (SetLattice()) and the mesh at rest it deforms "
+                  "(SetMesh()).");
+    return false;
+  }
+  if (id < 0 || id >= this->Mesh->GetNumberOfPoints())
+  {
+    vtkErrorMacro(
+      "Mesh point " << id << " is not a point of the mesh (" << this->Mesh->GetNumberOfPoints() << " points).");
+    return false;
+  }
+  // The solve reads its input while the lattice is overwritten: it starts from a copy.
+  vtkSmartPointer<vtkPointSet> from = vtkSmartPointer<vtkPointSet>::Take(this->Lattice->NewInstance());
+  from->DeepCopy(this->Lattice);
+  return this->SolveMeshPoint(from, id, target);
 }
 
 //------------------------------------------------------------------------------
@@ -238,6 +376,7 @@ bool vtkFFDLatticeRepresentation::ResetLatticeToRest()
 int vtkFFDLatticeRepresentation::ComputeInteractionState(int X, int Y, int)
 {
   this->HoveredControlPoint = -1;
+  this->HoveredMeshPoint = -1;
   if (this->InteractionState == Moving)
   {
     return this->InteractionState; // a drag keeps its control points until it ends
@@ -245,41 +384,23 @@ int vtkFFDLatticeRepresentation::ComputeInteractionState(int X, int Y, int)
   this->InteractionState = Outside;
   // vtkAbstractWidget::SetEnabled() asks before the first render, when the renderer may have no camera yet:
   // nothing is on screen to pick then.
-  if (!this->Lattice || !this->Renderer || !this->Renderer->IsActiveCameraCreated())
+  if (!this->Lattice || !this->Lattice->GetPoints() || !this->Renderer || !this->Renderer->IsActiveCameraCreated())
   {
     return this->InteractionState;
   }
-  const double tolerance2 = double(this->Tolerance) * this->Tolerance;
-  double bestDistance2 = VTK_DOUBLE_MAX;
-  double bestDepth = VTK_DOUBLE_MAX;
-  const vtkIdType n = this->Lattice->GetNumberOfPoints();
-  for (vtkIdType id = 0; id < n; ++id)
+  if (this->ManipulationMode == MESH_POINTS)
   {
-    if (!this->IsPickable(id))
+    vtkPointSet* deformed = this->GetDeformedMesh();
+    if (deformed && deformed->GetPoints())
     {
-      continue;
+      this->HoveredMeshPoint =
+        NearestOnScreen(this->Renderer, deformed->GetPoints(), X, Y, this->Tolerance, [](vtkIdType) { return true; });
     }
-    double x[3], display[3];
-    this->Lattice->GetPoint(id, x);
-    vtkInteractorObserver::ComputeWorldToDisplay(this->Renderer, x[0], x[1], x[2], display);
-    const double dx = display[0] - X;
-    const double dy = display[1] - Y;
-    const double distance2 = dx * dx + dy * dy;
-    if (distance2 > tolerance2 || display[2] < 0.0 || display[2] > 1.0) // beyond the clipping range
-    {
-      continue;
-    }
-    // The nearest on screen; among points within a pixel of each other (a lattice row seen end-on), the
-    // nearest to the camera.
-    const bool nearer = distance2 < bestDistance2 - 1.0;
-    const bool asNearAndInFront = distance2 <= bestDistance2 + 1.0 && display[2] < bestDepth;
-    if (nearer || asNearAndInFront)
-    {
-      bestDistance2 = distance2;
-      bestDepth = display[2];
-      this->HoveredControlPoint = id;
-    }
+    this->InteractionState = this->HoveredMeshPoint >= 0 ? OverMeshPoint : Outside;
+    return this->InteractionState;
   }
+  this->HoveredControlPoint = NearestOnScreen(this->Renderer, this->Lattice->GetPoints(), X, Y, this->Tolerance,
+    [this](vtkIdType id) { return this->IsPickable(id); });
   if (this->HoveredControlPoint >= 0)
   {
     this->InteractionState = OverControlPoint;
@@ -290,20 +411,35 @@ int vtkFFDLatticeRepresentation::ComputeInteractionState(int X, int Y, int)
 //------------------------------------------------------------------------------
 void vtkFFDLatticeRepresentation::StartWidgetInteraction(double eventPosition[2])
 {
-  if (!this->Lattice || !this->Renderer || this->HoveredControlPoint < 0)
+  vtkInternals& in = *this->Internals;
+  const bool meshPoint = this->ManipulationMode == MESH_POINTS;
+  vtkPointSet* deformed = meshPoint ? this->GetDeformedMesh() : nullptr;
+  if (!this->Lattice || !this->Renderer ||
+    (meshPoint ? !deformed || this->HoveredMeshPoint < 0 : this->HoveredControlPoint < 0))
   {
     return;
   }
-  // The drag plane goes through the picked control point, parallel to the view plane: its display depth.
+  // The drag plane goes through the picked point, parallel to the view plane: its display depth.
   double x[3], display[3], world[4];
-  this->Lattice->GetPoint(this->HoveredControlPoint, x);
+  if (meshPoint)
+  {
+    deformed->GetPoint(this->HoveredMeshPoint, x);
+    in.DraggedMeshPoint = this->HoveredMeshPoint;
+    std::copy_n(x, 3, in.DragStartPoint);
+    in.DragStartLattice = vtkSmartPointer<vtkPointSet>::Take(this->Lattice->NewInstance());
+    in.DragStartLattice->DeepCopy(this->Lattice);
+  }
+  else
+  {
+    this->Lattice->GetPoint(this->HoveredControlPoint, x);
+  }
   vtkInteractorObserver::ComputeWorldToDisplay(this->Renderer, x[0], x[1], x[2], display);
   this->InteractionDepth = display[2];
   vtkInteractorObserver::ComputeDisplayToWorld(
     this->Renderer, eventPosition[0], eventPosition[1], this->InteractionDepth, world);
   for (int c = 0; c < 3; ++c)
   {
-    this->LastWorldPosition[c] = world[c];
+    this->LastWorldPosition[c] = in.DragStartWorld[c] = world[c];
   }
   this->StartEventPosition[0] = eventPosition[0];
   this->StartEventPosition[1] = eventPosition[1];
@@ -321,6 +457,21 @@ void vtkFFDLatticeRepresentation::WidgetInteraction(double eventPosition[2])
   double world[4];
   vtkInteractorObserver::ComputeDisplayToWorld(
     this->Renderer, eventPosition[0], eventPosition[1], this->InteractionDepth, world);
+  vtkInternals& in = *this->Internals;
+  if (this->ManipulationMode == MESH_POINTS)
+  {
+    if (in.DragStartLattice && this->Mesh)
+    {
+      // From the drag's start with the whole motion: each move's solve is exact, so nothing accumulates.
+      double target[3];
+      for (int c = 0; c < 3; ++c)
+      {
+        target[c] = in.DragStartPoint[c] + world[c] - in.DragStartWorld[c];
+      }
+      this->SolveMeshPoint(in.DragStartLattice, in.DraggedMeshPoint, target);
+    }
+    return;
+  }
   const double delta[3] = { world[0] - this->LastWorldPosition[0], world[1] - this->LastWorldPosition[1],
     world[2] - this->LastWorldPosition[2] };
   for (int c = 0; c < 3; ++c)
@@ -334,6 +485,8 @@ void vtkFFDLatticeRepresentation::WidgetInteraction(double eventPosition[2])
 void vtkFFDLatticeRepresentation::EndWidgetInteraction(double eventPosition[2])
 {
   this->WidgetInteraction(eventPosition);
+  this->Internals->DragStartLattice = nullptr;
+  this->Internals->DraggedMeshPoint = -1;
   this->InteractionState = Outside;
 }
 
@@ -452,6 +605,10 @@ void vtkFFDLatticeRepresentation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Tolerance: " << this->Tolerance << " pixels\n";
   os << indent << "PickCulledPoints: " << (this->PickCulledPoints ? "On" : "Off") << "\n";
   os << indent << "HoveredControlPoint: " << this->HoveredControlPoint << "\n";
+  os << indent << "ManipulationMode: " << (this->ManipulationMode == MESH_POINTS ? "MESH_POINTS" : "CONTROL_POINTS")
+     << "\n";
+  os << indent << "Mesh: " << this->Mesh << "\n";
+  os << indent << "HoveredMeshPoint: " << this->HoveredMeshPoint << "\n";
   os << indent << "NumberOfSelectedControlPoints: " << this->GetNumberOfSelectedControlPoints() << "\n";
   os << indent << "SelectedPointProperty:\n";
   this->GetSelectedPointProperty()->PrintSelf(os, indent.GetNextIndent());

@@ -18,6 +18,12 @@
  * - A drag moves every selected control point by the cursor's motion on the plane through the picked control
  *   point parallel to the view plane (as vtkPointHandleRepresentation moves its focal point).
  * - ResetLatticeToRest() puts every point back at its `RestPosition`.
+ * - Direct manipulation (ManipulationMode MESH_POINTS, with SetMesh() the mesh at rest that the lattice
+ *   deforms): the point of the deformed mesh nearest the cursor is picked (as control points are), and a drag
+ *   moves the control points by the smallest displacement that keeps it under the cursor
+ *   (vtkFFDDirectManipulation), solved at every move from the lattice as it was when the drag began, with the
+ *   cursor's whole motion: nothing drifts however long the drag. MoveMeshPoint() does one such move without
+ *   events.
  *
  * The selection API (SelectControlPoint() and the rest) and MoveSelectedControlPoints() let an application
  * or a test edit the lattice without events. A lattice without an `Active` array has every point pickable; one
@@ -74,14 +80,46 @@ public:
 
   enum InteractionStates
   {
-    Outside = 0,      ///< no control point under the cursor
+    Outside = 0,      ///< nothing pickable under the cursor
     OverControlPoint, ///< a control point within Tolerance of the cursor (GetHoveredControlPoint())
-    Moving            ///< dragging the selected control points
+    Moving,           ///< dragging the selected control points, or a mesh point
+    OverMeshPoint     ///< MESH_POINTS: a deformed mesh point within Tolerance (GetHoveredMeshPoint())
   };
-  vtkSetClampMacro(InteractionState, int, Outside, Moving);
+  vtkSetClampMacro(InteractionState, int, Outside, OverMeshPoint);
 
   /// The control point found by the last ComputeInteractionState(), -1 when none.
   vtkGetMacro(HoveredControlPoint, vtkIdType);
+
+  /// What picking and dragging act on.
+  enum ManipulationModes
+  {
+    CONTROL_POINTS = 0, ///< control points, selected and dragged (the default)
+    MESH_POINTS = 1     ///< points of the deformed mesh, dragged by direct manipulation (needs SetMesh())
+  };
+
+  ///@{
+  /// What picking and dragging act on (default CONTROL_POINTS); the widget's key `m` switches.
+  vtkSetClampMacro(ManipulationMode, int, CONTROL_POINTS, MESH_POINTS);
+  vtkGetMacro(ManipulationMode, int);
+  void SetManipulationModeToControlPoints() { this->SetManipulationMode(CONTROL_POINTS); }
+  void SetManipulationModeToMeshPoints() { this->SetManipulationMode(MESH_POINTS); }
+  ///@}
+
+  ///@{
+  /// The mesh at rest that the lattice deforms (vtkFFDDeform's input 0), for MESH_POINTS.
+  void SetMesh(vtkPointSet* mesh);
+  vtkGetObjectMacro(Mesh, vtkPointSet);
+  ///@}
+
+  /// The mesh point found by the last ComputeInteractionState() in MESH_POINTS mode, -1 when none.
+  vtkGetMacro(HoveredMeshPoint, vtkIdType);
+
+  /**
+   * Moves the control points by the smallest displacement that takes mesh point `id`, once deformed, to
+   * `target` (world coordinates; vtkFFDDirectManipulation) and marks the lattice's points modified. False, with
+   * an error, without a lattice or a mesh, for an id out of range, or where the solve fails.
+   */
+  bool MoveMeshPoint(vtkIdType id, const double target[3]);
 
   ///@{
   /**
@@ -127,7 +165,15 @@ protected:
   /// Whether control point `id` may be picked or selected.
   bool IsPickable(vtkIdType id);
 
+  /// The lattice moved so that mesh point `id` goes to `target`, solved from `from` (the lattice or a copy).
+  bool SolveMeshPoint(vtkPointSet* from, vtkIdType id, const double target[3]);
+  /// The mesh deformed by the lattice as it is (null without both).
+  vtkPointSet* GetDeformedMesh();
+
   vtkPointSet* Lattice = nullptr;
+  vtkPointSet* Mesh = nullptr;
+  int ManipulationMode = CONTROL_POINTS;
+  vtkIdType HoveredMeshPoint = -1;
   int Tolerance = 10;
   bool PickCulledPoints = false;
   vtkIdType HoveredControlPoint = -1;

@@ -32,6 +32,8 @@ vtkFFDLatticeWidget::vtkFFDLatticeWidget()
     vtkWidgetEvent::Reset, this, vtkFFDLatticeWidget::ResetAction);
   mapper->SetCallbackMethod(vtkCommand::KeyPressEvent, vtkEvent::AnyModifier, 27, 0, "Escape", vtkWidgetEvent::Delete,
     this, vtkFFDLatticeWidget::ClearSelectionAction);
+  mapper->SetCallbackMethod(vtkCommand::KeyPressEvent, vtkEvent::AnyModifier, GetModeKey(), 0, "m",
+    vtkWidgetEvent::ModifyEvent, this, vtkFFDLatticeWidget::SwitchModeAction);
 }
 
 //------------------------------------------------------------------------------
@@ -69,7 +71,8 @@ vtkIdType vtkFFDLatticeWidget::PickAtEventPosition()
     return -1;
   }
   rep->ComputeInteractionState(position[0], position[1]);
-  return rep->GetHoveredControlPoint();
+  return rep->GetManipulationMode() == vtkFFDLatticeRepresentation::MESH_POINTS ? rep->GetHoveredMeshPoint()
+                                                                                : rep->GetHoveredControlPoint();
 }
 
 //------------------------------------------------------------------------------
@@ -98,7 +101,7 @@ void vtkFFDLatticeWidget::SelectAction(vtkAbstractWidget* widget)
     return; // not on a control point: the event goes on to the camera
   }
   vtkFFDLatticeRepresentation* rep = self->GetLatticeRepresentation();
-  if (!rep->IsControlPointSelected(id))
+  if (rep->GetManipulationMode() == vtkFFDLatticeRepresentation::CONTROL_POINTS && !rep->IsControlPointSelected(id))
   {
     rep->ClearSelection();
     rep->SelectControlPoint(id);
@@ -110,12 +113,18 @@ void vtkFFDLatticeWidget::SelectAction(vtkAbstractWidget* widget)
 void vtkFFDLatticeWidget::ToggleSelectAction(vtkAbstractWidget* widget)
 {
   auto* self = static_cast<vtkFFDLatticeWidget*>(widget);
+  vtkFFDLatticeRepresentation* rep = self->GetLatticeRepresentation();
+  if (rep && rep->GetManipulationMode() == vtkFFDLatticeRepresentation::MESH_POINTS)
+  {
+    SelectAction(widget); // mesh points have no selection: Shift drags as the plain button does
+    return;
+  }
   const vtkIdType id = self->PickAtEventPosition();
   if (id < 0)
   {
     return;
   }
-  if (self->GetLatticeRepresentation()->ToggleControlPoint(id))
+  if (rep->ToggleControlPoint(id))
   {
     self->StartDrag(); // added: the drag moves the selection with it
     return;
@@ -197,6 +206,22 @@ void vtkFFDLatticeWidget::ClearSelectionAction(vtkAbstractWidget* widget)
   rep->ClearSelection();
   self->EventCallbackCommand->SetAbortFlag(1);
   self->Render();
+}
+
+//------------------------------------------------------------------------------
+void vtkFFDLatticeWidget::SwitchModeAction(vtkAbstractWidget* widget)
+{
+  auto* self = static_cast<vtkFFDLatticeWidget*>(widget);
+  vtkFFDLatticeRepresentation* rep = self->GetLatticeRepresentation();
+  if (!rep || self->WidgetState == Dragging)
+  {
+    return;
+  }
+  rep->SetManipulationMode(rep->GetManipulationMode() == vtkFFDLatticeRepresentation::MESH_POINTS
+      ? vtkFFDLatticeRepresentation::CONTROL_POINTS
+      : vtkFFDLatticeRepresentation::MESH_POINTS);
+  self->EventCallbackCommand->SetAbortFlag(1);
+  self->RequestCursorShape(VTK_CURSOR_DEFAULT);
 }
 
 //------------------------------------------------------------------------------

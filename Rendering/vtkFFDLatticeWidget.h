@@ -15,7 +15,11 @@
  * - Shift + left button on a control point: adds it to the selection or removes it; when added, the drag
  *   moves the whole selection;
  * - key `x`: resets the whole lattice to its rest position (`RestPosition`);
- * - key Escape: clears the selection.
+ * - key Escape: clears the selection;
+ * - key `m`: switches between dragging control points and dragging points of the mesh (direct manipulation,
+ *   vtkFFDLatticeRepresentation::MESH_POINTS; the representation needs the mesh at rest, SetMesh()). In that
+ *   mode the left button on a point of the deformed mesh drags it: the lattice takes the smallest control-point
+ *   move that keeps the point under the cursor, and the mesh follows.
  *
  * It invokes StartInteractionEvent, InteractionEvent (after every move, and after a reset) and
  * EndInteractionEvent, so an application can observe the lattice's edits.
@@ -47,6 +51,9 @@ public:
   /// The key that resets the lattice to rest (`x`).
   static char GetResetKey() { return 'x'; }
 
+  /// The key that switches between dragging control points and mesh points (`m`).
+  static char GetModeKey() { return 'm'; }
+
   /// Whether a drag is under way.
   bool IsDragging() const { return this->WidgetState == Dragging; }
 
@@ -67,10 +74,12 @@ protected:
   static void EndSelectAction(vtkAbstractWidget* widget);
   static void ResetAction(vtkAbstractWidget* widget);
   static void ClearSelectionAction(vtkAbstractWidget* widget);
+  static void SwitchModeAction(vtkAbstractWidget* widget);
 
-  /// Picks the control point under the event position; -1 when there is none (or no renderer there).
+  /// Picks the control point (or, in MESH_POINTS mode, the mesh point) under the event position; -1 when there
+  /// is none (or no renderer there).
   vtkIdType PickAtEventPosition();
-  /// Starts dragging the selection from the picked control point.
+  /// Starts dragging the selection from the picked control point, or the picked mesh point.
   void StartDrag();
 
 private:

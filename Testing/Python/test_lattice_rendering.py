@@ -2,8 +2,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 """The Rendering module from Python: vtkFFDLatticeActor's parts (grid and hand-made tetrahedral lattices, voxel
 boxes without the hidden voxels, culled points, displacement colours), vtkFFDCellEdges, vtkFFDControlPoints,
-and vtkFFDLatticeRepresentation / vtkFFDLatticeWidget's API, keys and bad input (no lattice, a lattice without
-the data contract's arrays, malformed arrays). Renders offscreen, so it runs in an X display
+and vtkFFDLatticeRepresentation / vtkFFDLatticeWidget's API, keys, dragging mesh points (direct manipulation) and
+bad input (no lattice, a lattice without the data contract's arrays, malformed arrays). Renders offscreen, so it runs in an X display
 (Utilities/with-display.sh); PYTHONPATH=<build>/lib/python3/dist-packages.
 """
 import unittest
@@ -12,6 +12,7 @@ import numpy as np
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkCommand, vtkIdList, vtkPoints
 from vtkmodules.vtkCommonDataModel import VTK_TETRA, vtkStructuredGrid, vtkUnstructuredGrid
+from vtkmodules.vtkCommonExecutionModel import vtkAlgorithm
 from vtkmodules.vtkFiltersSources import vtkSphereSource
 from vtkmodules.vtkInteractionStyle import vtkInteractorStyleTrackballCamera
 from vtkmodules.vtkRenderingCore import vtkInteractorObserver, vtkRenderer, vtkRenderWindowInteractor
@@ -311,6 +312,70 @@ class LatticeWidgetTest(unittest.TestCase):
         self.key("x", "x")
         np.testing.assert_array_equal(vtk_to_numpy(self.lattice.GetPoints().GetData()),
                                       vtk_to_numpy(self.lattice.GetPointData().GetArray("RestPosition")))
+
+    def world(self, position, depth):
+        w = [0.0, 0.0, 0.0, 0.0]
+        vtkInteractorObserver.ComputeDisplayToWorld(self.renderer, position[0], position[1], depth, w)
+        return np.array(w[:3])
+
+    def test_mesh_point_mode_drags_a_point_of_the_surface(self):
+        """Key `m`, then a drag of a sphere's point: the point, deformed by the moved lattice, is where the cursor
+        took it (its start plus the cursor's motion on the view-parallel plane through it) within 1e-9 of the
+        lattice's size (one target: the solve is exact up to rounding); only the 8 control points of its voxel
+        move. MoveMeshPoint() without events; bad ids and a missing mesh are errors."""
+        sphere = vtkSphereSource()
+        sphere.SetThetaResolution(24)
+        sphere.SetPhiResolution(16)
+        sphere.Update()
+        mesh = sphere.GetOutput()
+        self.rep.SetMesh(mesh)
+        self.enable(self.lattice)
+        self.key("m", "m")
+        self.assertEqual(self.rep.GetManipulationMode(), vtkffd.vtkFFDLatticeRepresentation.MESH_POINTS)
+        deform = vtkffd.vtkFFDDeform()
+        deform.SetInputData(mesh)
+        deform.SetLatticeData(self.lattice)
+        deform.SetOutputPointsPrecision(vtkAlgorithm.DOUBLE_PRECISION)  # the sphere's points are float
+        rest = vtk_to_numpy(self.lattice.GetPointData().GetArray("RestPosition")).copy()
+        size = float(np.linalg.norm(rest.max(axis=0) - rest.min(axis=0)))
+
+        # A point facing the camera (which looks down -z).
+        points = vtk_to_numpy(mesh.GetPoints().GetData())
+        d = [0.0, 0.0, 0.0]
+        vtkInteractorObserver.ComputeWorldToDisplay(self.renderer, *points[int(np.argmax(points[:, 2]))], d)
+        start = (round(d[0]), round(d[1]))
+        self.event(vtkCommand.MouseMoveEvent, start)
+        self.event(vtkCommand.LeftButtonPressEvent, start)
+        picked = self.rep.GetHoveredMeshPoint()
+        self.assertGreaterEqual(picked, 0)
+        self.assertTrue(self.widget.IsDragging())
+        vtkInteractorObserver.ComputeWorldToDisplay(self.renderer, *points[picked], d)
+        depth = d[2]
+        end = (start[0] + 30, start[1] + 12)
+        self.event(vtkCommand.MouseMoveEvent, (start[0] + 15, start[1] + 5))
+        self.event(vtkCommand.MouseMoveEvent, end)
+        self.event(vtkCommand.LeftButtonReleaseEvent, end)
+        self.assertFalse(self.widget.IsDragging())
+        expected = points[picked] + self.world(end, depth) - self.world(start, depth)
+        self.assertGreater(np.linalg.norm(expected - points[picked]), 0.05 * size)
+        deform.Update()
+        got = np.array(deform.GetOutput().GetPoint(picked))
+        self.assertLess(np.linalg.norm(got - expected), 1e-9 * size)
+        moved = np.flatnonzero(np.any(vtk_to_numpy(self.lattice.GetPoints().GetData()) != rest, axis=1))
+        self.assertTrue(1 <= len(moved) <= 8, moved)
+
+        other = int(np.argmin(points[:, 0]))
+        target = np.array(deform.GetOutput().GetPoint(other)) + (0.0, 0.1 * size, 0.0)
+        self.assertTrue(self.rep.MoveMeshPoint(other, target))
+        deform.Update()
+        self.assertLess(np.linalg.norm(np.array(deform.GetOutput().GetPoint(other)) - target), 1e-9 * size)
+        errors = catch_errors(self.rep)
+        self.assertFalse(self.rep.MoveMeshPoint(mesh.GetNumberOfPoints(), target))
+        self.rep.SetMesh(None)
+        self.assertFalse(self.rep.MoveMeshPoint(0, target))
+        self.assertEqual(len(errors.messages), 2, errors.messages)
+        self.key("m", "m")
+        self.assertEqual(self.rep.GetManipulationMode(), vtkffd.vtkFFDLatticeRepresentation.CONTROL_POINTS)
 
     def test_no_lattice(self):
         self.widget.On()
