@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""Direct manipulation from Python (README, "Direct manipulation"): mesh point ids and targets from numpy, the
-moved lattice's deformation checked with numpy.
+"""Direct manipulation and inverse mapping from Python (README, "Direct manipulation", "Inverse mapping"): mesh
+point ids and targets from numpy, the moved lattice's deformation checked with numpy; a manipulated mesh mapped
+back to rest with vtkFFDInverseDeform.
 
 Run with Debian's /usr/bin/python3, PYTHONPATH=<build>/lib/python3/dist-packages and VOXELFFD_MESH_DIR set to the
 folder of the meshes (ctest does both). Exits non-zero when a test fails.
@@ -77,6 +78,31 @@ class TestDirectManipulation(unittest.TestCase):
         manipulate.SetTargetPositions(positions)
         manipulate.Update()
         self.assertTrue(any("names mesh point" in m for m in errors.messages), errors.messages)
+
+    def test_the_inverse_takes_the_deformed_mesh_back_to_rest(self):
+        # Newton stops at 1e-12 of the frame's diagonal, so the round trip is within |J^-1| 1e-12 of it: with
+        # det J > 0.5 everywhere (asserted: a pull of one point concentrates the move, and larger pulls fold the
+        # sub-region) 1e-10 of the mesh's diagonal bounds it with margin. The status array says all were found.
+        points = points_of(self.mesh)
+        ids = [int(points[:, 2].argmax())]
+        moved = self.manipulate(ids, points[ids] + 0.005 * self.diagonal).GetOutput()
+        deform = vtkffd.vtkFFDDeform()
+        deform.SetInputData(self.mesh)
+        deform.SetLatticeData(moved)
+        deform.SetOutputPointsPrecision(1)  # vtkAlgorithm.DOUBLE_PRECISION
+        deform.ComputeJacobianDeterminantOn()
+        deform.Update()
+        determinants = deform.GetOutput().GetPointData().GetArray(vtkffd.vtkFFDDeform.JacobianDeterminantArrayName())
+        self.assertGreater(determinants.GetRange()[0], 0.5)
+        inverse = vtkffd.vtkFFDInverseDeform()
+        inverse.SetInputConnection(deform.GetOutputPort())
+        inverse.SetLatticeData(moved)
+        inverse.Update()
+        back = inverse.GetOutput()
+        np.testing.assert_allclose(points_of(back), points, rtol=0, atol=1e-10 * self.diagonal)
+        status = vtk_to_numpy(back.GetPointData().GetArray(vtkffd.vtkFFDInverseDeform.InverseStatusArrayName()))
+        self.assertEqual(int(status.max()), 0)
+        self.assertEqual(inverse.GetNumberOfFoldedPoints() + inverse.GetNumberOfUnconvergedPoints(), 0)
 
 
 if __name__ == "__main__":
