@@ -26,7 +26,8 @@ shift
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 if [[ $action == sanitize ]]; then
   build=${VOXELFFD_BUILD_DIR:-$root/build-sanitize}
-  configure_options=(-DCMAKE_BUILD_TYPE=Debug "-DVOXELFFD_SANITIZE=address;undefined")
+  # No CUDA backend here: nvcc's device code is not instrumented, and the release build compiles and tests it.
+  configure_options=(-DCMAKE_BUILD_TYPE=Debug "-DVOXELFFD_SANITIZE=address;undefined" -DVOXELFFD_ENABLE_CUDA=OFF)
 else
   build=${VOXELFFD_BUILD_DIR:-$root/build}
   configure_options=(-DCMAKE_BUILD_TYPE=Release)
@@ -123,8 +124,9 @@ case $action in
     ;;
   test)
     step "Tests: ctest"
-    # One X display for the whole suite (the caller's, or one virtual server): the tests that render use it.
-    "$root/Utilities/with-display.sh" ctest --test-dir "$build" --output-on-failure "$@"
+    # One X display for the whole suite (the caller's, or one virtual server): the tests that render use it. As
+    # many tests at a time as there are cores: no test depends on timing or on another's files.
+    "$root/Utilities/with-display.sh" ctest --test-dir "$build" --output-on-failure -j "$(nproc)" "$@"
     ;;
   sanitize)
     step "Tests under AddressSanitizer and UndefinedBehaviorSanitizer: ctest"
@@ -134,6 +136,6 @@ case $action in
     ASAN_OPTIONS=halt_on_error=1:detect_leaks=1:strict_string_checks=1:check_initialization_order=1 \
       UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
       LSAN_OPTIONS=suppressions=$sanitizers/lsan.supp:print_suppressions=0 \
-      "$root/Utilities/with-display.sh" ctest --test-dir "$build" --output-on-failure "$@"
+      "$root/Utilities/with-display.sh" ctest --test-dir "$build" --output-on-failure -j "$(nproc)" "$@"
     ;;
 esac
