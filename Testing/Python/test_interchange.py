@@ -4,7 +4,8 @@
 vtkFFDBuildLattice's; PyGeM .prm files and ITK .tfm files written by hand in the tests and evaluated by numpy
 references of PyGeM's and ITK's formulas, written here from their sources (pygem/ffd.py and pygem/utils.py;
 itkBSplineTransform.hxx, itkBSplineInterpolationWeightFunction.hxx); vtkBSplineTransform and vtkGridTransform
-evaluated by VTK's own vtkTransformFilter; round trips through every format and file extension; bad lattices and
+evaluated by VTK's own vtkTransformFilter; .tfm files read and written by ITK's own code (Testing/ITK, where the
+build found ITK); round trips through every format and file extension; bad lattices and
 malformed files.
 
 Every comparison of two deformations of a real mesh takes the tolerance 1e-12 of its diagonal: both sides are
@@ -23,6 +24,7 @@ folder of the meshes (ctest does both). Exits non-zero when a test fails.
 import configparser
 import math
 import os
+import subprocess
 import tempfile
 import unittest
 
@@ -42,6 +44,8 @@ from ffdtesting import bbox_diagonal, build_lattice, points_of, read_mesh  # the
 Build = vtkffd.vtkFFDBuildLattice
 BASES = (Build.BERNSTEIN, Build.TRILINEAR, Build.TRIQUADRATIC_BEZIER, Build.TRICUBIC_BEZIER, Build.CUBIC_BSPLINE)
 EXACT = 1e-12  # of the mesh's or the frame's diagonal: see the module's docstring
+# ITK's own code (Testing/ITK/FFDITKTransformPeer.cxx), where the build found ITK (ctest sets it).
+ITK_PEER = os.environ.get("VOXELFFD_ITK_PEER", "")
 
 # --- the pipeline and lattices -----------------------------------------------------------------------------------
 
@@ -678,6 +682,44 @@ class TestITK(InterchangeTest):
                 interchange.read_tfm(self.write_text("bad.tfm", text))
         with self.assertRaises(FileNotFoundError):
             interchange.read_tfm(self.path("missing.tfm"))
+
+
+@unittest.skipUnless(ITK_PEER, "ITK was not found at configure time (the set-up installs libinsighttoolkit5-dev)")
+class TestITKOwnCode(InterchangeTest):
+    """ITK 5's TransformFileReader and BSplineTransform::TransformPoint (FFDITKTransformPeer), not a reference
+    written here: our exports deform the bear in ITK as vtkFFDDeform does, and a file written by ITK's
+    TransformFileWriter deforms it through read_tfm as ITK does."""
+
+    def itk_apply(self, path):
+        np.savetxt(self.path("in.txt"), self.points, fmt="%.17g")
+        subprocess.run([ITK_PEER, "apply", path, self.path("in.txt"), self.path("out.txt")], check=True)
+        return np.loadtxt(self.path("out.txt"))
+
+    def test_itk_deforms_our_exports_as_vtkFFDDeform(self):
+        dense = principal_axes_lattice(self.bear, (3, 4, 3), Build.CUBIC_BSPLINE)
+        sparse = sparse_lattice(self.bear, (6, 6, 5), Build.CUBIC_BSPLINE)
+        for lattice in (dense, sparse):
+            move(lattice, self.rng, 0.03 * self.diagonal)
+            interchange.write_tfm(lattice, self.path("ours.tfm"))
+            self.assertSameDeformation(deformed(self.bear, lattice), self.itk_apply(self.path("ours.tfm")))
+
+    def test_we_deform_itks_files_as_itk(self):
+        # A box over the middle of the bear, so that points lie inside and outside the valid region; points
+        # within 1e-9 of its faces (in grid units) are left out: there the two sides may decide differently.
+        low, high = self.points.min(axis=0), self.points.max(axis=0)
+        origin, size = low + 0.2 * (high - low), 0.6 * (high - low)
+        subprocess.run([ITK_PEER, "make", self.path("itk.tfm"), "11", *("%.17g" % v for v in (*origin, *size))],
+                       check=True)
+        _, parameters, fixed = itk_read(self.path("itk.tfm"))
+        _, index = itk_deform(self.points, parameters, fixed)
+        grid = fixed[0:3]
+        inside = np.all((index >= 1) & (index < grid - 2), axis=1)
+        clear = np.all((np.abs(index - 1) > 1e-9) & (np.abs(index - (grid - 2)) > 1e-9), axis=1)
+        self.assertGreater(inside.sum(), 1000)
+        self.assertGreater((~inside).sum(), 1000)
+        theirs = self.itk_apply(self.path("itk.tfm"))
+        self.assertGreater(np.abs(theirs - self.points).max(), 1e-3 * self.diagonal)  # it does move points
+        self.assertSameDeformation(deformed(self.bear, interchange.read_tfm(self.path("itk.tfm"))), theirs, clear)
 
 
 class TestFiles(InterchangeTest):
