@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace
 {
@@ -243,6 +244,37 @@ int vtkFFDTetrahedronLocator::FindClosestTetrahedron(const double x[3], double c
   vtkIdType tetrahedron = -1; // VTK leaves it as is where no tetrahedron gives a distance (none has volume)
   int subId;
   double dist2;
-  this->CellLocator->FindClosestPoint(x, closest, this->Cell.Local(), tetrahedron, subId, dist2);
-  return static_cast<int>(tetrahedron);
+  vtkGenericCell* cell = this->Cell.Local();
+  this->CellLocator->FindClosestPoint(x, closest, cell, tetrahedron, subId, dist2);
+  if (tetrahedron < 0)
+  {
+    return -1;
+  }
+  // Several tetrahedra are often as near (x's nearest point a node or an edge they share), and which of them
+  // VTK's locator returns depends on the order its parallel build gave them: take the lowest id among those as
+  // near, one with volume first, so that a point's result is the same at every binding.
+  const double margin = 1e-9 * this->Rest->GetLength();
+  const double box[6] = { closest[0] - margin, closest[0] + margin, closest[1] - margin, closest[1] + margin,
+    closest[2] - margin, closest[2] + margin };
+  vtkNew<vtkIdList> candidates;
+  this->CellLocator->FindCellsWithinBounds(const_cast<double*>(box), candidates);
+  const double tie = dist2 + 1e-10 * (dist2 + margin * margin);
+  std::pair<bool, vtkIdType> best(this->Degenerate[tetrahedron] != 0, tetrahedron);
+  for (vtkIdType i = 0; i < candidates->GetNumberOfIds(); ++i)
+  {
+    const vtkIdType id = candidates->GetId(i);
+    const std::pair<bool, vtkIdType> key(this->Degenerate[id] != 0, id);
+    if (!(key < best))
+    {
+      continue;
+    }
+    this->Rest->GetCell(id, cell);
+    double nearest[3], pcoords[3], weights[4], d2;
+    if (cell->EvaluatePosition(x, nearest, subId, pcoords, d2, weights) >= 0 && d2 <= tie)
+    {
+      best = key;
+      std::copy_n(nearest, 3, closest);
+    }
+  }
+  return static_cast<int>(best.second);
 }

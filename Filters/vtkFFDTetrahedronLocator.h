@@ -73,8 +73,9 @@ public:
   int FindTetrahedron(const double x[3]) const;
 
   /**
-   * The tetrahedron nearest x, possibly one without volume, and its point nearest x (`closest`); -1 when VTK's
-   * locator finds none (when no tetrahedron has volume).
+   * The tetrahedron nearest x, and its point nearest x (`closest`); among tetrahedra as near (within 1e-10 of
+   * the squared distance), the lowest id of one with volume, else of one without: the same answer however VTK's
+   * locator ordered them. -1 when VTK's locator finds none (when no tetrahedron has volume).
    */
   int FindClosestTetrahedron(const double x[3], double closest[3]) const;
 
