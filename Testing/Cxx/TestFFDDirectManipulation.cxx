@@ -106,6 +106,38 @@ double Missed(vtkPointSet* mesh, vtkPointSet* lattice, Targets& targets)
   return worst;
 }
 
+/// The float64 reference's weights of the targets' mesh points (rows) on every control point of `rest`'s dense
+/// lattice (columns, i fastest).
+Eigen::MatrixXd ReferenceWeights(vtkPointSet* mesh, Targets& targets, const ffdtest::Reference& rest)
+{
+  const int* n = rest.N;
+  const int dims[3] = { ffdref::PointsAlongAxis(rest.Basis, n[0]), ffdref::PointsAlongAxis(rest.Basis, n[1]),
+    ffdref::PointsAlongAxis(rest.Basis, n[2]) };
+  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(targets.Ids->GetNumberOfValues(), Eigen::Index(rest.P.size()));
+  for (Eigen::Index t = 0; t < w.rows(); ++t)
+  {
+    Vec x;
+    mesh->GetPoint(targets.Ids->GetValue(t), x.data());
+    const Vec stu = ffdref::Parameters(rest.F, x);
+    std::vector<double> axes[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      axes[a] = ffdref::AxisWeights(rest.Basis, n[a], stu[a]);
+    }
+    for (int c = 0; c < dims[2]; ++c)
+    {
+      for (int b = 0; b < dims[1]; ++b)
+      {
+        for (int a = 0; a < dims[0]; ++a)
+        {
+          w(t, a + dims[0] * (b + Eigen::Index(dims[1]) * c)) = axes[0][a] * axes[1][b] * axes[2][c];
+        }
+      }
+    }
+  }
+  return w;
+}
+
 const int Bases[] = { vtkFFDBuildLattice::BERNSTEIN, vtkFFDBuildLattice::TRILINEAR,
   vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, vtkFFDBuildLattice::TRICUBIC_BEZIER, vtkFFDBuildLattice::CUBIC_BSPLINE };
 } // namespace
@@ -141,29 +173,8 @@ TEST(vtkFFDDirectManipulation, MeetsTargetsWithTheMinimumNormMoveForEveryGridBas
         ffdtest::ReferenceOf(ffdtest::MovedLattice(bear, basis, n, vtkFFDBuildLattice::DENSE, rng, 0.0));
       const int dims[3] = { ffdref::PointsAlongAxis(rest.Basis, n[0]), ffdref::PointsAlongAxis(rest.Basis, n[1]),
         ffdref::PointsAlongAxis(rest.Basis, n[2]) };
-      const Eigen::Index k = targets.Ids->GetNumberOfValues(), m = Eigen::Index(rest.P.size());
-      Eigen::MatrixXd w = Eigen::MatrixXd::Zero(k, m);
-      for (Eigen::Index t = 0; t < k; ++t)
-      {
-        Vec x;
-        bear->GetPoint(targets.Ids->GetValue(t), x.data());
-        const Vec stu = ffdref::Parameters(rest.F, x);
-        std::vector<double> axes[3];
-        for (int a = 0; a < 3; ++a)
-        {
-          axes[a] = ffdref::AxisWeights(rest.Basis, n[a], stu[a]);
-        }
-        for (int c = 0; c < dims[2]; ++c)
-        {
-          for (int b = 0; b < dims[1]; ++b)
-          {
-            for (int a = 0; a < dims[0]; ++a)
-            {
-              w(t, a + dims[0] * (b + Eigen::Index(dims[1]) * c)) = axes[0][a] * axes[1][b] * axes[2][c];
-            }
-          }
-        }
-      }
+      const Eigen::MatrixXd w = ReferenceWeights(bear, targets, rest);
+      const Eigen::Index m = w.cols();
       Eigen::MatrixXd move = Eigen::MatrixXd::Zero(m, 3);
       vtkDataArray* index = moved->GetPointData()->GetArray("LatticeIndex");
       vtkIdType movedOutside = 0;
@@ -260,6 +271,44 @@ TEST(vtkFFDDirectManipulation, OnePointAskedToTwoPlacesGoesHalfWay)
   }
   EXPECT_LT(less, full);
   EXPECT_GT(regularised->GetMaximumTargetDistance(), manipulate->GetMaximumTargetDistance());
+}
+
+// More targets than the lattice can meet (40 points on a 2 x 2 x 2 trilinear lattice: 27 control points per
+// coordinate): the result satisfies the least-squares optimality condition W^T (T - F(x)) = 0 for the reference's
+// W. The move is computed by a backward-stable decomposition, so W^T r is rounding of the size
+// eps |W| |r| cond(W); 1e-9 |W| |r| leaves room for cond(W) < 1e6 (these points are well spread: far less).
+TEST(vtkFFDDirectManipulation, OverdeterminedTargetsMeetTheLeastSquaresCondition)
+{
+  vtkSmartPointer<vtkPolyData> bear = ReadTestMesh("bear");
+  std::mt19937 rng(24);
+  const int n[3] = { 2, 2, 2 };
+  vtkSmartPointer<vtkPointSet> lattice =
+    ffdtest::MovedLattice(bear, vtkFFDBuildLattice::TRILINEAR, n, vtkFFDBuildLattice::DENSE, rng, 0.02);
+  const double size = ffdtest::Diagonal(ffdtest::FrameOf(lattice));
+  Targets targets;
+  ChooseTargets(bear, lattice, 40, 0.03 * size, rng, targets);
+  vtkNew<vtkFFDDirectManipulation> manipulate;
+  vtkSmartPointer<vtkPointSet> moved = Manipulate(lattice, bear, targets, manipulate);
+  EXPECT_GT(Missed(bear, moved, targets), 1e-3 * size) << "the targets could all be met";
+
+  const Eigen::MatrixXd w = ReferenceWeights(bear, targets, ffdtest::ReferenceOf(lattice));
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(bear);
+  deform->SetLatticeData(moved);
+  deform->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
+  deform->Update();
+  Eigen::MatrixXd r(w.rows(), 3);
+  for (Eigen::Index t = 0; t < w.rows(); ++t)
+  {
+    double y[3], want[3];
+    vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0))->GetPoint(targets.Ids->GetValue(t), y);
+    targets.Positions->GetPoint(t, want);
+    for (int c = 0; c < 3; ++c)
+    {
+      r(t, c) = want[c] - y[c];
+    }
+  }
+  EXPECT_LE((w.transpose() * r).norm(), 1e-9 * w.norm() * r.norm());
 }
 
 TEST(vtkFFDDirectManipulation, RefusesBadTargets)
