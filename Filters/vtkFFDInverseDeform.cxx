@@ -9,6 +9,7 @@
 #include "vtkFFDGridDeformer.h"
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDSparseLattice.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkIdList.h"
 #include "vtkInformation.h"
@@ -40,6 +41,55 @@ struct InverseOutput
   unsigned char* Status;
 };
 
+// The cell whose evaluation extends F to x for the search: Bind()'s under CLAMP_TO_EDGE (beyond the frame, F as
+// CLAMP_TO_EDGE extends it) and, for a sparse lattice's point in a voxel without a cell, the nearest cell within
+// two voxels (its evaluation clamps x's local coordinates to that cell: F extended across the cell's faces). Under
+// KEEP_POSITION, F jumps wherever the lattice's border or a sparse lattice's last cells moved: a mesh point pushed
+// out of the cells would otherwise be found at its own place, which F keeps.
+int SearchCell(const vtkFFDGridDeformer& deformer, const ffd::Frame<double>& frame, const ffd::Vec3<double>& x)
+{
+  const double p[3] = { x.x, x.y, x.z };
+  const int cell = deformer.BindPoint(p, vtkFFDDeform::CLAMP_TO_EDGE);
+  const vtkFFDSparseCells* sparse = deformer.GetSparseCells();
+  const int* n = deformer.GetLattice().Divisions;
+  int v[3];
+  if (cell >= 0 || !sparse || !ffd::BindToCells(frame, n, x, true, v))
+  {
+    return cell;
+  }
+  const ffd::Vec3<double> stu = frame.ToParametric(x);
+  const double q[3] = { stu.x * n[0], stu.y * n[1], stu.z * n[2] }; // in voxels
+  double nearest = VTK_DOUBLE_MAX;
+  int found = -1;
+  for (int k = std::max(v[2] - 2, 0); k <= std::min(v[2] + 2, n[2] - 1); ++k)
+  {
+    for (int j = std::max(v[1] - 2, 0); j <= std::min(v[1] + 2, n[1] - 1); ++j)
+    {
+      for (int i = std::max(v[0] - 2, 0); i <= std::min(v[0] + 2, n[0] - 1); ++i)
+      {
+        const int c = sparse->Find(vtkFFDFlatIndex(i, j, k, n));
+        if (c < 0)
+        {
+          continue;
+        }
+        const int w[3] = { i, j, k };
+        double distance2 = 0;
+        for (int a = 0; a < 3; ++a)
+        {
+          const double outside = std::max({ w[a] - q[a], 0.0, q[a] - (w[a] + 1) });
+          distance2 += outside * outside;
+        }
+        if (distance2 < nearest || (distance2 == nearest && c < found))
+        {
+          nearest = distance2;
+          found = c;
+        }
+      }
+    }
+  }
+  return found;
+}
+
 // Grid lattices: ffd::InvertPoint on the lattice's float64 evaluation. A normal m at y goes back by the inverse's
 // cofactor, det(J^-1) J^T: as J^T m, renormalised.
 bool InvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, vtkPoints* points, vtkDataArray* normals,
@@ -52,13 +102,8 @@ bool InvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, vtkPoi
   vtkFFDWithGridDeformation(deformer,
     [&](const auto& deformation)
     {
-      // The search runs on F extended continuously beyond the frame (CLAMP_TO_EDGE), so that it can cross the
-      // frame's faces: under KEEP_POSITION, F jumps there wherever the lattice's border moved.
-      const auto bind = [&](const ffd::Vec3<double>& x)
-      {
-        const double p[3] = { x.x, x.y, x.z };
-        return deformer.BindPoint(p, vtkFFDDeform::CLAMP_TO_EDGE);
-      };
+      const ffd::Frame<double> frame = ffd::Frame<double>::FromArray(deformer.GetLattice().Frame);
+      const auto bind = [&](const ffd::Vec3<double>& x) { return SearchCell(deformer, frame, x); };
       auto invert = [&](vtkIdType begin, vtkIdType end)
       {
         for (vtkIdType p = begin; p < end; ++p)
@@ -75,7 +120,8 @@ bool InvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, vtkPoi
             const double found[3] = { x.x, x.y, x.z };
             if (deformer.BindPoint(found, vtkFFDDeform::KEEP_POSITION) < 0)
             {
-              // Outside the frame F is the identity: y is its own rest position there, and has none inside.
+              // Outside the lattice's cells F is the identity: y is its own rest position there, and has none
+              // inside.
               const bool outside = deformer.BindPoint(y, vtkFFDDeform::KEEP_POSITION) < 0;
               x = ffd::Vec3<double>::From(y);
               jacobian = ffd::Mat3<double>::Identity();

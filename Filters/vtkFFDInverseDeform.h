@@ -13,9 +13,10 @@
  * Grid lattices (every basis, dense or sparse): Newton's method with a backtracking line search on the lattice's
  * own evaluation (ffd::InvertPoint, Filters/Kernels/FFDInverse.h), from y minus the displacement at y, each iterate
  * bound to its cell again, until |F(x) - y| <= Tolerance times the frame's diagonal. The search runs on F extended
- * beyond the frame as CLAMP_TO_EDGE extends it (continuous, where KEEP_POSITION jumps at a face whose control
- * points moved), so that a point pushed out of the frame finds its rest position inside; a search that ends
- * outside the frame gives y itself, its own rest position there (status 2 where y is inside: no rest position).
+ * beyond the lattice's cells (beyond the frame as CLAMP_TO_EDGE extends it; in a sparse lattice's voxels without
+ * a cell, by the nearest cell within two voxels), where KEEP_POSITION makes F jump, so that a point pushed out of
+ * the cells finds its rest position inside; a search that ends outside the cells gives y itself, its own rest
+ * position there (status 2 where y is inside a cell: no rest position).
  * Tetrahedral lattices: the map is affine in each tetrahedron, so its inverse is the same kind of lattice with rest and
  * deformed positions exchanged: y is located among the deformed tetrahedra and mapped back exactly; points in a
  * tetrahedron that the deformation turned inside out are marked folded. Point normals follow the inverse map (dropped

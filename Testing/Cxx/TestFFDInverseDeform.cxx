@@ -17,6 +17,7 @@
 #include "FFDTestMeshes.h"
 
 #include "vtkCell.h"
+#include "vtkCellData.h"
 #include "vtkFFDBuildTetrahedralLattice.h"
 #include "vtkFFDInverseDeform.h"
 #include "vtkGenericCell.h"
@@ -31,6 +32,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <set>
 
 namespace
 {
@@ -212,6 +214,54 @@ TEST(vtkFFDInverseDeform, RoundTripsALargeDeformationAndKeepsFloatPoints)
   EXPECT_EQ(inverse->GetOutput()->GetPoints()->GetDataType(), VTK_FLOAT);
   // The float input's rounding (half a float ulp of coordinates of size d), carried back through J^-1 (< 2 here).
   EXPECT_LE(LargestDistance(inverse->GetOutput(), mesh), 2 * std::numeric_limits<float>::epsilon() * d);
+}
+
+//------------------------------------------------------------------------------------------------------------
+// A sparse lattice whose moves push mesh points out of its cells (into voxels without one, where vtkFFDDeform
+// keeps points: each such y is also its own image): the rest positions inside the cells are found, within 1e-11 d
+// (the tolerance derivation above; det J > 0.5 asserted).
+TEST(vtkFFDInverseDeform, FindsPointsPushedOutOfASparseLatticesCells)
+{
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("armadillo");
+  const int n[3] = { 8, 8, 8 };
+  std::mt19937 rng(2107);
+  for (int basis : { vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::CUBIC_BSPLINE })
+  {
+    SCOPED_TRACE("basis " + std::to_string(basis));
+    vtkSmartPointer<vtkPointSet> lattice =
+      ffdtest::MovedLattice(mesh, basis, n, vtkFFDBuildLattice::SPARSE, rng, 0.01);
+    ASSERT_GT(SmallestDeterminant(mesh, lattice), 0.5);
+    const ffdref::Frame f = ffdtest::FrameOf(lattice);
+    const double d = ffdtest::Diagonal(f);
+    vtkSmartPointer<vtkPointSet> deformed = Deformed(mesh, lattice);
+    // The premise: some deformed points lie in voxels without a cell.
+    std::set<std::array<int, 3>> cells;
+    vtkDataArray* voxels = lattice->GetCellData()->GetArray("VoxelIndex");
+    for (vtkIdType c = 0; c < lattice->GetNumberOfCells(); ++c)
+    {
+      cells.insert(
+        { int(voxels->GetComponent(c, 0)), int(voxels->GetComponent(c, 1)), int(voxels->GetComponent(c, 2)) });
+    }
+    vtkIdType pushedOut = 0;
+    for (vtkIdType p = 0; p < deformed->GetNumberOfPoints(); ++p)
+    {
+      Vec y;
+      deformed->GetPoint(p, y.data());
+      const Vec stu = ffdref::Parameters(f, y);
+      std::array<int, 3> v;
+      for (int a = 0; a < 3; ++a)
+      {
+        v[a] = std::clamp(int(std::floor(stu[a] * n[a])), 0, n[a] - 1);
+      }
+      pushedOut += cells.count(v) == 0;
+    }
+    EXPECT_GT(pushedOut, 0);
+    vtkNew<vtkFFDInverseDeform> inverse;
+    vtkNew<FFDTestErrorObserver> observer;
+    vtkSmartPointer<vtkPointSet> rest = Inverted(deformed, lattice, inverse, observer);
+    EXPECT_EQ(observer->Errors + observer->Warnings, "");
+    EXPECT_LE(LargestDistance(rest, mesh), 1e-11 * d);
+  }
 }
 
 //------------------------------------------------------------------------------------------------------------
