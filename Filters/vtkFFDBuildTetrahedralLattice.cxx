@@ -2,6 +2,7 @@
 #include "vtkFFDBuildTetrahedralLattice.h"
 
 #include "vtkFFDDataContract.h"
+#include "vtkFFDDistributed.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDTetrahedralDeformer.h"
 
@@ -12,6 +13,7 @@
 #include "vtkIdTypeArray.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -34,6 +36,7 @@
 #include <vector>
 
 vtkStandardNewMacro(vtkFFDBuildTetrahedralLattice);
+vtkCxxSetObjectMacro(vtkFFDBuildTetrahedralLattice, Controller, vtkMultiProcessController);
 
 namespace
 {
@@ -126,6 +129,20 @@ std::string ConvexHull(std::vector<double>& coordinates, std::vector<std::array<
   return message;
 }
 
+// The points (3 doubles each) in increasing lexicographic order, each once.
+void SortPoints(std::vector<double>& coordinates)
+{
+  if (coordinates.empty())
+  {
+    return;
+  }
+  std::vector<std::array<double, 3>> points(coordinates.size() / 3);
+  std::copy(coordinates.begin(), coordinates.end(), points.front().data());
+  std::sort(points.begin(), points.end());
+  points.erase(std::unique(points.begin(), points.end()), points.end());
+  coordinates.assign(points.front().data(), points.front().data() + 3 * points.size());
+}
+
 // Splits every tetrahedron into eight: four at its corners, four around the shortest diagonal of the inner
 // octahedron; the midpoint of an edge shared by several tetrahedra is one node.
 TetrahedralMesh Subdivide(const TetrahedralMesh& coarse)
@@ -198,7 +215,15 @@ vtkFFDBuildTetrahedralLattice::vtkFFDBuildTetrahedralLattice()
   , SubdivisionLevels(0)
   , NumberOfHullFaces(0)
   , NumberOfActiveNodes(0)
+  , Controller(nullptr)
 {
+  this->SetController(vtkMultiProcessController::GetGlobalController());
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkFFDBuildTetrahedralLattice::~vtkFFDBuildTetrahedralLattice()
+{
+  this->SetController(nullptr);
 }
 
 //------------------------------------------------------------------------------------------------------------
@@ -224,16 +249,18 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector);
   this->NumberOfHullFaces = 0;
   this->NumberOfActiveNodes = 0;
-  if (!input || input->GetNumberOfPoints() == 0)
+  // With several processes, every one takes part in the reductions, an empty piece too.
+  vtkMultiProcessController* controller = vtkFFDIsDistributed(this->Controller) ? this->Controller : nullptr;
+  if (!input || (input->GetNumberOfPoints() == 0 && !controller))
   {
     return 1; // an empty input gives an empty output
   }
 
-  // The finite points and their centroid.
+  // The finite points and their centroid, an exact sum over every process rounded once.
   const vtkIdType numberOfPoints = input->GetNumberOfPoints();
   std::vector<double> coordinates;
   coordinates.reserve(3 * numberOfPoints);
-  double centroid[3] = { 0.0, 0.0, 0.0 };
+  std::vector<ffd::ExactSum> sums(4); // x, y, z, count
   for (vtkIdType id = 0; id < numberOfPoints; ++id)
   {
     double x[3];
@@ -243,22 +270,26 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
       coordinates.insert(coordinates.end(), x, x + 3);
       for (int c = 0; c < 3; ++c)
       {
-        centroid[c] += x[c];
+        sums[c].Add(x[c]);
       }
+      sums[3].Add(1.0);
     }
   }
-  const vtkIdType finite = static_cast<vtkIdType>(coordinates.size() / 3);
+  vtkFFDSumOverProcesses(controller, sums);
+  const double finite = sums[3].Value();
   if (finite < 4)
   {
     vtkErrorMacro("The input has " << finite << " finite points; a tetrahedral lattice needs at least 4 that "
                                    << "are not coplanar.");
     return 0;
   }
-  for (int c = 0; c < 3; ++c)
-  {
-    centroid[c] /= static_cast<double>(finite);
-  }
+  const double centroid[3] = { sums[0].Value() / finite, sums[1].Value() / finite, sums[2].Value() / finite };
 
+  // The hull of every process's points in lexicographic order: the same however the points are ordered and
+  // split (Qhull's handling of nearly coplanar points depends on the points it is given and their order, so
+  // each process takes all of them, 24 bytes a point).
+  coordinates = vtkFFDGatherOverProcesses(controller, coordinates);
+  SortPoints(coordinates);
   std::vector<std::array<int, 3>> triangles;
   const std::string qhullMessage = ConvexHull(coordinates, triangles);
   if (!qhullMessage.empty() || triangles.empty())
@@ -353,8 +384,9 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   vtkFFDTetrahedralDeformer binding;
   const std::string problem = binding.SetLattice(output);
   bool rebound = false;
-  if (!problem.empty() ||
-    !binding.Bind(input->GetPoints(), vtkFFDTetrahedralDeformer::KEEP_POSITION, this, 0.5, 1.0, rebound))
+  vtkNew<vtkPoints> none; // an empty piece
+  vtkPoints* inputPoints = input->GetPoints() ? input->GetPoints() : none.Get();
+  if (!problem.empty() || !binding.Bind(inputPoints, vtkFFDTetrahedralDeformer::KEEP_POSITION, this, 0.5, 1.0, rebound))
   {
     if (!problem.empty())
     {
@@ -387,6 +419,7 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
       }
     }
   }
+  vtkFFDAnyOverProcesses(controller, active->GetPointer(0), numberOfNodes);
   output->GetPointData()->AddArray(active);
   this->NumberOfActiveNodes = std::count(active->GetPointer(0), active->GetPointer(0) + numberOfNodes, 1);
   if (this->NumberOfActiveNodes < numberOfNodes)
@@ -413,4 +446,5 @@ void vtkFFDBuildTetrahedralLattice::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SubdivisionLevels: " << this->SubdivisionLevels << "\n";
   os << indent << "NumberOfHullFaces: " << this->NumberOfHullFaces << "\n";
   os << indent << "NumberOfActiveNodes: " << this->NumberOfActiveNodes << "\n";
+  os << indent << "Controller: " << this->Controller << "\n";
 }

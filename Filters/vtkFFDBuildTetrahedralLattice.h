@@ -19,6 +19,13 @@
  *   tetrahedra (bound as vtkFFDDeform binds it). The others are culled: `Active` is 0 and the ghost array marks
  *   them HIDDENPOINT, as vtkFFDBuildLattice does for grid lattices.
  *
+ * The hull is Qhull's of the points in lexicographic order, and the centroid an exact sum rounded once, so the
+ * lattice does not depend on the points' order. A mesh split among processes (Controller with more than one
+ * process, as for vtkFFDVoxelize): every process takes every process's finite points for the hull (24 bytes a
+ * point), the centroid is that of all of them, and a node is active where it is on some process, so each process
+ * outputs the same lattice, bit for bit the one a single process makes of the whole mesh. Every process must
+ * execute the filter then.
+ *
  * Every tetrahedron is positively oriented. An input with fewer than four finite points, or whose points are
  * flat (no 3D hull), is an error and gives an empty output; non-finite points are ignored.
  *
@@ -29,6 +36,8 @@
 
 #include "vtkFFDFiltersModule.h" // For export macro
 #include "vtkUnstructuredGridAlgorithm.h"
+
+class vtkMultiProcessController;
 
 class VTKFFDFILTERS_EXPORT vtkFFDBuildTetrahedralLattice : public vtkUnstructuredGridAlgorithm
 {
@@ -55,9 +64,16 @@ public:
   vtkGetMacro(NumberOfActiveNodes, vtkIdType);
   ///@}
 
+  ///@{
+  /// The processes among which the mesh is split (default: vtkMultiProcessController::GetGlobalController());
+  /// null or one process: this one only.
+  virtual void SetController(vtkMultiProcessController*);
+  vtkGetObjectMacro(Controller, vtkMultiProcessController);
+  ///@}
+
 protected:
   vtkFFDBuildTetrahedralLattice();
-  ~vtkFFDBuildTetrahedralLattice() override = default;
+  ~vtkFFDBuildTetrahedralLattice() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
@@ -68,6 +84,7 @@ protected:
   int SubdivisionLevels;
   vtkIdType NumberOfHullFaces;
   vtkIdType NumberOfActiveNodes;
+  vtkMultiProcessController* Controller;
 
 private:
   vtkFFDBuildTetrahedralLattice(const vtkFFDBuildTetrahedralLattice&) = delete;

@@ -3,11 +3,14 @@
 
 #include "vtkArrayDispatch.h"
 #include "vtkDataArrayRange.h"
+#include "vtkDoubleArray.h"
+#include "vtkFFDDistributed.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDSparseLattice.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
+#include "vtkMultiProcessController.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
@@ -24,6 +27,7 @@
 #include <vector>
 
 vtkStandardNewMacro(vtkFFDVoxelize);
+vtkCxxSetObjectMacro(vtkFFDVoxelize, Controller, vtkMultiProcessController);
 
 namespace
 {
@@ -94,12 +98,13 @@ struct OrientedBox
   }
 };
 
-/// Mean and covariance of the finite points, in double, two serial passes (deterministic and free of the
-/// cancellation of the one-pass formula).
-bool PrincipalAxes(vtkDataArray* points, Eigen::Vector3d& mean, Eigen::Matrix3d& axes)
+/// Mean and covariance of the finite points over every process, each an exact sum rounded once (the same
+/// whatever the points' order and the processes), in two passes (free of the cancellation of the one-pass
+/// formula).
+bool PrincipalAxes(
+  vtkDataArray* points, vtkMultiProcessController* controller, Eigen::Vector3d& mean, Eigen::Matrix3d& axes)
 {
-  mean.setZero();
-  vtkIdType count = 0;
+  std::vector<ffd::ExactSum> sums(4); // x, y, z, count
   WithPointRange(points,
     [&](auto range)
     {
@@ -107,17 +112,22 @@ bool PrincipalAxes(vtkDataArray* points, Eigen::Vector3d& mean, Eigen::Matrix3d&
       {
         if (IsFinite(p))
         {
-          mean += Eigen::Vector3d(p[0], p[1], p[2]);
-          ++count;
+          for (int c = 0; c < 3; ++c)
+          {
+            sums[c].Add(static_cast<double>(p[c]));
+          }
+          sums[3].Add(1.0);
         }
       }
     });
+  vtkFFDSumOverProcesses(controller, sums);
+  const double count = sums[3].Value();
   if (count == 0)
   {
     return false;
   }
-  mean /= static_cast<double>(count);
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  mean = Eigen::Vector3d(sums[0].Value(), sums[1].Value(), sums[2].Value()) / count;
+  std::vector<ffd::ExactSum> products(6); // the upper triangle, row by row
   WithPointRange(points,
     [&](auto range)
     {
@@ -126,11 +136,25 @@ bool PrincipalAxes(vtkDataArray* points, Eigen::Vector3d& mean, Eigen::Matrix3d&
         if (IsFinite(p))
         {
           const Eigen::Vector3d d = Eigen::Vector3d(p[0], p[1], p[2]) - mean;
-          covariance.noalias() += d * d.transpose();
+          for (int r = 0, e = 0; r < 3; ++r)
+          {
+            for (int c = r; c < 3; ++c)
+            {
+              products[e++].Add(d[r] * d[c]);
+            }
+          }
         }
       }
     });
-  covariance /= static_cast<double>(count);
+  vtkFFDSumOverProcesses(controller, products);
+  Eigen::Matrix3d covariance;
+  for (int r = 0, e = 0; r < 3; ++r)
+  {
+    for (int c = r; c < 3; ++c)
+    {
+      covariance(r, c) = covariance(c, r) = products[e++].Value() / count;
+    }
+  }
 
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
   if (solver.info() != Eigen::Success)
@@ -162,7 +186,15 @@ vtkFFDVoxelize::vtkFFDVoxelize()
   , FrameT{ 0.0, 1.0, 0.0 }
   , FrameU{ 0.0, 0.0, 1.0 }
   , NumberOfActiveVoxels(0)
+  , Controller(nullptr)
 {
+  this->SetController(vtkMultiProcessController::GetGlobalController());
+}
+
+//------------------------------------------------------------------------------
+vtkFFDVoxelize::~vtkFFDVoxelize()
+{
+  this->SetController(nullptr);
 }
 
 //------------------------------------------------------------------------------
@@ -224,11 +256,15 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
   vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector);
   this->NumberOfActiveVoxels = 0;
   const vtkIdType numPoints = input ? input->GetNumberOfPoints() : 0;
-  if (numPoints == 0)
+  // With several processes, every one takes part in the reductions, an empty piece too.
+  vtkMultiProcessController* controller = vtkFFDIsDistributed(this->Controller) ? this->Controller : nullptr;
+  if (numPoints == 0 && !controller)
   {
     return 1; // an empty input gives an empty output
   }
-  vtkDataArray* points = input->GetPoints()->GetData();
+  vtkNew<vtkDoubleArray> none;
+  none->SetNumberOfComponents(3);
+  vtkDataArray* points = numPoints > 0 ? input->GetPoints()->GetData() : none.Get();
   const int nx = this->Divisions[0], ny = this->Divisions[1], nz = this->Divisions[2];
   // Voxels and corners are found by their int64 linear index i + nx (j + ny k): the corners' count must fit.
   if ((nx + 1.0) * (ny + 1.0) * (nz + 1.0) >= 0x1p63)
@@ -251,13 +287,14 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
   else
   {
     OrientedBox box;
-    if (this->FrameMode == PRINCIPAL_AXES && !PrincipalAxes(points, box.Anchor, box.Axes))
+    if (this->FrameMode == PRINCIPAL_AXES && !PrincipalAxes(points, controller, box.Anchor, box.Axes))
     {
       vtkErrorMacro(<< "The principal axes of the input's points could not be computed (no finite point, or "
                        "the eigen-decomposition failed): remove the NaN/Inf points or set an explicit frame.");
       return 0;
     }
     box.Enclose(points);
+    vtkFFDBoundsOverProcesses(controller, box.Count, box.Min.data(), box.Max.data());
     if (box.Count == 0)
     {
       vtkErrorMacro(<< "None of the input's " << numPoints
@@ -335,7 +372,8 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
     return 0;
   }
   const vtkTypeInt64 dims[3] = { nx, ny, nz };
-  vtkSmartPointer<vtkIntArray> voxelIndex = vtkFFDMakeVoxelIndex(active.TakeSortedIndices(dims), this->Divisions);
+  const std::vector<vtkTypeInt64> voxels = vtkFFDUnionOverProcesses(controller, active.TakeSortedIndices(dims));
+  vtkSmartPointer<vtkIntArray> voxelIndex = vtkFFDMakeVoxelIndex(voxels, this->Divisions);
   this->UpdateProgress(0.6);
   if (this->GetAbortExecute())
   {
@@ -348,7 +386,7 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
   {
     return 0;
   }
-  this->NumberOfActiveVoxels = numVoxels;
+  this->NumberOfActiveVoxels = static_cast<vtkIdType>(voxels.size());
   this->UpdateProgress(1.0);
   return 1;
 }
@@ -367,4 +405,5 @@ void vtkFFDVoxelize::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "FrameT: " << this->FrameT[0] << ", " << this->FrameT[1] << ", " << this->FrameT[2] << "\n";
   os << indent << "FrameU: " << this->FrameU[0] << ", " << this->FrameU[1] << ", " << this->FrameU[2] << "\n";
   os << indent << "NumberOfActiveVoxels: " << this->NumberOfActiveVoxels << "\n";
+  os << indent << "Controller: " << this->Controller << "\n";
 }

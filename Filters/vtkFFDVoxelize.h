@@ -26,6 +26,12 @@
  * (at most 8 corners a voxel, fewer where voxels touch); that, and the 8 bytes an index that sorting takes
  * meanwhile, is checked against the memory the system can give before it is allocated.
  *
+ * A mesh split among processes (MPI: pvbatch, pvserver, or a script's vtkMPIController): when Controller has more
+ * than one process, the frame's bounds and principal axes are computed over every process's points and the active
+ * voxels are the union of every process's, so each process outputs the same voxel grid, bit for bit the one a
+ * single process makes of the whole mesh (the principal axes' sums are exact, rounded once, so their order does
+ * not matter). Every process must execute the filter then, an empty piece too.
+ *
  * Non-finite input points are ignored. An empty input gives an empty output without an error. Divisions below
  * one or with more corners than an int64 counts, a flat or non-finite frame are errors.
  *
@@ -36,6 +42,8 @@
 
 #include "vtkFFDFiltersModule.h" // For export macro
 #include "vtkUnstructuredGridAlgorithm.h"
+
+class vtkMultiProcessController;
 
 class VTKFFDFILTERS_EXPORT vtkFFDVoxelize : public vtkUnstructuredGridAlgorithm
 {
@@ -92,9 +100,16 @@ public:
   /// Number of active voxels found by the last execution.
   vtkGetMacro(NumberOfActiveVoxels, vtkIdType);
 
+  ///@{
+  /// The processes among which the mesh is split (default: vtkMultiProcessController::GetGlobalController(), which
+  /// pvbatch and pvserver set, and a script sets with SetGlobalController()); null or one process: this one only.
+  virtual void SetController(vtkMultiProcessController*);
+  vtkGetObjectMacro(Controller, vtkMultiProcessController);
+  ///@}
+
 protected:
   vtkFFDVoxelize();
-  ~vtkFFDVoxelize() override = default;
+  ~vtkFFDVoxelize() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
@@ -110,6 +125,7 @@ protected:
   double FrameT[3];
   double FrameU[3];
   vtkIdType NumberOfActiveVoxels;
+  vtkMultiProcessController* Controller;
 
 private:
   vtkFFDVoxelize(const vtkFFDVoxelize&) = delete;

@@ -50,7 +50,7 @@ as_root() {
 # --- 1. Debian packages ---------------------------------------------------------------------------------------
 packages=(build-essential cmake ninja-build libvtk9-dev python3-vtk9 libopenvdb-dev libopenvdb-tools
   libboost-iostreams-dev libeigen3-dev libqhull-dev libgtest-dev xvfb xauth libgl1-mesa-dri python3-numpy
-  libinsighttoolkit5-dev) # ITK: tests only, the peer of the .tfm interchange
+  libinsighttoolkit5-dev openmpi-bin python3-mpi4py) # ITK: tests only; Open MPI and mpi4py: the MPI test
 step "Debian packages"
 missing=()
 for package in "${packages[@]}"; do
