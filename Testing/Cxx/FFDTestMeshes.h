@@ -8,17 +8,34 @@
 #define FFDTestMeshes_h
 
 #include "vtkNew.h"
+#include "vtkPointSet.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 #include "vtkXMLPolyDataReader.h"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+/// The largest distance between the same points of two point sets (over a's points).
+inline double LargestDistance(vtkPointSet* a, vtkPointSet* b)
+{
+  double largest = 0.0;
+  for (vtkIdType p = 0; p < a->GetNumberOfPoints(); ++p)
+  {
+    double x[3], y[3];
+    a->GetPoint(p, x);
+    b->GetPoint(p, y);
+    largest = std::max(largest, std::hypot(x[0] - y[0], x[1] - y[1], x[2] - y[2]));
+  }
+  return largest;
+}
 
 /// The mesh `name` (e.g. "bear"); throws with a hint when the set-up has not fetched it.
 inline vtkSmartPointer<vtkPolyData> ReadTestMesh(const std::string& name)

@@ -90,19 +90,6 @@ vtkUnsignedCharArray* StatusOf(vtkPointSet* output)
     output->GetPointData()->GetArray(vtkFFDInverseDeform::InverseStatusArrayName()));
 }
 
-/// The largest distance between the same points of two point sets.
-double LargestDistance(vtkPointSet* a, vtkPointSet* b)
-{
-  double largest = 0;
-  for (vtkIdType p = 0; p < a->GetNumberOfPoints(); ++p)
-  {
-    double x[3], y[3];
-    a->GetPoint(p, x);
-    b->GetPoint(p, y);
-    largest = std::max(largest, Distance(x, y));
-  }
-  return largest;
-}
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -228,8 +215,7 @@ TEST(vtkFFDInverseDeform, FindsPointsPushedOutOfASparseLatticesCells)
   for (int basis : { vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::CUBIC_BSPLINE })
   {
     SCOPED_TRACE("basis " + std::to_string(basis));
-    vtkSmartPointer<vtkPointSet> lattice =
-      ffdtest::MovedLattice(mesh, basis, n, vtkFFDBuildLattice::SPARSE, rng, 0.01);
+    vtkSmartPointer<vtkPointSet> lattice = ffdtest::MovedLattice(mesh, basis, n, vtkFFDBuildLattice::SPARSE, rng, 0.01);
     ASSERT_GT(SmallestDeterminant(mesh, lattice), 0.5);
     const ffdref::Frame f = ffdtest::FrameOf(lattice);
     const double d = ffdtest::Diagonal(f);

@@ -49,19 +49,6 @@ vtkSmartPointer<vtkPointSet> Deformed(vtkPointSet* mesh, vtkPointSet* lattice)
   return vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0));
 }
 
-double MaxDistance(vtkPointSet* a, vtkPointSet* b)
-{
-  double worst = 0;
-  for (vtkIdType p = 0; p < a->GetNumberOfPoints(); ++p)
-  {
-    double x[3], y[3];
-    a->GetPoint(p, x);
-    b->GetPoint(p, y);
-    worst = std::max(worst, std::sqrt(vtkMath::Distance2BetweenPoints(x, y)));
-  }
-  return worst;
-}
-
 /// Random points filling the box [0, 1] x [0, 0.6] x [0, 0.4]: every voxel of a few divisions holds some.
 vtkSmartPointer<vtkPolyData> FilledBox(std::mt19937& rng, int count)
 {
@@ -97,12 +84,12 @@ TEST(vtkFFDRefineLattice, DeformsTheBearAsTheCoarseLatticeForEveryBasisAndForm)
       EXPECT_EQ(fine->GetDataObjectType(), coarse->GetDataObjectType());
       const double size = ffdtest::Diagonal(ffdtest::FrameOf(coarse));
       vtkSmartPointer<vtkPointSet> expected = Deformed(bear, coarse);
-      EXPECT_LE(MaxDistance(Deformed(bear, fine), expected), 1e-12 * size)
+      EXPECT_LE(LargestDistance(Deformed(bear, fine), expected), 1e-12 * size)
         << vtkFFDBuildLattice::GetBasisAsString(basis) << (form == vtkFFDBuildLattice::SPARSE ? " sparse" : " dense");
       // The deformation moved the bear (the comparison is not between two identities).
-      EXPECT_GT(MaxDistance(expected, bear), 0.01 * size);
+      EXPECT_GT(LargestDistance(expected, bear), 0.01 * size);
       // Twice refined (n -> 4n) too.
-      EXPECT_LE(MaxDistance(Deformed(bear, Refine(coarse, 2)), expected), 1e-12 * size)
+      EXPECT_LE(LargestDistance(Deformed(bear, Refine(coarse, 2)), expected), 1e-12 * size)
         << vtkFFDBuildLattice::GetBasisAsString(basis) << " refined twice";
     }
   }
@@ -282,5 +269,5 @@ TEST(vtkFFDRefineLattice, RefusesWhatItCannotRefine)
   // Levels 0 passes the lattice through.
   vtkSmartPointer<vtkPointSet> lattice =
     MovedLattice(cow, vtkFFDBuildLattice::TRILINEAR, degree17, vtkFFDBuildLattice::SPARSE, rng);
-  EXPECT_EQ(MaxDistance(Refine(lattice, 0), lattice), 0.0);
+  EXPECT_EQ(LargestDistance(Refine(lattice, 0), lattice), 0.0);
 }

@@ -79,21 +79,10 @@ void Drag(vtkRenderWindowInteractor* interactor, const int from[2], const int to
   Event(interactor, vtkCommand::LeftButtonReleaseEvent, to, shift);
 }
 
-/// Largest distance between corresponding points of two point sets of the same size.
-double MaxDistance(vtkPointSet* a, vtkPointSet* b)
-{
-  double largest = 0.0;
-  for (vtkIdType p = 0; p < a->GetNumberOfPoints(); ++p)
-  {
-    largest = std::max(largest, std::sqrt(vtkMath::Distance2BetweenPoints(a->GetPoint(p), b->GetPoint(p))));
-  }
-  return largest;
-}
-
 /// Checks every control point against `expected` (a copy of the lattice with the expected moves).
 bool CheckLattice(vtkStructuredGrid* lattice, vtkStructuredGrid* expected, double diagonal, const char* step)
 {
-  const double error = MaxDistance(lattice, expected);
+  const double error = LargestDistance(lattice, expected);
   std::cout << step << ": control points within " << error << " of the expected positions\n";
   if (error > PointTolerance * diagonal)
   {
@@ -113,12 +102,12 @@ bool CheckMesh(vtkFFDDeform* deform, vtkPolyData* mesh, vtkStructuredGrid* expec
   fresh->SetInputData(mesh);
   fresh->SetLatticeData(expected);
   fresh->Update();
-  const double error = MaxDistance(deform->GetOutput(), fresh->GetOutput());
+  const double error = LargestDistance(deform->GetOutput(), fresh->GetOutput());
   std::cout << step << ": mesh within " << error << " of a fresh deformation; bindings "
             << deform->GetNumberOfBindings() << "\n";
   if (largestMotion)
   {
-    *largestMotion = MaxDistance(deform->GetOutput(), mesh);
+    *largestMotion = LargestDistance(deform->GetOutput(), mesh);
   }
   // Both run the same evaluation on the same numbers: any difference beyond the control points' own
   // tolerance means the pipeline did not re-execute.
@@ -259,7 +248,7 @@ int TestFFDLatticeWidget(int argc, char* argv[])
   {
     return EXIT_FAILURE;
   }
-  const double restError = MaxDistance(deform->GetOutput(), bear);
+  const double restError = LargestDistance(deform->GetOutput(), bear);
   if (restError > PointTolerance * diagonal)
   {
     std::cerr << "Expected the rest lattice to give back the input mesh, off by " << restError << "\n";
