@@ -25,7 +25,7 @@ from vtkmodules.vtkCommonDataModel import vtkPolyData
 
 import vtkffd
 from vtkffd import interchange, meshio
-from ffdtesting import read_mesh  # the same folder
+from ffdtesting import points_of, read_mesh  # the same folder
 
 # The folder that holds the package under test, for the subprocesses (which run in a temporary folder).
 PACKAGE_PARENT = os.path.dirname(os.path.dirname(os.path.abspath(vtkffd.__file__)))
@@ -252,9 +252,32 @@ class TestCommandLine(unittest.TestCase):
                 with self.assertRaisesRegex(ValueError, problem):
                     meshio.read_mesh(self.path("bad.off"))
 
+    def test_invert_takes_the_deformed_mesh_back(self):
+        """`deform` then `invert` by the same moved lattice: the bear back at rest within 1e-10 of its size (Newton
+        stops at 1e-12 of the frame's diagonal; det J stays near 1 for these small moves), and the output's
+        InverseStatus says every point was found; in-process vtkFFDInverseDeform gives the same points bit for
+        bit."""
+        lattice = build_in_process(self.mesh, vtkffd.vtkFFDBuildLattice.CUBIC_BSPLINE, (3, 3, 3)).GetOutput()
+        moved = vtk_to_numpy(lattice.GetPoints().GetData())
+        moved += np.random.default_rng(5).uniform(-0.005, 0.005, moved.shape)
+        interchange.write_lattice(lattice, self.path("inv.vtu"))
+        self.succeed("deform", "bear.vtp", "inv.vtu", "-o", "deformed.vtp", "--double")
+        self.succeed("invert", "deformed.vtp", "inv.vtu", "-o", "back.vtp", "--double")
+        back = meshio.read_mesh(self.path("back.vtp"))
+        points = points_of(self.mesh)
+        size = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+        self.assertLess(np.abs(points_of(back) - points).max(), 1e-10 * size)
+        self.assertEqual(int(vtk_to_numpy(back.GetPointData().GetArray("InverseStatus")).max()), 0)
+        inverse = vtkffd.vtkFFDInverseDeform()
+        inverse.SetInputData(meshio.read_mesh(self.path("deformed.vtp")))
+        inverse.SetLatticeData(interchange.read_lattice(self.path("inv.vtu")))
+        inverse.SetOutputPointsPrecision(1)  # vtkAlgorithm.DOUBLE_PRECISION
+        inverse.Update()
+        np.testing.assert_array_equal(points_of(back), points_of(inverse.GetOutput()))
+
     def test_help_names_every_command(self):
         out = self.succeed("--help")
-        for command in ("build", "deform", "info", "convert"):
+        for command in ("build", "deform", "invert", "info", "convert"):
             self.assertIn(command, out)
             self.assertIn("examples:", self.succeed(command, "--help"))
 

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""The command line `python3 -m vtkffd`: build a lattice around a mesh, deform a mesh by a lattice, describe or
-convert a lattice file. main() is its entry point; README, "Command line", shows it at work.
+"""The command line `python3 -m vtkffd`: build a lattice around a mesh, deform a mesh by a lattice (or map it back),
+describe or convert a lattice file. main() is its entry point; README, "Command line", shows it at work.
 
 Meshes are read and written by vtkffd.meshio, lattices by vtkffd.interchange, each by its file's extension. A
 user's mistake (a missing file, an unknown extension, options that do not fit, a filter's error) ends in one line
@@ -44,7 +44,8 @@ global Bernstein basis, only those near the moved control points for the local b
 
 The pipeline: `build` writes the lattice around a mesh, at rest; move its points in any tool that edits the file
 (ParaView, numpy, Blender through .vdb, PyGeM through .prm, ITK through .tfm); `deform` moves the mesh, or any
-other inside the lattice, by it. `info` describes a lattice and `convert` changes its format.
+other inside the lattice, by it; `invert` takes a deformed mesh back to rest. `info` describes a lattice and
+`convert` changes its format.
 
 meshes: {MESH_FORMATS}; lattices: {LATTICE_FORMATS}."""
 
@@ -53,6 +54,7 @@ examples:
   {PROG} build bear.off -o bear.vts --divisions 2 3 4
   {PROG} info bear.vts
   {PROG} deform bear.off bear_moved.vts -o bear_deformed.vtp
+  {PROG} invert bear_deformed.vtp bear_moved.vts -o bear_back.vtp
   {PROG} convert bear_moved.vts -o bear_moved.prm
 {PROG} COMMAND --help tells more of each."""
 
@@ -185,6 +187,24 @@ def deform(arguments, console):
     console.check()
     console.say(f"{arguments.output}: {mesh.GetNumberOfPoints()} points deformed on the "
                 f"{deformer.GetLastBackendUsed()}")
+
+
+def invert(arguments, console):
+    mesh = read_point_set(arguments.mesh)
+    meshio.check_format(mesh, arguments.output)
+    lattice = interchange.read_lattice(arguments.lattice)
+    console.check()
+    inverter = vtkffd.vtkFFDInverseDeform()
+    inverter.SetInputData(mesh)
+    inverter.SetLatticeData(lattice)
+    if arguments.double:
+        inverter.SetOutputPointsPrecision(vtkAlgorithm.DOUBLE_PRECISION)
+    console.update(inverter, "invert")
+    meshio.write_mesh(inverter.GetOutput(), arguments.output)
+    console.check()
+    failed = inverter.GetNumberOfFoldedPoints() + inverter.GetNumberOfUnconvergedPoints()
+    console.say(f"{arguments.output}: {mesh.GetNumberOfPoints()} points back at rest"
+                + (f", {failed} without a reliable rest position (the InverseStatus point array)" if failed else ""))
 
 
 def describe(lattice):
@@ -342,6 +362,16 @@ with the deformation, to OUT.""", [
     sub.add_argument("--backend", choices=BACKENDS, default="auto",
                      help="where to compute: auto (a CUDA GPU where there is one, else the CPU; the default), cpu, "
                           "cuda (the CPU, with a warning, where CUDA cannot run)")
+    sub.add_argument("--double", action="store_true", help="float64 points (default: the precision of MESH's)")
+
+    sub = command("invert", invert, "map a deformed mesh back to rest", """\
+Moves each point of MESH, a mesh in the deformed space, to the rest position that LATTICE deforms to it (the
+inverse of `deform` with points outside the lattice kept): Newton's method on the lattice's own evaluation for
+grid lattices, exact for tetrahedral ones. OUT gets an InverseStatus point array: 0 found, 1 where the
+deformation folds, 2 not found.""", ["bear_deformed.vtp bear_moved.vts -o bear_back.vtp"])
+    sub.add_argument("mesh", metavar="MESH", help=f"the deformed mesh ({MESH_FORMATS})")
+    sub.add_argument("lattice", metavar="LATTICE", help=f"the lattice that deformed it ({LATTICE_FORMATS})")
+    sub.add_argument("-o", "--output", metavar="OUT", required=True, help="the mesh at rest")
     sub.add_argument("--double", action="store_true", help="float64 points (default: the precision of MESH's)")
 
     sub = command("info", info, "describe a lattice", """\
