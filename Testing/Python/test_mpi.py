@@ -39,6 +39,16 @@ def point_cloud(points):
     return cloud
 
 
+def deformed(points, lattice):
+    """`points` deformed by `lattice` (vtkFFDDeform on the CPU), as an (N, 3) array."""
+    deform = vtkffd.vtkFFDDeform()
+    deform.SetInputData(point_cloud(points))
+    deform.SetLatticeData(lattice)
+    deform.SetBackendToCPU()
+    deform.Update()
+    return points_of(deform.GetOutput())
+
+
 def pipeline(points, frame_mode):
     """Voxelize `points` (3 x 4 x 5 voxels), build the tricubic Bezier lattice (dense), move every control point
     by a pseudo-random vector the same on every process, and deform `points`. Returns (voxel grid's frame,
@@ -56,14 +66,9 @@ def pipeline(points, frame_mode):
     lattice.DeepCopy(build.GetOutput())
     moved = vtk_to_numpy(lattice.GetPoints().GetData())
     moved += np.random.default_rng(19).uniform(-0.02, 0.02, moved.shape)
-    deform = vtkffd.vtkFFDDeform()
-    deform.SetInputData(point_cloud(points))
-    deform.SetLatticeData(lattice)
-    deform.SetBackendToCPU()
-    deform.Update()
     grid = voxelize.GetOutput()
     return (vtk_to_numpy(grid.GetFieldData().GetArray("FFDFrame")).copy(),
-            vtk_to_numpy(grid.GetCellData().GetArray("VoxelIndex")).copy(), points_of(deform.GetOutput()))
+            vtk_to_numpy(grid.GetCellData().GetArray("VoxelIndex")).copy(), deformed(points, lattice))
 
 
 def tetrahedral_pipeline(points):
@@ -79,12 +84,7 @@ def tetrahedral_pipeline(points):
     nodes = points_of(lattice)
     moved = vtk_to_numpy(lattice.GetPoints().GetData())
     moved += np.random.default_rng(23).uniform(-0.01, 0.01, moved.shape)
-    deform = vtkffd.vtkFFDDeform()
-    deform.SetInputData(point_cloud(points))
-    deform.SetLatticeData(lattice)
-    deform.SetBackendToCPU()
-    deform.Update()
-    return nodes, structure, points_of(deform.GetOutput())
+    return nodes, structure, deformed(points, lattice)
 
 
 def run(case, points):
