@@ -21,7 +21,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkCommonDataModel import vtkStructuredGrid
 from vtkmodules.vtkFiltersCore import vtkImageAppend, vtkPolyDataNormals
 from vtkmodules.vtkImagingCore import vtkImageResize
@@ -35,6 +34,8 @@ from vtkmodules.vtkRenderingCore import (
     vtkWindowToImageFilter,
 )
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL implementations of the rendering classes)
+
+from twist_lattice import twist_lattice
 
 try:
     import vtkffd
@@ -50,10 +51,6 @@ BASES = {  # --basis name: the vtkFFDBuildLattice setter
     "cubic": "SetBasisToTricubicBezier",
     "bspline": "SetBasisToCubicBSpline",
 }
-# CGAL's meshes stand along +Y, the frame's T axis: "up" below is T, and the camera looks along -Z.
-TWIST_DEGREES = 40.0  # rotation of the top layer about the vertical axis (zero at the bottom layer)
-BULGE = 0.35  # outward push of the middle layers, as a fraction of their distance to the axis
-STRETCH = 0.25  # lift of the top layer, as a fraction of the frame's height
 EVALUATION_RUNS = 5
 
 
@@ -92,32 +89,6 @@ def read_mesh(name):
     if mesh.GetNumberOfPoints() == 0:
         sys.exit(f"{path} holds no points")
     return path.stem, mesh
-
-
-def deform_lattice(lattice):
-    """Moves the lattice's points in place: twist and lift the upper layers, bulge the middle ones."""
-    n_i, n_j, n_k = lattice.GetDimensions()
-    frame = vtk_to_numpy(lattice.GetFieldData().GetArray("FFDFrame"))
-    origin, s_axis, t_axis, u_axis = frame.reshape(4, 3)
-    rest = vtk_to_numpy(lattice.GetPointData().GetArray("RestPosition")).reshape(n_k, n_j, n_i, 3)
-    # A view of the lattice's own points (VTK order: i fastest, so the numpy shape is k, j, i).
-    points = vtk_to_numpy(lattice.GetPoints().GetData()).reshape(n_k, n_j, n_i, 3)
-
-    # Parameter t of each layer along T, from the rest positions: a B-spline lattice's outer layers lie outside
-    # the frame, at t < 0 and t > 1.
-    parameters = np.linalg.solve(np.column_stack((s_axis, t_axis, u_axis)), (rest[0, :, 0] - origin).T)
-    height = parameters[1][None, :, None, None]
-    axis = t_axis / np.linalg.norm(t_axis)
-    centre = origin + 0.5 * s_axis + 0.5 * u_axis + height * t_axis  # the vertical axis through the frame
-    offset = rest - centre
-    angle = np.radians(TWIST_DEGREES) * height
-    # Rotate the part of each offset across the axis (Rodrigues' formula with no along-axis term), scale it.
-    along = (offset @ axis)[..., None] * axis
-    across = offset - along
-    rotated = across * np.cos(angle) + np.cross(axis, across) * np.sin(angle)
-    scale = 1.0 + BULGE * np.sin(np.pi * height)
-    points[...] = centre + along + scale * rotated + STRETCH * height**2 * t_axis
-    lattice.GetPoints().Modified()  # numpy wrote behind VTK's back: tell the pipeline
 
 
 def render(output_path, size, mesh, lattice, camera_bounds, point_radius=None, azimuth=30.0):
@@ -218,7 +189,7 @@ def main():
     # Our own copy to move, so that a re-execution of vtkFFDBuildLattice cannot undo the moves.
     lattice = vtkStructuredGrid()
     lattice.DeepCopy(rest_lattice)
-    deform_lattice(lattice)
+    twist_lattice(lattice)
 
     deform = vtkffd.vtkFFDDeform()
     deform.SetInputData(mesh)

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 """Level of detail: a coarse lattice deformed, refined exactly, detail added locally, and coarsened back.
 
-1. The bear in a 3x3x3 cubic B-spline lattice, twisted and lifted as the demo does (deform_mesh.deform_lattice).
+1. The bear in a 3x3x3 cubic B-spline lattice, twisted and lifted as the demo does (twist_lattice.twist_lattice).
 2. vtkFFDRefineLattice: the same deformation on a 6x6x6 lattice (the script prints the largest difference over the
    bear's points: rounding only).
 3. vtkFFDBuildDetailLattice over the refined lattice's voxels around the head: a 12x12x12 detail lattice, at rest,
@@ -25,7 +25,8 @@ from vtkmodules.util.vtkConstants import VTK_INT
 from vtkmodules.vtkCommonDataModel import vtkStructuredGrid, vtkUnstructuredGrid
 
 # The demo's mesh reading, lattice motion and rendering (this folder is on sys.path when run as a script).
-from deform_mesh import REPOSITORY, contact_sheet, deform_lattice, read_mesh, render, union_bounds, vtkffd
+from deform_mesh import REPOSITORY, contact_sheet, read_mesh, render, union_bounds, vtkffd
+from twist_lattice import twist_lattice
 
 SIZE = (500, 500)
 HEAD_RADIUS = 0.15  # of the bounding box's diagonal: the refined voxels whose centre is this near the head
@@ -96,11 +97,11 @@ def main():
     build = vtkffd.vtkFFDBuildLattice()
     build.SetInputConnection(voxelize.GetOutputPort())
     build.SetBasisToCubicBSpline()
-    build.SetLatticeFormToDense()  # deform_lattice reshapes the dense grid
+    build.SetLatticeFormToDense()  # twist_lattice reshapes the dense grid
     build.Update()
     coarse = vtkStructuredGrid()
     coarse.DeepCopy(build.GetOutput())
-    deform_lattice(coarse)
+    twist_lattice(coarse)
     coarse_mesh = deformed(mesh, coarse)
 
     # 2. Refined exactly.
