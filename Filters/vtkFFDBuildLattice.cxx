@@ -7,6 +7,7 @@
 #include "vtkDoubleArray.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDPipelineKeys.h"
 #include "vtkFFDSparseLattice.h"
 #include "vtkFFDWholeInput.h"
 #include "vtkFieldData.h"
@@ -171,12 +172,23 @@ int vtkFFDBuildLattice::RequestDataObject(vtkInformation*, vtkInformationVector*
 }
 
 //------------------------------------------------------------------------------
-int vtkFFDBuildLattice::ExecuteInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+int vtkFFDBuildLattice::ExecuteInformation(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  // The dense lattice's extent follows the input's FFDDivisions, which comes with its data: unknown until
-  // RequestData. The executive copied the input's WHOLE_EXTENT, if any (a structured voxel grid's), which is not
-  // the lattice's; without one it announces an empty extent.
-  outputVector->GetInformationObject(0)->Remove(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT());
+  // The dense lattice's extent follows the voxel grid's divisions: announced by vtkFFDVoxelize
+  // (vtkFFDPipelineKeys.h says why it matters), else unknown until RequestData. The executive copied the input's
+  // WHOLE_EXTENT, if any (a structured voxel grid's), which is not the lattice's.
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  outInfo->Remove(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT());
+  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  int points[3];
+  std::string why;
+  if (!IsSparse(this->LatticeForm, this->Basis) && inInfo && inInfo->Has(vtkFFDPipelineKeys::DIVISIONS()) &&
+    GetControlPointsPerAxis(this->Basis, inInfo->Get(vtkFFDPipelineKeys::DIVISIONS()), points, why, DENSE))
+  {
+    const int extent[6] = { 0, points[0] - 1, 0, points[1] - 1, 0, points[2] - 1 };
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+  }
   return 1;
 }
 

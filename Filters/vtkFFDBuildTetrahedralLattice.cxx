@@ -234,6 +234,14 @@ int vtkFFDBuildTetrahedralLattice::FillInputPortInformation(int, vtkInformation*
 }
 
 //------------------------------------------------------------------------------------------------------------
+int vtkFFDBuildTetrahedralLattice::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  return vtkFFDRequestOwnPiece(this->Controller, inputVector) ||
+    this->Superclass::RequestUpdateExtent(request, inputVector, outputVector);
+}
+
+//------------------------------------------------------------------------------------------------------------
 vtkTypeBool vtkFFDBuildTetrahedralLattice::ProcessRequest(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -256,8 +264,11 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
     return 1; // an empty input gives an empty output
   }
 
-  // The finite points and their centroid, an exact sum over every process rounded once.
+  // The finite points and their centroid, an exact sum over every process rounded once; a distributed mesh's
+  // points shared by pieces (marked as copies in its ghost array) count once.
   const vtkIdType numberOfPoints = input->GetNumberOfPoints();
+  vtkUnsignedCharArray* ghostArray = input->GetPointGhostArray();
+  const unsigned char* ghosts = ghostArray ? ghostArray->GetPointer(0) : nullptr;
   std::vector<double> coordinates;
   coordinates.reserve(3 * numberOfPoints);
   std::vector<ffd::ExactSum> sums(4); // x, y, z, count
@@ -265,7 +276,7 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   {
     double x[3];
     input->GetPoint(id, x);
-    if (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))
+    if (vtkFFDIsOwnedPoint(ghosts, id) && std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))
     {
       coordinates.insert(coordinates.end(), x, x + 3);
       for (int c = 0; c < 3; ++c)

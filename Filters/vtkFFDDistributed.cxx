@@ -2,10 +2,17 @@
 #include "vtkFFDDistributed.h"
 
 #include "vtkCommunicator.h"
+#include "vtkDataSetAttributes.h"
 #include "vtkDoubleArray.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
 #include "vtkMultiProcessController.h"
 #include "vtkNew.h"
+#include "vtkPointSet.h"
+#include "vtkPoints.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkTypeInt64Array.h"
+#include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
 
@@ -23,6 +30,57 @@ std::vector<T> GatherAll(vtkMultiProcessController* controller, const std::vecto
   return std::vector<T>(received->GetPointer(0), received->GetPointer(0) + received->GetNumberOfValues());
 }
 } // namespace
+
+//------------------------------------------------------------------------------
+bool vtkFFDRequestOwnPiece(vtkMultiProcessController* controller, vtkInformationVector** inputVector)
+{
+  if (!vtkFFDIsDistributed(controller))
+  {
+    return false;
+  }
+  if (vtkInformation* inInfo = inputVector[0]->GetInformationObject(0))
+  {
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), controller->GetLocalProcessId());
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), controller->GetNumberOfProcesses());
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkFFDIsOwnedPoint(const unsigned char* ghosts, vtkIdType id)
+{
+  return !ghosts || !(ghosts[id] & vtkDataSetAttributes::DUPLICATEPOINT);
+}
+
+//------------------------------------------------------------------------------
+vtkSmartPointer<vtkDataArray> vtkFFDOwnedPoints(vtkPointSet* input)
+{
+  vtkDataArray* points = input->GetPoints()->GetData();
+  vtkUnsignedCharArray* ghostArray = input->GetPointGhostArray();
+  const unsigned char* ghosts = ghostArray ? ghostArray->GetPointer(0) : nullptr;
+  const vtkIdType count = points->GetNumberOfTuples();
+  vtkIdType owned = 0;
+  for (vtkIdType id = 0; id < count; ++id)
+  {
+    owned += vtkFFDIsOwnedPoint(ghosts, id) ? 1 : 0;
+  }
+  if (owned == count)
+  {
+    return points;
+  }
+  auto copy = vtkSmartPointer<vtkDataArray>::Take(points->NewInstance());
+  copy->SetNumberOfComponents(3);
+  copy->SetNumberOfTuples(owned);
+  for (vtkIdType id = 0, next = 0; id < count; ++id)
+  {
+    if (vtkFFDIsOwnedPoint(ghosts, id))
+    {
+      copy->SetTuple(next++, id, points);
+    }
+  }
+  return copy;
+}
 
 //------------------------------------------------------------------------------------------------------------
 bool vtkFFDIsDistributed(vtkMultiProcessController* controller)

@@ -11,13 +11,31 @@
 #ifndef vtkFFDDistributed_h
 #define vtkFFDDistributed_h
 
+#include "vtkSmartPointer.h"
 #include "vtkType.h"
 
 #include "FFDExactSum.h"
 
 #include <vector>
 
+class vtkDataArray;
+class vtkInformationVector;
 class vtkMultiProcessController;
+class vtkPointSet;
+
+/// The points of `input` that count in sums over processes: all of them, or, where its ghost array marks some
+/// as copies of another process's (DUPLICATEPOINT, as vtkGenerateGlobalIds marks the points that pieces share),
+/// a copy without those, so that each point of a mesh split among processes counts once.
+vtkSmartPointer<vtkDataArray> vtkFFDOwnedPoints(vtkPointSet* input);
+
+/// Whether the point `id` of an input with the point ghost array `ghosts` (or none) counts in sums.
+bool vtkFFDIsOwnedPoint(const unsigned char* ghosts, vtkIdType id);
+
+/// The update request of the filters whose output is the same on every process, built from every process's
+/// piece: with several processes, each asks its input for its own piece (without ghost levels), whatever was
+/// asked of the output (a lattice asks for all of it). False where `controller` is not distributed: the
+/// caller's superclass then passes the request on as usual.
+bool vtkFFDRequestOwnPiece(vtkMultiProcessController* controller, vtkInformationVector** inputVector);
 
 /// Whether `controller` spreads the input over more than one process.
 bool vtkFFDIsDistributed(vtkMultiProcessController* controller);

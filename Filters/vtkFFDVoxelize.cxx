@@ -3,9 +3,11 @@
 
 #include "vtkArrayDispatch.h"
 #include "vtkDataArrayRange.h"
+#include "vtkDemandDrivenPipeline.h"
 #include "vtkDoubleArray.h"
 #include "vtkFFDDistributed.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDPipelineKeys.h"
 #include "vtkFFDSparseLattice.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -27,6 +29,25 @@
 #include <vector>
 
 vtkStandardNewMacro(vtkFFDVoxelize);
+
+//------------------------------------------------------------------------------
+vtkInformationIntegerVectorKey* vtkFFDPipelineKeys::DIVISIONS()
+{
+  // Registered with vtkInformationKeyLookup by its constructor, which deletes it at exit, as VTK's own keys.
+  static vtkInformationIntegerVectorKey* const key =
+    new vtkFFDDownstreamIntegerVectorKey("DIVISIONS", "vtkFFDPipelineKeys", 3);
+  return key;
+}
+
+//------------------------------------------------------------------------------
+void vtkFFDDownstreamIntegerVectorKey::CopyDefaultInformation(
+  vtkInformation* request, vtkInformation* fromInfo, vtkInformation* toInfo)
+{
+  if (request->Has(vtkDemandDrivenPipeline::REQUEST_INFORMATION()))
+  {
+    this->ShallowCopy(fromInfo, toInfo);
+  }
+}
 vtkCxxSetObjectMacro(vtkFFDVoxelize, Controller, vtkMultiProcessController);
 
 namespace
@@ -229,7 +250,7 @@ int vtkFFDVoxelize::FillInputPortInformation(int, vtkInformation* info)
 }
 
 //------------------------------------------------------------------------------
-int vtkFFDVoxelize::RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*)
+int vtkFFDVoxelize::RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   const int* n = this->Divisions;
   if (n[0] < 1 || n[1] < 1 || n[2] < 1)
@@ -238,7 +259,16 @@ int vtkFFDVoxelize::RequestInformation(vtkInformation*, vtkInformationVector**, 
                   << ") must be at least 1 on every axis: call SetDivisions() with positive numbers.");
     return 0;
   }
+  outputVector->GetInformationObject(0)->Set(vtkFFDPipelineKeys::DIVISIONS(), this->Divisions, 3);
   return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDVoxelize::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  return vtkFFDRequestOwnPiece(this->Controller, inputVector) ||
+    this->Superclass::RequestUpdateExtent(request, inputVector, outputVector);
 }
 
 //------------------------------------------------------------------------------------------------------------
@@ -264,7 +294,8 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
   }
   vtkNew<vtkDoubleArray> none;
   none->SetNumberOfComponents(3);
-  vtkDataArray* points = numPoints > 0 ? input->GetPoints()->GetData() : none.Get();
+  // A distributed mesh's points shared by pieces count once: in the principal axes' sums above all.
+  const vtkSmartPointer<vtkDataArray> points = numPoints > 0 ? vtkFFDOwnedPoints(input) : none.Get();
   const int nx = this->Divisions[0], ny = this->Divisions[1], nz = this->Divisions[2];
   // Voxels and corners are found by their int64 linear index i + nx (j + ny k): the corners' count must fit.
   if ((nx + 1.0) * (ny + 1.0) * (nz + 1.0) >= 0x1p63)
@@ -340,7 +371,7 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
   WithPointRange(points,
     [&](auto range)
     {
-      active.Mark(numPoints,
+      active.Mark(points->GetNumberOfTuples(),
         [&](vtkIdType begin, vtkIdType end, vtkFFDBoxMarker& marker)
         {
           const int one[3] = { 1, 1, 1 };

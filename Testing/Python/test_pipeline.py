@@ -95,6 +95,37 @@ class TestPipeline(unittest.TestCase):
         np.testing.assert_allclose(self.lattice_points(), expected, rtol=0, atol=1e-12 * self.diagonal)
         np.testing.assert_array_equal(rest, self.lattice_points())
 
+    def test_dense_lattice_feeds_structured_consumers(self):
+        # A structured grid's consumers ask for pieces of its WHOLE_EXTENT, announced before execution from the
+        # voxel grid's divisions; without it they (and ParaView's displays) got an empty lattice. Each consumer
+        # downstream of the filter must give what it gives on a copy of the lattice (no pipeline before it), also
+        # with a filter between the voxel grid and the lattice (as ParaView puts after every filter).
+        from vtkmodules.vtkCommonDataModel import vtkStructuredGrid
+        from vtkmodules.vtkFiltersCore import vtkPassThrough
+        from vtkmodules.vtkFiltersExtraction import vtkExtractEdges
+        from vtkmodules.vtkFiltersGeometry import vtkDataSetSurfaceFilter
+        for basis, dimensions in ((vtkffd.vtkFFDBuildLattice.BERNSTEIN, (3, 4, 5)),
+                                  (vtkffd.vtkFFDBuildLattice.TRIQUADRATIC_BEZIER, (5, 7, 9))):
+            between = vtkPassThrough()
+            between.SetInputConnection(self.voxelize.GetOutputPort())
+            build = vtkffd.vtkFFDBuildLattice()
+            build.SetInputConnection(between.GetOutputPort())
+            build.SetBasis(basis)
+            build.SetLatticeFormToDense()
+            build.Update()
+            copy = vtkStructuredGrid()
+            copy.DeepCopy(build.GetOutput())
+            self.assertEqual(copy.GetDimensions(), dimensions)
+            for consumer in (vtkDataSetSurfaceFilter, vtkExtractEdges):
+                downstream, alone = consumer(), consumer()
+                downstream.SetInputConnection(build.GetOutputPort())
+                alone.SetInputData(copy)
+                downstream.Update()
+                alone.Update()
+                self.assertGreater(alone.GetOutput().GetNumberOfCells(), 0)
+                self.assertEqual(downstream.GetOutput().GetNumberOfCells(), alone.GetOutput().GetNumberOfCells())
+                np.testing.assert_array_equal(points_of(downstream.GetOutput()), points_of(alone.GetOutput()))
+
     def test_rest_lattice_leaves_mesh_unchanged(self):
         self.deform.SetOutputPointsPrecision(vtkAlgorithm.DEFAULT_PRECISION)
         # The deformation is added as displacements P - P_rest, all exactly zero here: the points come back
@@ -164,6 +195,48 @@ class TestPipeline(unittest.TestCase):
         self.assertEqual(algorithm.GetExecutive().Update(), 0)
         self.assertTrue(any(needle in message for message in errors.messages), errors.messages)
         self.assertEqual(algorithm.GetOutputDataObject(0).GetNumberOfPoints(), 0)
+
+    def test_points_marked_as_copies_count_once(self):
+        # A piece of a distributed mesh holds copies of points that another piece owns, marked DUPLICATEPOINT
+        # in its ghost array (vtkGenerateGlobalIds): they must not weigh twice in the principal axes or in the
+        # tetrahedral lattice's centroid. The elephant plus marked copies of 2000 of its points gives the
+        # elephant's frame and tetrahedra bit for bit; unmarked, the copies change them.
+        from vtkmodules.vtkCommonDataModel import vtkDataSetAttributes
+        rng = np.random.default_rng(20261126)
+        copies = rng.choice(self.mesh.GetNumberOfPoints(), 2000, replace=False)
+        with_copies = vtkPolyData()
+        points = vtkPoints()
+        points.SetDataTypeToDouble()
+        points.SetData(numpy_to_vtk(np.concatenate([self.mesh_points, self.mesh_points[copies]]), deep=True))
+        with_copies.SetPoints(points)
+        ghosts = np.zeros(points.GetNumberOfPoints(), np.uint8)
+        ghosts[self.mesh.GetNumberOfPoints():] = vtkDataSetAttributes.DUPLICATEPOINT
+        ghost_array = numpy_to_vtk(ghosts, deep=True)
+        ghost_array.SetName(vtkDataSetAttributes.GhostArrayName())
+
+        def lattices(mesh):
+            voxelize = vtkffd.vtkFFDVoxelize()
+            voxelize.SetInputData(mesh)
+            voxelize.SetFrameModeToPrincipalAxes()
+            voxelize.SetDivisions(5, 6, 4)
+            tetrahedral = vtkffd.vtkFFDBuildTetrahedralLattice()
+            tetrahedral.SetInputData(mesh)
+            voxelize.Update()
+            tetrahedral.Update()
+            return (vtk_to_numpy(voxelize.GetOutput().GetFieldData().GetArray("FFDFrame")),
+                    points_of(tetrahedral.GetOutput()))
+
+        plain = vtkPolyData()
+        plain.SetPoints(vtkPoints())
+        plain.GetPoints().SetData(numpy_to_vtk(self.mesh_points, deep=True))
+        expected_frame, expected_nodes = lattices(plain)
+        unmarked_frame, unmarked_nodes = lattices(with_copies)
+        self.assertFalse(np.array_equal(unmarked_frame, expected_frame))
+        self.assertFalse(np.array_equal(unmarked_nodes, expected_nodes))
+        with_copies.GetPointData().AddArray(ghost_array)
+        frame, nodes = lattices(with_copies)
+        np.testing.assert_array_equal(frame, expected_frame)
+        np.testing.assert_array_equal(nodes, expected_nodes)
 
     def test_memory_follows_the_active_voxels(self):
         # The abort: divisions of 100000^3 once asked for a dense voxel grid beyond any machine's memory.
