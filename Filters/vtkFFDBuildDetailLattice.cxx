@@ -133,6 +133,17 @@ vtkIntArray* vtkFFDBuildDetailLattice::GetSelectedVoxels()
 }
 
 //------------------------------------------------------------------------------------------------------------
+vtkMTimeType vtkFFDBuildDetailLattice::GetMTime()
+{
+  vtkMTimeType time = this->Superclass::GetMTime();
+  if (this->SelectedVoxels)
+  {
+    time = std::max(time, this->SelectedVoxels->GetMTime());
+  }
+  return time;
+}
+
+//------------------------------------------------------------------------------------------------------------
 int vtkFFDBuildDetailLattice::FillInputPortInformation(int, vtkInformation* info)
 {
   info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPointSet");

@@ -51,6 +51,9 @@ public:
   /// The input voxels the last update refined (selected and over the threshold, each once).
   vtkGetMacro(NumberOfRefinedVoxels, vtkIdType);
 
+  /// Includes SelectedVoxels' modification time: changing its values re-executes the filter.
+  vtkMTimeType GetMTime() override;
+
 protected:
   vtkFFDBuildDetailLattice();
   ~vtkFFDBuildDetailLattice() override;

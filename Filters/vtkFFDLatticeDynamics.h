@@ -81,13 +81,13 @@ public:
   ///@}
 
   ///@{
-  /// A spring's force per unit of stretch (default 100).
+  /// A spring's force per unit of stretch (default 1).
   vtkSetClampMacro(SpringStiffness, double, 0.0, VTK_DOUBLE_MAX);
   vtkGetMacro(SpringStiffness, double);
   ///@}
 
   ///@{
-  /// A spring's force per unit of relative velocity of its ends (default 1).
+  /// A spring's force per unit of relative velocity of its ends (default 0.01).
   vtkSetClampMacro(SpringDamping, double, 0.0, VTK_DOUBLE_MAX);
   vtkGetMacro(SpringDamping, double);
   ///@}

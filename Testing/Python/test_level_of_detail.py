@@ -107,6 +107,15 @@ class TestLevelOfDetail(unittest.TestCase):
         detail.SetSelectedVoxels(selected)
         detail.Update()
         self.assertEqual(detail.GetNumberOfRefinedVoxels(), 2)
+        # Changing the selection's values alone re-executes the filter (as ParaView's properties change it).
+        selected.SetNumberOfTuples(1)
+        selected.Modified()
+        detail.Update()
+        self.assertEqual(detail.GetNumberOfRefinedVoxels(), 1)
+        selected.InsertNextTuple3(3, 2, 1)
+        selected.Modified()  # value changes do not touch an array's modification time by themselves
+        detail.Update()
+        self.assertEqual(detail.GetNumberOfRefinedVoxels(), 2)
         levels = vtkUnstructuredGrid()
         levels.DeepCopy(detail.GetOutput())
         add = vtkffd.vtkFFDDeformBlocks()
