@@ -3,7 +3,7 @@
 #
 # The README's two Quick start commands:
 #   Utilities/setup.sh demo [demo options]   set up, build, run the main demo (Examples/Python/deform_mesh.py)
-#   Utilities/setup.sh test [ctest options]  set up, build, run every test through ctest
+#   Utilities/setup.sh test [ctest options]  set up, build (the ParaView plugin too), run every test through ctest
 # and the sanitizer run that CI adds (README, Tests):
 #   Utilities/setup.sh sanitize [ctest options]  the same set-up, then every test of an ASan + UBSan build
 # Set-up = install the missing Debian 12 packages, fetch the real meshes, configure once, build. Every step is
@@ -50,7 +50,10 @@ as_root() {
 # --- 1. Debian packages ---------------------------------------------------------------------------------------
 packages=(build-essential cmake ninja-build libvtk9-dev python3-vtk9 libopenvdb-dev libopenvdb-tools
   libboost-iostreams-dev libeigen3-dev libqhull-dev libgtest-dev xvfb xauth libgl1-mesa-dri python3-numpy
-  libinsighttoolkit5-dev openmpi-bin python3-mpi4py) # ITK: tests only; Open MPI and mpi4py: the MPI test
+  libinsighttoolkit5-dev openmpi-bin python3-mpi4py) # ITK: tests only; Open MPI and mpi4py: the MPI tests
+if [[ $action == test ]]; then
+  packages+=(paraview paraview-dev) # the plugin and its tests (ParaView/, Testing/ParaView)
+fi
 step "Debian packages"
 missing=()
 for package in "${packages[@]}"; do
@@ -106,13 +109,30 @@ else
 fi
 
 # --- 3. Configure and build -----------------------------------------------------------------------------------
+# The ParaView plugin (test only) has a build tree of its own in $build/paraview, against ParaView's VTK; it is
+# configured first, so that the main build finds the plugin's test settings there (Testing/ParaView).
+if [[ $action == test ]]; then
+  step "ParaView plugin in ${build}/paraview"
+  "$root/Utilities/paraview-prefix.sh" "$build/paraview-prefix"
+  if [[ ! -f $build/paraview/build.ninja ]]; then
+    cmake -G Ninja -S "$root/ParaView" -B "$build/paraview" -DCMAKE_BUILD_TYPE=Release \
+      "-DParaView_DIR=$build/paraview-prefix/usr/lib/$(gcc -print-multiarch)/cmake/paraview-5.11"
+  fi
+  configure_options+=("-DVOXELFFD_PARAVIEW_PLUGIN_TREE=$build/paraview")
+fi
+
 step "Build in ${build}"
-# Configure only when there is no build system yet (also after a configure that failed half-way).
-if [[ ! -f $build/build.ninja ]]; then
+# Configure only when there is no build system yet (also after a configure that failed half-way), or when the
+# ParaView plugin's tree is not known to it yet (a build made by `demo` before).
+if [[ ! -f $build/build.ninja ]] ||
+  { [[ $action == test ]] && ! grep -q "^VOXELFFD_PARAVIEW_PLUGIN_TREE:PATH=$build/paraview\$" "$build/CMakeCache.txt"; }; then
   cmake -G Ninja -S "$root" -B "$build" -DPython3_EXECUTABLE="$python" "${configure_options[@]}"
 fi
 # Ninja re-runs CMake by itself when a CMakeLists.txt changed.
 cmake --build "$build"
+if [[ $action == test ]]; then
+  cmake --build "$build/paraview"
+fi
 
 # --- 4. Run ---------------------------------------------------------------------------------------------------
 case $action in

@@ -1,0 +1,284 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
+"""The ParaView plugin in ParaView's own programs, against this build's vtkffd (Debian's VTK 9.1).
+
+- pvbatch runs the pipeline of paraview_pipeline.py (voxelize with principal axes, a sparse cubic B-spline lattice
+  moved by a Programmable Filter, deform; a subdivided tetrahedral lattice, moved, deform with Extrapolate) on
+  the bear, and every output equals, bit for bit, the same pipeline built here with vtkffd: the plugin compiles
+  the same sources against ParaView's VTK 9.2, and nothing in them depends on the VTK or the thread count.
+- mpirun -np 2 and 3 pvbatch: the mesh split among the processes by RedistributeDataSet, the points that pieces
+  share marked by GenerateGlobalIds; the voxel grid and the lattices that the first process holds, and the
+  deformed pieces of every process (each point found by its id), equal pvbatch's single-process outputs bit for
+  bit. The ParaView demo on 2 processes reads and deforms the bear once.
+- pvpython loads the plugin and runs a filter; the GUI (paraview --plugins) loads it and builds the pipeline
+  from a script, in an X display.
+
+ctest passes the programs and paths in the environment (Testing/ParaView/CMakeLists.txt); run one part with -k.
+"""
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+import numpy as np
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkCommonDataModel import vtkStructuredGrid, vtkUnstructuredGrid
+from vtkmodules.vtkIOXML import vtkXMLGenericDataObjectReader, vtkXMLPolyDataReader
+
+import vtkffd
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from lattice_moves import move_control_points  # noqa: E402  (the same folder)
+
+PLUGIN = os.environ.get("VOXELFFD_PARAVIEW_PLUGIN", "")
+PVBATCH = os.environ.get("VOXELFFD_PVBATCH", "pvbatch")
+PVPYTHON = os.environ.get("VOXELFFD_PVPYTHON", "pvpython")
+PARAVIEW = os.environ.get("VOXELFFD_PARAVIEW_GUI", "paraview")
+MESH = Path(os.environ.get("VOXELFFD_MESH_DIR", HERE.parents[1] / "Testing" / "Data" / "Meshes")) / "bear.vtp"
+TIMEOUT = 300  # seconds a ParaView program may take here (a few seconds each when all is well)
+
+
+def paraview_environment():
+    """ParaView's Python modules instead of Debian's VTK ones, whose libraries a ParaView process must not load.
+    pvpython looks for its modules beside the libraries it loaded: ParaView's prefix's, on LD_LIBRARY_PATH."""
+    environment = dict(os.environ)
+    environment["PYTHONPATH"] = os.environ["VOXELFFD_PARAVIEW_PYTHONPATH"]
+    environment["LD_LIBRARY_PATH"] = os.environ["VOXELFFD_PARAVIEW_LIBRARY_PATH"]
+    environment.pop("LD_PRELOAD", None)
+    # Open MPI as root in a container: allowed, and several processes on fewer cores.
+    environment.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+                       OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_btl_vader_single_copy_mechanism="none")
+    return environment
+
+
+def run(command, **kwargs):
+    result = subprocess.run([str(part) for part in command], env=paraview_environment(), capture_output=True,
+                            text=True, timeout=TIMEOUT, **kwargs)
+    output = result.stdout + result.stderr
+    if result.returncode != 0:
+        raise AssertionError(f"{command[0]} failed ({result.returncode}):\n{output}")
+    # ParaView reports a failing filter, proxy or property on stderr and goes on: any error fails the test.
+    for line in output.splitlines():
+        if "ERROR" in line or "Traceback" in line:
+            raise AssertionError(f"{command[0]} reported an error:\n{output}")
+    return output
+
+
+def read(path):
+    reader = vtkXMLGenericDataObjectReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    return reader.GetOutput()
+
+
+def points(data):
+    return vtk_to_numpy(data.GetPoints().GetData())
+
+
+def array(data, name, where="point"):
+    attributes = {"point": data.GetPointData, "field": data.GetFieldData, "cell": data.GetCellData}[where]()
+    found = attributes.GetArray(name)
+    if found is None:
+        raise AssertionError(f"no {where} array {name}")
+    return vtk_to_numpy(found)
+
+
+def cells(data):
+    if data.IsA("vtkUnstructuredGrid"):
+        return vtk_to_numpy(data.GetCells().GetConnectivityArray()), vtk_to_numpy(data.GetCellTypesArray())
+    if data.IsA("vtkPolyData"):
+        return vtk_to_numpy(data.GetPolys().GetConnectivityArray()), np.zeros(0)
+    return np.array(data.GetDimensions()), np.zeros(0)
+
+
+def run_pipeline(folder, processes=1):
+    """paraview_pipeline.py in pvbatch, on `processes` MPI processes; its outputs by name, a distributed one as
+    the list of its pieces in process order."""
+    command = [PVBATCH, "--dr", HERE / "paraview_pipeline.py", PLUGIN, MESH, folder]
+    if processes > 1:
+        command = ["mpirun", "-np", processes] + command
+    run(command)
+    outputs = {}
+    for path in sorted(Path(folder).glob("*.vt?"), key=lambda p: (p.stem.rsplit("_", 1)[0], p.stem)):
+        name, _, rank = path.stem.rpartition("_")
+        if rank.isdigit():
+            outputs.setdefault(name, []).append((int(rank), read(path)))
+        else:
+            outputs[path.stem] = read(path)
+    return {name: [piece for _, piece in sorted(value)] if isinstance(value, list) else value
+            for name, value in outputs.items()}
+
+
+class ParaViewTestCase(unittest.TestCase):
+    def assertSameDataSet(self, actual, expected, what, arrays=()):
+        """Bit for bit: the points, the cells and the named point and field arrays."""
+        self.assertEqual(actual.GetClassName(), expected.GetClassName(), what)
+        np.testing.assert_array_equal(points(actual), points(expected), err_msg=f"{what}: points")
+        for part, (got, want) in zip(("connectivity", "cell types"), zip(cells(actual), cells(expected))):
+            np.testing.assert_array_equal(got, want, err_msg=f"{what}: {part}")
+        for name, where in arrays:
+            np.testing.assert_array_equal(array(actual, name, where), array(expected, name, where),
+                                          err_msg=f"{what}: {name}")
+
+
+LATTICE_ARRAYS = (("FFDFrame", "field"), ("FFDDivisions", "field"), ("FFDBasis", "field"),
+                  ("RestPosition", "point"), ("Active", "point"))
+
+
+class Pipeline(ParaViewTestCase):
+    """pvbatch against vtkffd (Debian's VTK): the same sources, compiled against two VTKs, give the same bits."""
+
+    def reference(self):
+        reader = vtkXMLPolyDataReader()
+        reader.SetFileName(str(MESH))
+        reader.Update()
+        mesh = reader.GetOutput()
+        voxelize = vtkffd.vtkFFDVoxelize()
+        voxelize.SetInputData(mesh)
+        voxelize.SetDivisions(5, 6, 4)
+        voxelize.SetFrameModeToPrincipalAxes()
+        build = vtkffd.vtkFFDBuildLattice()
+        build.SetInputConnection(voxelize.GetOutputPort())
+        build.SetBasisToCubicBSpline()
+        build.SetLatticeFormToSparse()
+        build.Update()
+        lattice = vtkUnstructuredGrid()
+        lattice.DeepCopy(build.GetOutput())
+        move_control_points(lattice)
+        deform = vtkffd.vtkFFDDeform()
+        deform.SetInputData(mesh)
+        deform.SetLatticeData(lattice)
+        deform.Update()
+        tetrahedral = vtkffd.vtkFFDBuildTetrahedralLattice()
+        tetrahedral.SetInputData(mesh)
+        tetrahedral.SetSubdivisionLevels(1)
+        tetrahedral.Update()
+        tetrahedra = vtkUnstructuredGrid()
+        tetrahedra.DeepCopy(tetrahedral.GetOutput())
+        move_control_points(tetrahedra)
+        tetrahedral_deform = vtkffd.vtkFFDDeform()
+        tetrahedral_deform.SetInputData(mesh)
+        tetrahedral_deform.SetLatticeData(tetrahedra)
+        tetrahedral_deform.SetOutsidePolicyToExtrapolate()
+        tetrahedral_deform.Update()
+        return {"mesh": mesh, "voxels": voxelize.GetOutput(), "lattice": lattice, "deformed": deform.GetOutput(),
+                "tetrahedra": tetrahedra, "tetrahedral_deformed": tetrahedral_deform.GetOutput()}
+
+    def test_pvbatch_equals_vtkffd(self):
+        with tempfile.TemporaryDirectory() as folder:
+            paraview = run_pipeline(folder)
+        expected = self.reference()
+        self.assertGreater(paraview["voxels"].GetNumberOfCells(), 20)
+        self.assertSameDataSet(paraview["voxels"], expected["voxels"], "voxels",
+                               (("FFDFrame", "field"), ("FFDDivisions", "field"), ("VoxelIndex", "cell")))
+        self.assertSameDataSet(paraview["lattice"], expected["lattice"], "lattice", LATTICE_ARRAYS)
+        self.assertSameDataSet(paraview["tetrahedra"], expected["tetrahedra"], "tetrahedra",
+                               (("RestPosition", "point"),))
+        for name in ("deformed", "tetrahedral_deformed"):
+            (deformed,) = paraview[name]  # one process, one piece
+            # The deformation moved the bear: the comparison is not one of two unmoved copies.
+            moved = np.linalg.norm(points(deformed) - points(expected["mesh"]), axis=1)
+            self.assertGreater(moved.max(), 0.01 * np.ptp(points(expected["mesh"]), axis=0).max(), name)
+            np.testing.assert_array_equal(points(deformed), points(expected[name]), err_msg=name)
+
+
+class Mpi(ParaViewTestCase):
+    """mpirun -np 2 and 3 pvbatch: the bear split among the processes gives, once gathered, the serial output."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.folder = tempfile.TemporaryDirectory()
+        cls.serial = run_pipeline(Path(cls.folder.name) / "serial")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.folder.cleanup()
+
+    def check(self, processes):
+        parallel = run_pipeline(Path(self.folder.name) / f"np{processes}", processes)
+        (serial_mesh,) = self.serial["mesh"]
+        mesh_points = serial_mesh.GetNumberOfPoints()
+        np.testing.assert_array_equal(array(serial_mesh, "MeshPointId"), np.arange(mesh_points))
+        # Every process held a piece, not the whole mesh.
+        self.assertEqual(len(parallel["mesh"]), processes)
+        for piece in parallel["mesh"]:
+            self.assertGreater(piece.GetNumberOfPoints(), 0)
+            self.assertLess(piece.GetNumberOfPoints(), mesh_points)
+        self.assertSameDataSet(parallel["voxels"], self.serial["voxels"], "voxels",
+                               (("FFDFrame", "field"), ("VoxelIndex", "cell")))
+        self.assertSameDataSet(parallel["lattice"], self.serial["lattice"], "lattice", LATTICE_ARRAYS)
+        self.assertSameDataSet(parallel["tetrahedra"], self.serial["tetrahedra"], "tetrahedra",
+                               (("RestPosition", "point"),))
+        for name in ("deformed", "tetrahedral_deformed"):
+            (serial,) = self.serial[name]
+            ids = np.concatenate([array(piece, "MeshPointId") for piece in parallel[name]])
+            deformed = np.concatenate([points(piece) for piece in parallel[name]])
+            # Points shared by pieces come once from each: every copy must equal the serial point.
+            self.assertEqual(set(ids.tolist()), set(range(mesh_points)), name)
+            np.testing.assert_array_equal(deformed, points(serial)[ids], err_msg=name)
+
+    def test_two_processes(self):
+        self.check(2)
+
+    def test_three_processes(self):
+        self.check(3)
+
+    def test_demo_on_two_processes(self):
+        # Examples/ParaView/deform_mesh.py as the README runs it under MPI: the reader straight before
+        # FFDVoxelize, which asks it for this process's piece, so that the bear is read and deformed once
+        # (its vertices counted over the processes), not once a process.
+        with tempfile.TemporaryDirectory() as folder:
+            output = run(["mpirun", "-np", 2, PVBATCH, "--dr", HERE.parents[1] / "Examples" / "ParaView" /
+                          "deform_mesh.py", "--plugin", PLUGIN, "--output-dir", folder, "--size", 200, 200])
+            self.assertTrue((Path(folder) / "bear_after.png").is_file())
+        (mesh,) = self.serial["mesh"]
+        self.assertIn(f"bear: {mesh.GetNumberOfPoints()} vertices, 60 control points (3x4x5)", output)
+
+
+class Clients(ParaViewTestCase):
+    """The plugin loads in pvpython and in the GUI, and its filters run there."""
+
+    SCRIPT = """
+import sys
+from paraview.simple import *
+LoadPlugin({plugin!r}, ns=globals())
+voxels = FFDVoxelize(Input=XMLPolyDataReader(FileName=[{mesh!r}]), Divisions=[3, 3, 3])
+voxels.UpdatePipeline()
+voxels.UpdatePropertyInformation()
+open({report!r}, "w").write("%d %d\\n" % (voxels.NumberOfActiveVoxels, voxels.GetDataInformation().GetNumberOfCells()))
+"""
+
+    def expected_voxels(self):
+        reader = vtkXMLPolyDataReader()
+        reader.SetFileName(str(MESH))
+        voxelize = vtkffd.vtkFFDVoxelize()
+        voxelize.SetInputConnection(reader.GetOutputPort())
+        voxelize.SetDivisions(3, 3, 3)
+        voxelize.Update()
+        return voxelize.GetNumberOfActiveVoxels()
+
+    def check_client(self, command_for_script):
+        with tempfile.TemporaryDirectory() as folder:
+            report = Path(folder) / "report.txt"
+            script = Path(folder) / "script.py"
+            script.write_text(self.SCRIPT.format(plugin=PLUGIN, mesh=str(MESH), report=str(report)))
+            run(command_for_script(script))
+            active, cell_count = (int(v) for v in report.read_text().split())
+        expected = self.expected_voxels()
+        self.assertGreater(expected, 1)
+        self.assertEqual(active, expected)
+        self.assertEqual(cell_count, expected)
+
+    def test_pvpython(self):
+        self.check_client(lambda script: [PVPYTHON, "--dr", script])
+
+    def test_gui(self):
+        # The GUI runs the script at start-up, then quits (--exit); it needs the X display ctest runs in.
+        self.check_client(lambda script: [PARAVIEW, "--dr", f"--plugins={PLUGIN}", f"--script={script}", "--exit"])
+
+
+if __name__ == "__main__":
+    unittest.main()
