@@ -175,19 +175,18 @@ int vtkFFDBuildLattice::RequestDataObject(vtkInformation*, vtkInformationVector*
 int vtkFFDBuildLattice::ExecuteInformation(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  // The dense lattice's extent follows the voxel grid's divisions: announced by vtkFFDVoxelize
-  // (vtkFFDPipelineKeys.h says why it matters), else unknown until RequestData. The executive copied the input's
-  // WHOLE_EXTENT, if any (a structured voxel grid's), which is not the lattice's.
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  outInfo->Remove(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT());
+  // The lattice's extent follows the voxel grid's divisions, which vtkFFDVoxelize announces (vtkFFDPipelineKeys.h
+  // says why it matters); else it is unknown until RequestData. The executive copied the input's WHOLE_EXTENT, if
+  // any (a structured voxel grid's), which is not the lattice's.
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
-  int points[3];
-  std::string why;
-  if (!IsSparse(this->LatticeForm, this->Basis) && inInfo && inInfo->Has(vtkFFDPipelineKeys::DIVISIONS()) &&
-    GetControlPointsPerAxis(this->Basis, inInfo->Get(vtkFFDPipelineKeys::DIVISIONS()), points, why, DENSE))
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  if (inInfo && inInfo->Has(vtkFFDPipelineKeys::DIVISIONS()))
   {
-    const int extent[6] = { 0, points[0] - 1, 0, points[1] - 1, 0, points[2] - 1 };
-    outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+    vtkFFDPipelineKeys::AnnounceLattice(outInfo, this->Basis, inInfo->Get(vtkFFDPipelineKeys::DIVISIONS()));
+  }
+  else
+  {
+    vtkFFDPipelineKeys::Forget(outInfo);
   }
   return 1;
 }

@@ -9,6 +9,7 @@
 #include "vtkFFDGridDeformer.h"
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDPipelineKeys.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkFFDVoxelize.h"
 #include "vtkFFDWholeInput.h"
@@ -98,9 +99,24 @@ int vtkFFDCoarsenLattice::FillInputPortInformation(int port, vtkInformation* inf
 
 //------------------------------------------------------------------------------------------------------------
 int vtkFFDCoarsenLattice::ExecuteInformation(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  outputVector->GetInformationObject(0)->Remove(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT());
+  // The coarse lattice's extent, where its input's divisions and basis are announced (vtkFFDPipelineKeys.h), by
+  // the rules of RequestData.
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  int basis;
+  int divisions[3];
+  if (!vtkFFDPipelineKeys::AnnouncedLattice(inputVector[0]->GetInformationObject(0), basis, divisions))
+  {
+    vtkFFDPipelineKeys::Forget(outInfo);
+    return 1;
+  }
+  const bool halve = this->Divisions[0] < 1 || this->Divisions[1] < 1 || this->Divisions[2] < 1;
+  for (int a = 0; a < 3; ++a)
+  {
+    divisions[a] = halve ? (divisions[a] + 1) / 2 : this->Divisions[a];
+  }
+  vtkFFDPipelineKeys::AnnounceLattice(outInfo, this->Basis < 0 ? basis : this->Basis, divisions);
   return 1;
 }
 

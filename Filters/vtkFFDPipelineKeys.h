@@ -1,25 +1,39 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
  * @file vtkFFDPipelineKeys.h
- * @brief Information keys that the filters set in RequestInformation (private to the Filters module).
+ * @brief What the filters announce of a voxel grid or lattice in RequestInformation, before any data exists
+ * (private to the Filters module).
  *
  * A dense lattice is a vtkStructuredGrid, whose consumers (vtkDataSetSurfaceFilter, vtkExtractEdges, ParaView's
  * representations) ask for pieces of its WHOLE_EXTENT: without one announced before execution, the executive
- * gives them an empty output. The lattice's extent follows the divisions of the voxel grid, which
- * vtkFFDVoxelize knows before it executes: it announces them with DIVISIONS(), which travels downstream through
- * any filter (ParaView puts one after every filter), and vtkFFDBuildLattice turns them into the WHOLE_EXTENT of
- * its dense output.
+ * gives them an empty output. The lattice's extent follows its divisions and basis, which its data carries: so
+ * vtkFFDVoxelize announces its divisions, vtkFFDBuildLattice, vtkFFDRefineLattice and vtkFFDCoarsenLattice the
+ * divisions and basis of their output and, when it is dense, its WHOLE_EXTENT. The keys travel downstream through
+ * any filter (ParaView puts one after every filter). Where nothing is announced (a voxel grid read from a file),
+ * a dense lattice's extent is unknown until it executes, as before.
  */
 #ifndef vtkFFDPipelineKeys_h
 #define vtkFFDPipelineKeys_h
 
 #include "vtkInformationIntegerVectorKey.h"
 
+class vtkInformation;
+
 class vtkFFDPipelineKeys
 {
 public:
-  /// The voxels per axis (3 ints) of the voxel grid that this output information describes.
+  /// The voxels per axis (3 ints) of the voxel grid or lattice that this output information describes.
   static vtkInformationIntegerVectorKey* DIVISIONS();
+  /// The lattice's basis (1 int, vtkFFDBuildLattice::Bases).
+  static vtkInformationIntegerVectorKey* BASIS();
+
+  /// Announces a lattice of `basis` over `divisions` in `outInfo`, with the WHOLE_EXTENT of its control points
+  /// where the output is a vtkStructuredGrid.
+  static void AnnounceLattice(vtkInformation* outInfo, int basis, const int divisions[3]);
+  /// Removes what `outInfo` holds of an announcement (copied from an input): the output's is unknown.
+  static void Forget(vtkInformation* outInfo);
+  /// The divisions and basis that `inInfo` announces, if it announces both.
+  static bool AnnouncedLattice(vtkInformation* inInfo, int& basis, int divisions[3]);
 };
 
 /// An integer-vector key that every executive copies from a filter's first input to its outputs, as

@@ -8,6 +8,7 @@
 #include "vtkFFDGridDeformer.h"
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDPipelineKeys.h"
 #include "vtkFFDSparseLattice.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkFFDWholeInput.h"
@@ -65,9 +66,24 @@ vtkFFDRefineLattice::vtkFFDRefineLattice()
 }
 
 //------------------------------------------------------------------------------------------------------------
-int vtkFFDRefineLattice::ExecuteInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+int vtkFFDRefineLattice::ExecuteInformation(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  outputVector->GetInformationObject(0)->Remove(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT());
+  // The refined lattice's extent, where its input's divisions and basis are announced (vtkFFDPipelineKeys.h).
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  int basis;
+  int divisions[3];
+  if (!vtkFFDPipelineKeys::AnnouncedLattice(inputVector[0]->GetInformationObject(0), basis, divisions) ||
+    std::max({ divisions[0], divisions[1], divisions[2] }) > (VTK_INT_MAX >> this->Levels))
+  {
+    vtkFFDPipelineKeys::Forget(outInfo); // unknown, or too large: the execution reports it
+    return 1;
+  }
+  for (int& d : divisions)
+  {
+    d <<= this->Levels;
+  }
+  vtkFFDPipelineKeys::AnnounceLattice(outInfo, basis, divisions);
   return 1;
 }
 

@@ -3,7 +3,6 @@
 
 #include "vtkArrayDispatch.h"
 #include "vtkDataArrayRange.h"
-#include "vtkDemandDrivenPipeline.h"
 #include "vtkDoubleArray.h"
 #include "vtkFFDDistributed.h"
 #include "vtkFFDMemory.h"
@@ -30,24 +29,6 @@
 
 vtkStandardNewMacro(vtkFFDVoxelize);
 
-//------------------------------------------------------------------------------
-vtkInformationIntegerVectorKey* vtkFFDPipelineKeys::DIVISIONS()
-{
-  // Registered with vtkInformationKeyLookup by its constructor, which deletes it at exit, as VTK's own keys.
-  static vtkInformationIntegerVectorKey* const key =
-    new vtkFFDDownstreamIntegerVectorKey("DIVISIONS", "vtkFFDPipelineKeys", 3);
-  return key;
-}
-
-//------------------------------------------------------------------------------
-void vtkFFDDownstreamIntegerVectorKey::CopyDefaultInformation(
-  vtkInformation* request, vtkInformation* fromInfo, vtkInformation* toInfo)
-{
-  if (request->Has(vtkDemandDrivenPipeline::REQUEST_INFORMATION()))
-  {
-    this->ShallowCopy(fromInfo, toInfo);
-  }
-}
 vtkCxxSetObjectMacro(vtkFFDVoxelize, Controller, vtkMultiProcessController);
 
 namespace

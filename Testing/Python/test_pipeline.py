@@ -97,34 +97,56 @@ class TestPipeline(unittest.TestCase):
 
     def test_dense_lattice_feeds_structured_consumers(self):
         # A structured grid's consumers ask for pieces of its WHOLE_EXTENT, announced before execution from the
-        # voxel grid's divisions; without it they (and ParaView's displays) got an empty lattice. Each consumer
-        # downstream of the filter must give what it gives on a copy of the lattice (no pipeline before it), also
-        # with a filter between the voxel grid and the lattice (as ParaView puts after every filter).
+        # divisions and basis (vtkFFDVoxelize's, then each lattice filter's); without it they (and ParaView's
+        # displays) got an empty lattice. Each consumer downstream of a filter that makes a dense lattice must
+        # give what it gives on a copy of the lattice (no pipeline before it), also with a filter between the
+        # voxel grid and the lattice (as ParaView puts after every filter).
         from vtkmodules.vtkCommonDataModel import vtkStructuredGrid
         from vtkmodules.vtkFiltersCore import vtkPassThrough
         from vtkmodules.vtkFiltersExtraction import vtkExtractEdges
         from vtkmodules.vtkFiltersGeometry import vtkDataSetSurfaceFilter
-        for basis, dimensions in ((vtkffd.vtkFFDBuildLattice.BERNSTEIN, (3, 4, 5)),
-                                  (vtkffd.vtkFFDBuildLattice.TRIQUADRATIC_BEZIER, (5, 7, 9))):
-            between = vtkPassThrough()
-            between.SetInputConnection(self.voxelize.GetOutputPort())
-            build = vtkffd.vtkFFDBuildLattice()
-            build.SetInputConnection(between.GetOutputPort())
-            build.SetBasis(basis)
-            build.SetLatticeFormToDense()
-            build.Update()
+        between = vtkPassThrough()
+        between.SetInputConnection(self.voxelize.GetOutputPort())
+
+        builds = []  # an output port does not keep its filter alive
+
+        def build(basis):
+            lattice = vtkffd.vtkFFDBuildLattice()
+            lattice.SetInputConnection(between.GetOutputPort())
+            lattice.SetBasis(basis)
+            lattice.SetLatticeFormToDense()
+            builds.append(lattice)
+            return lattice
+
+        refine = vtkffd.vtkFFDRefineLattice()
+        refine.SetInputConnection(build(vtkffd.vtkFFDBuildLattice.TRIQUADRATIC_BEZIER).GetOutputPort())
+        coarsen = vtkffd.vtkFFDCoarsenLattice()  # half of (2, 3, 4), rounded up
+        coarsen.SetInputConnection(build(vtkffd.vtkFFDBuildLattice.CUBIC_BSPLINE).GetOutputPort())
+        coarsen.SetMeshData(self.mesh)
+        into_trilinear = vtkffd.vtkFFDCoarsenLattice()
+        into_trilinear.SetInputConnection(build(vtkffd.vtkFFDBuildLattice.BERNSTEIN).GetOutputPort())
+        into_trilinear.SetMeshData(self.mesh)
+        into_trilinear.SetDivisions(3, 2, 2)
+        into_trilinear.SetBasis(vtkffd.vtkFFDBuildLattice.TRILINEAR)
+        for producer, dimensions in ((build(vtkffd.vtkFFDBuildLattice.BERNSTEIN), (3, 4, 5)),
+                                     (build(vtkffd.vtkFFDBuildLattice.TRIQUADRATIC_BEZIER), (5, 7, 9)),
+                                     (refine, (9, 13, 17)), (coarsen, (4, 5, 5)), (into_trilinear, (4, 3, 3))):
+            producer.Update()
             copy = vtkStructuredGrid()
-            copy.DeepCopy(build.GetOutput())
-            self.assertEqual(copy.GetDimensions(), dimensions)
+            copy.DeepCopy(producer.GetOutput())
+            self.assertEqual(copy.GetDimensions(), dimensions, producer.GetClassName())
             for consumer in (vtkDataSetSurfaceFilter, vtkExtractEdges):
                 downstream, alone = consumer(), consumer()
-                downstream.SetInputConnection(build.GetOutputPort())
+                downstream.SetInputConnection(producer.GetOutputPort())
                 alone.SetInputData(copy)
                 downstream.Update()
                 alone.Update()
-                self.assertGreater(alone.GetOutput().GetNumberOfCells(), 0)
-                self.assertEqual(downstream.GetOutput().GetNumberOfCells(), alone.GetOutput().GetNumberOfCells())
-                np.testing.assert_array_equal(points_of(downstream.GetOutput()), points_of(alone.GetOutput()))
+                what = f"{consumer.__name__} after {producer.GetClassName()}"
+                self.assertGreater(alone.GetOutput().GetNumberOfCells(), 0, what)
+                self.assertEqual(downstream.GetOutput().GetNumberOfCells(), alone.GetOutput().GetNumberOfCells(),
+                                 what)
+                np.testing.assert_array_equal(points_of(downstream.GetOutput()), points_of(alone.GetOutput()),
+                                              err_msg=what)
 
     def test_rest_lattice_leaves_mesh_unchanged(self):
         self.deform.SetOutputPointsPrecision(vtkAlgorithm.DEFAULT_PRECISION)
