@@ -101,7 +101,7 @@ def build_pipeline(path):
 
 
 def show_scene(view, mesh, lattice):
-    """Shows a mesh (ivory) and a lattice (red control points, dark grey edges) in `view`."""
+    """Shows a mesh (ivory) and a lattice (red control points, dark grey edges) in `view`; returns the displays."""
     mesh_display = Show(mesh, view)
     mesh_display.Representation = "Surface"
     mesh_display.ColorArrayName = ["POINTS", ""]
@@ -119,7 +119,7 @@ def show_scene(view, mesh, lattice):
     point_display.AmbientColor = point_display.DiffuseColor = [0.85, 0.1, 0.1]
     point_display.RenderPointsAsSpheres = 1
     point_display.PointSize = 14.0
-    return [mesh_display, edge_display, point_display], edges
+    return [mesh_display, edge_display, point_display]
 
 
 def frame_camera(view, bounds):
@@ -167,7 +167,7 @@ def main(argv):
     after_png = arguments.output_dir / f"{path.stem}_after.png"
     view = new_view(arguments.size)
     bounds = union_bounds(pipeline["mesh"], pipeline["lattice"], pipeline["deformed"], pipeline["moved"])
-    displays, edges = show_scene(view, pipeline["mesh"], pipeline["lattice"])
+    displays = show_scene(view, pipeline["mesh"], pipeline["lattice"])
     frame_camera(view, bounds)
     Render(view)
     SaveScreenshot(str(before_png), view, ImageResolution=list(arguments.size))

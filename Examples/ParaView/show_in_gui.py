@@ -11,7 +11,7 @@ run from the repository's folder: the GUI runs a --script as a string, with no _
 import importlib.util
 from pathlib import Path
 
-from paraview.simple import GetActiveViewOrCreate, Hide, Render, SetActiveSource
+from paraview.simple import GetActiveViewOrCreate, Render, SetActiveSource
 
 # The demo by its path: beside this file where Python knows it, else from the repository's folder.
 here = Path(__file__).resolve().parent if "__file__" in globals() else Path.cwd() / "Examples" / "ParaView"
@@ -26,7 +26,7 @@ demo.load_plugin(demo.PLUGIN)
 pipeline = demo.build_pipeline(demo.mesh_path("bear"))
 view = GetActiveViewOrCreate("RenderView")
 view.OrientationAxesVisibility = 0
-displays, edges = demo.show_scene(view, pipeline["deformed"], pipeline["moved"])
+demo.show_scene(view, pipeline["deformed"], pipeline["moved"])
 demo.frame_camera(view, demo.union_bounds(pipeline["deformed"], pipeline["moved"]))
 SetActiveSource(pipeline["deformed"])
 Render(view)
