@@ -266,17 +266,16 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
 
   // The finite points and their centroid, an exact sum over every process rounded once; a distributed mesh's
   // points shared by pieces (marked as copies in its ghost array) count once.
-  const vtkIdType numberOfPoints = input->GetNumberOfPoints();
-  vtkUnsignedCharArray* ghostArray = input->GetPointGhostArray();
-  const unsigned char* ghosts = ghostArray ? ghostArray->GetPointer(0) : nullptr;
+  const vtkSmartPointer<vtkDataArray> owned = vtkFFDOwnedPoints(input);
+  const vtkIdType numberOfOwned = owned->GetNumberOfTuples();
   std::vector<double> coordinates;
-  coordinates.reserve(3 * numberOfPoints);
+  coordinates.reserve(3 * numberOfOwned);
   std::vector<ffd::ExactSum> sums(4); // x, y, z, count
-  for (vtkIdType id = 0; id < numberOfPoints; ++id)
+  for (vtkIdType id = 0; id < numberOfOwned; ++id)
   {
     double x[3];
-    input->GetPoint(id, x);
-    if (vtkFFDIsOwnedPoint(ghosts, id) && std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))
+    owned->GetTuple(id, x);
+    if (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))
     {
       coordinates.insert(coordinates.end(), x, x + 3);
       for (int c = 0; c < 3; ++c)
@@ -411,7 +410,7 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   active->SetNumberOfValues(numberOfNodes);
   active->FillValue(0);
   const std::vector<int>& bound = binding.GetCellOfPoint();
-  for (vtkIdType id = 0; id < numberOfPoints; ++id)
+  for (vtkIdType id = 0; id < inputPoints->GetNumberOfPoints(); ++id)
   {
     if (bound[id] < 0)
     {

@@ -48,22 +48,23 @@ bool vtkFFDRequestOwnPiece(vtkMultiProcessController* controller, vtkInformation
 }
 
 //------------------------------------------------------------------------------
-bool vtkFFDIsOwnedPoint(const unsigned char* ghosts, vtkIdType id)
-{
-  return !ghosts || !(ghosts[id] & vtkDataSetAttributes::DUPLICATEPOINT);
-}
-
-//------------------------------------------------------------------------------
 vtkSmartPointer<vtkDataArray> vtkFFDOwnedPoints(vtkPointSet* input)
 {
+  if (!input->GetPoints()) // an empty piece
+  {
+    auto none = vtkSmartPointer<vtkDoubleArray>::New();
+    none->SetNumberOfComponents(3);
+    return none;
+  }
   vtkDataArray* points = input->GetPoints()->GetData();
   vtkUnsignedCharArray* ghostArray = input->GetPointGhostArray();
   const unsigned char* ghosts = ghostArray ? ghostArray->GetPointer(0) : nullptr;
+  auto isOwned = [ghosts](vtkIdType id) { return !ghosts || !(ghosts[id] & vtkDataSetAttributes::DUPLICATEPOINT); };
   const vtkIdType count = points->GetNumberOfTuples();
   vtkIdType owned = 0;
   for (vtkIdType id = 0; id < count; ++id)
   {
-    owned += vtkFFDIsOwnedPoint(ghosts, id) ? 1 : 0;
+    owned += isOwned(id) ? 1 : 0;
   }
   if (owned == count)
   {
@@ -74,7 +75,7 @@ vtkSmartPointer<vtkDataArray> vtkFFDOwnedPoints(vtkPointSet* input)
   copy->SetNumberOfTuples(owned);
   for (vtkIdType id = 0, next = 0; id < count; ++id)
   {
-    if (vtkFFDIsOwnedPoint(ghosts, id))
+    if (isOwned(id))
     {
       copy->SetTuple(next++, id, points);
     }

@@ -23,13 +23,11 @@ class vtkInformationVector;
 class vtkMultiProcessController;
 class vtkPointSet;
 
-/// The points of `input` that count in sums over processes: all of them, or, where its ghost array marks some
-/// as copies of another process's (DUPLICATEPOINT, as vtkGenerateGlobalIds marks the points that pieces share),
-/// a copy without those, so that each point of a mesh split among processes counts once.
+/// The points of `input` that count in sums over processes (an empty array for an empty piece): all of them,
+/// or, where its ghost array marks some as copies of another process's (DUPLICATEPOINT, as vtkGenerateGlobalIds
+/// marks the points that pieces share), a copy without those, so that each point of a mesh split among processes
+/// counts once.
 vtkSmartPointer<vtkDataArray> vtkFFDOwnedPoints(vtkPointSet* input);
-
-/// Whether the point `id` of an input with the point ghost array `ghosts` (or none) counts in sums.
-bool vtkFFDIsOwnedPoint(const unsigned char* ghosts, vtkIdType id);
 
 /// The update request of the filters whose output is the same on every process, built from every process's
 /// piece: with several processes, each asks its input for its own piece (without ghost levels), whatever was

@@ -4,25 +4,45 @@
 #include "vtkDemandDrivenPipeline.h"
 #include "vtkFFDBuildLattice.h"
 #include "vtkInformation.h"
+#include "vtkInformationIntegerVectorKey.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStructuredGrid.h"
 
 #include <string>
 
+namespace
+{
+/// An integer-vector key that every executive copies from a filter's first input to its outputs at
+/// REQUEST_INFORMATION, as vtkInformationDataObjectMetaDataKey does with data objects.
+class DownstreamIntegerVectorKey : public vtkInformationIntegerVectorKey
+{
+public:
+  DownstreamIntegerVectorKey(const char* name, int length)
+    : vtkInformationIntegerVectorKey(name, "vtkFFDPipelineKeys", length)
+  {
+  }
+  void CopyDefaultInformation(vtkInformation* request, vtkInformation* fromInfo, vtkInformation* toInfo) override
+  {
+    if (request->Has(vtkDemandDrivenPipeline::REQUEST_INFORMATION()))
+    {
+      this->ShallowCopy(fromInfo, toInfo);
+    }
+  }
+};
+} // namespace
+
 // Each key is registered with vtkInformationKeyLookup by its constructor, which deletes it at exit, as VTK's own.
 //------------------------------------------------------------------------------
 vtkInformationIntegerVectorKey* vtkFFDPipelineKeys::DIVISIONS()
 {
-  static vtkInformationIntegerVectorKey* const key =
-    new vtkFFDDownstreamIntegerVectorKey("DIVISIONS", "vtkFFDPipelineKeys", 3);
+  static vtkInformationIntegerVectorKey* const key = new DownstreamIntegerVectorKey("DIVISIONS", 3);
   return key;
 }
 
 //------------------------------------------------------------------------------
 vtkInformationIntegerVectorKey* vtkFFDPipelineKeys::BASIS()
 {
-  static vtkInformationIntegerVectorKey* const key =
-    new vtkFFDDownstreamIntegerVectorKey("BASIS", "vtkFFDPipelineKeys", 1);
+  static vtkInformationIntegerVectorKey* const key = new DownstreamIntegerVectorKey("BASIS", 1);
   return key;
 }
 
@@ -60,14 +80,4 @@ bool vtkFFDPipelineKeys::AnnouncedLattice(vtkInformation* inInfo, int& basis, in
   inInfo->Get(DIVISIONS(), divisions);
   basis = inInfo->Get(BASIS(), 0);
   return true;
-}
-
-//------------------------------------------------------------------------------
-void vtkFFDDownstreamIntegerVectorKey::CopyDefaultInformation(
-  vtkInformation* request, vtkInformation* fromInfo, vtkInformation* toInfo)
-{
-  if (request->Has(vtkDemandDrivenPipeline::REQUEST_INFORMATION()))
-  {
-    this->ShallowCopy(fromInfo, toInfo);
-  }
 }

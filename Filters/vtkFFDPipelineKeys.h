@@ -15,9 +15,8 @@
 #ifndef vtkFFDPipelineKeys_h
 #define vtkFFDPipelineKeys_h
 
-#include "vtkInformationIntegerVectorKey.h"
-
 class vtkInformation;
+class vtkInformationIntegerVectorKey;
 
 class vtkFFDPipelineKeys
 {
@@ -34,19 +33,6 @@ public:
   static void Forget(vtkInformation* outInfo);
   /// The divisions and basis that `inInfo` announces, if it announces both.
   static bool AnnouncedLattice(vtkInformation* inInfo, int& basis, int divisions[3]);
-};
-
-/// An integer-vector key that every executive copies from a filter's first input to its outputs, as
-/// vtkInformationDataObjectMetaDataKey does with data objects.
-class vtkFFDDownstreamIntegerVectorKey : public vtkInformationIntegerVectorKey
-{
-public:
-  vtkTypeMacro(vtkFFDDownstreamIntegerVectorKey, vtkInformationIntegerVectorKey);
-  vtkFFDDownstreamIntegerVectorKey(const char* name, const char* location, int length)
-    : vtkInformationIntegerVectorKey(name, location, length)
-  {
-  }
-  void CopyDefaultInformation(vtkInformation* request, vtkInformation* fromInfo, vtkInformation* toInfo) override;
 };
 
 #endif

@@ -273,10 +273,8 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
   {
     return 1; // an empty input gives an empty output
   }
-  vtkNew<vtkDoubleArray> none;
-  none->SetNumberOfComponents(3);
   // A distributed mesh's points shared by pieces count once: in the principal axes' sums above all.
-  const vtkSmartPointer<vtkDataArray> points = numPoints > 0 ? vtkFFDOwnedPoints(input) : none.Get();
+  const vtkSmartPointer<vtkDataArray> points = vtkFFDOwnedPoints(input);
   const int nx = this->Divisions[0], ny = this->Divisions[1], nz = this->Divisions[2];
   // Voxels and corners are found by their int64 linear index i + nx (j + ny k): the corners' count must fit.
   if ((nx + 1.0) * (ny + 1.0) * (nz + 1.0) >= 0x1p63)
