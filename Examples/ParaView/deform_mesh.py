@@ -102,24 +102,24 @@ def build_pipeline(path):
 
 def show_scene(view, mesh, lattice):
     """Shows a mesh (ivory) and a lattice (red control points, dark grey edges) in `view`; returns the displays."""
-    mesh_display = Show(mesh, view)
+    mesh_display = solid(Show(mesh, view), [0.93, 0.90, 0.82])
     mesh_display.Representation = "Surface"
-    mesh_display.ColorArrayName = ["POINTS", ""]
-    mesh_display.AmbientColor = mesh_display.DiffuseColor = [0.93, 0.90, 0.82]
     mesh_display.Specular = 0.2
     mesh_display.SpecularPower = 20.0
-    edges = ExtractEdges(Input=lattice)
-    edge_display = Show(edges, view)
-    edge_display.ColorArrayName = ["POINTS", ""]
-    edge_display.AmbientColor = edge_display.DiffuseColor = [0.25, 0.25, 0.25]
+    edge_display = solid(Show(ExtractEdges(Input=lattice), view), [0.25, 0.25, 0.25])
     edge_display.LineWidth = 2.0
-    point_display = Show(lattice, view)
+    point_display = solid(Show(lattice, view), [0.85, 0.1, 0.1])
     point_display.Representation = "Points"
-    point_display.ColorArrayName = ["POINTS", ""]
-    point_display.AmbientColor = point_display.DiffuseColor = [0.85, 0.1, 0.1]
     point_display.RenderPointsAsSpheres = 1
     point_display.PointSize = 14.0
     return [mesh_display, edge_display, point_display]
+
+
+def solid(display, colour):
+    """`display` in one colour, not coloured by an array; returns it."""
+    display.ColorArrayName = ["POINTS", ""]
+    display.AmbientColor = display.DiffuseColor = colour
+    return display
 
 
 def frame_camera(view, bounds):

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkCommonDataModel import vtkUnstructuredGrid
-from vtkmodules.vtkIOXML import vtkXMLGenericDataObjectReader, vtkXMLPolyDataReader
+from vtkmodules.vtkIOXML import vtkXMLGenericDataObjectReader
 
 import vtkffd
 
@@ -94,6 +94,22 @@ def cells(data):
     return np.array(data.GetDimensions()), np.zeros(0)
 
 
+def moved_and_deformed(mesh, lattice_filter, extrapolate=False):
+    """A copy of `lattice_filter`'s output moved by lattice_moves.py, as pvbatch's Programmable Filter moves it,
+    and `mesh` deformed by it (Extrapolate outside where asked)."""
+    lattice_filter.Update()
+    lattice = vtkUnstructuredGrid()
+    lattice.DeepCopy(lattice_filter.GetOutput())
+    move_control_points(lattice)
+    deform = vtkffd.vtkFFDDeform()
+    deform.SetInputData(mesh)
+    deform.SetLatticeData(lattice)
+    if extrapolate:
+        deform.SetOutsidePolicyToExtrapolate()
+    deform.Update()
+    return lattice, deform.GetOutput()
+
+
 def run_pipeline(folder, processes=1):
     """paraview_pipeline.py in pvbatch, on `processes` MPI processes; its outputs by name, a distributed one as
     the list of its pieces in process order."""
@@ -132,10 +148,7 @@ class Pipeline(ParaViewTestCase):
     """pvbatch against vtkffd (Debian's VTK): the same sources, compiled against two VTKs, give the same bits."""
 
     def reference(self):
-        reader = vtkXMLPolyDataReader()
-        reader.SetFileName(str(MESH))
-        reader.Update()
-        mesh = reader.GetOutput()
+        mesh = read(MESH)
         voxelize = vtkffd.vtkFFDVoxelize()
         voxelize.SetInputData(mesh)
         voxelize.SetDivisions(5, 6, 4)
@@ -144,28 +157,13 @@ class Pipeline(ParaViewTestCase):
         build.SetInputConnection(voxelize.GetOutputPort())
         build.SetBasisToCubicBSpline()
         build.SetLatticeFormToSparse()
-        build.Update()
-        lattice = vtkUnstructuredGrid()
-        lattice.DeepCopy(build.GetOutput())
-        move_control_points(lattice)
-        deform = vtkffd.vtkFFDDeform()
-        deform.SetInputData(mesh)
-        deform.SetLatticeData(lattice)
-        deform.Update()
         tetrahedral = vtkffd.vtkFFDBuildTetrahedralLattice()
         tetrahedral.SetInputData(mesh)
         tetrahedral.SetSubdivisionLevels(1)
-        tetrahedral.Update()
-        tetrahedra = vtkUnstructuredGrid()
-        tetrahedra.DeepCopy(tetrahedral.GetOutput())
-        move_control_points(tetrahedra)
-        tetrahedral_deform = vtkffd.vtkFFDDeform()
-        tetrahedral_deform.SetInputData(mesh)
-        tetrahedral_deform.SetLatticeData(tetrahedra)
-        tetrahedral_deform.SetOutsidePolicyToExtrapolate()
-        tetrahedral_deform.Update()
-        return {"mesh": mesh, "voxels": voxelize.GetOutput(), "lattice": lattice, "deformed": deform.GetOutput(),
-                "tetrahedra": tetrahedra, "tetrahedral_deformed": tetrahedral_deform.GetOutput()}
+        lattice, deformed = moved_and_deformed(mesh, build)
+        tetrahedra, tetrahedral_deformed = moved_and_deformed(mesh, tetrahedral, extrapolate=True)
+        return {"mesh": mesh, "voxels": voxelize.GetOutput(), "lattice": lattice, "deformed": deformed,
+                "tetrahedra": tetrahedra, "tetrahedral_deformed": tetrahedral_deformed}
 
     def test_pvbatch_equals_vtkffd(self):
         with tempfile.TemporaryDirectory() as folder:
@@ -252,10 +250,8 @@ open({report!r}, "w").write("%d %d\\n" % (voxels.NumberOfActiveVoxels, voxels.Ge
 """
 
     def expected_voxels(self):
-        reader = vtkXMLPolyDataReader()
-        reader.SetFileName(str(MESH))
         voxelize = vtkffd.vtkFFDVoxelize()
-        voxelize.SetInputConnection(reader.GetOutputPort())
+        voxelize.SetInputData(read(MESH))
         voxelize.SetDivisions(3, 3, 3)
         voxelize.Update()
         return voxelize.GetNumberOfActiveVoxels()
