@@ -237,11 +237,10 @@ int vtkFFDBuildLattice::RequestData(
                   << " field array (3 ints >= 1): connect the output of vtkFFDVoxelize.");
     return 0;
   }
-  if (ffd::CheckFrame(frame) != ffd::FrameStatus::Valid)
+  if (const ffd::FrameStatus status = ffd::CheckFrame(frame); status != ffd::FrameStatus::Valid)
   {
-    vtkErrorMacro(<< "The input's " << vtkFFDDataContract::FrameArrayName()
-                  << " has (nearly) zero volume: its edge vectors S, T, U must be linearly independent; "
-                     "connect the output of vtkFFDVoxelize or fix the frame.");
+    vtkErrorMacro(<< "The input's " << vtkFFDDataContract::FrameArrayName() << " "
+                  << ffd::DescribeFrameStatus(status) << ": connect the output of vtkFFDVoxelize or fix the frame.");
     return 0;
   }
   const bool sparse = IsSparse(this->LatticeForm, this->Basis);

@@ -52,6 +52,57 @@ bool IsFinite(const Tuple& p)
     std::isfinite(static_cast<double>(p[2]));
 }
 
+/// Whether Divisions can be voxelized; else an error of `self`. RequestInformation and RequestData both check:
+/// ParaView's executive still calls RequestData after RequestInformation failed.
+bool CheckDivisions(vtkFFDVoxelize* self, const int n[3])
+{
+  if (n[0] < 1 || n[1] < 1 || n[2] < 1)
+  {
+    vtkErrorWithObjectMacro(self, << "Divisions (" << n[0] << ", " << n[1] << ", " << n[2]
+                                  << ") must be at least 1 on every axis: set Divisions (SetDivisions()) to "
+                                     "positive numbers.");
+    return false;
+  }
+  // Voxels and corners are found by their int64 linear index i + nx (j + ny k): the corners' count must fit.
+  if ((n[0] + 1.0) * (n[1] + 1.0) * (n[2] + 1.0) >= 0x1p63)
+  {
+    vtkErrorWithObjectMacro(self, << "Divisions (" << n[0] << ", " << n[1] << ", " << n[2]
+                                  << ") have more voxel corners than a 64-bit index counts: use at most 2^21 "
+                                     "divisions per axis, or fewer on the others.");
+    return false;
+  }
+  return true;
+}
+
+/// Whether the frame of `self` can be used; else an error that names the setting to change.
+bool CheckFrame(vtkFFDVoxelize* self, const double frame[12])
+{
+  const ffd::FrameStatus status = ffd::CheckFrame(frame);
+  if (status == ffd::FrameStatus::Valid)
+  {
+    return true;
+  }
+  std::ostringstream fix;
+  const double padding = self->GetPadding();
+  if (self->GetFrameMode() == vtkFFDVoxelize::EXPLICIT)
+  {
+    fix << "give the explicit frame (SetFrame(), FrameOrigin, FrameS, FrameT, FrameU) finite, linearly independent "
+           "edge vectors S, T, U.";
+  }
+  else if (!std::isfinite(padding) || status != ffd::FrameStatus::ZeroVolume)
+  {
+    fix << "Padding " << padding << " times the input's extent does not give a finite frame: set Padding "
+        << "(SetPadding()) to a finite fraction such as 0.05.";
+  }
+  else
+  {
+    fix << "the input is flat; set Padding (SetPadding()) above 0 or give an explicit frame.";
+  }
+  vtkErrorWithObjectMacro(self, << "The " << self->GetFrameModeAsString() << " frame "
+                                << ffd::DescribeFrameStatus(status) << ": " << fix.str());
+  return false;
+}
+
 /// A box along three orthonormal axes: the points a + sum_c x_c axis_c with x_c in [Min_c, Max_c].
 struct OrientedBox
 {
@@ -233,11 +284,8 @@ int vtkFFDVoxelize::FillInputPortInformation(int, vtkInformation* info)
 //------------------------------------------------------------------------------
 int vtkFFDVoxelize::RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  const int* n = this->Divisions;
-  if (n[0] < 1 || n[1] < 1 || n[2] < 1)
+  if (!CheckDivisions(this, this->Divisions))
   {
-    vtkErrorMacro(<< "Divisions (" << n[0] << ", " << n[1] << ", " << n[2]
-                  << ") must be at least 1 on every axis: call SetDivisions() with positive numbers.");
     return 0;
   }
   outputVector->GetInformationObject(0)->Set(vtkFFDPipelineKeys::DIVISIONS(), this->Divisions, 3);
@@ -275,15 +323,11 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
   }
   // A distributed mesh's points shared by pieces count once: in the principal axes' sums above all.
   const vtkSmartPointer<vtkDataArray> points = vtkFFDOwnedPoints(input);
-  const int nx = this->Divisions[0], ny = this->Divisions[1], nz = this->Divisions[2];
-  // Voxels and corners are found by their int64 linear index i + nx (j + ny k): the corners' count must fit.
-  if ((nx + 1.0) * (ny + 1.0) * (nz + 1.0) >= 0x1p63)
+  if (!CheckDivisions(this, this->Divisions))
   {
-    vtkErrorMacro(<< "Divisions (" << nx << ", " << ny << ", " << nz
-                  << ") have more voxel corners than a 64-bit index counts: use at most 2^21 divisions per "
-                     "axis, or fewer on the others.");
     return 0;
   }
+  const int nx = this->Divisions[0], ny = this->Divisions[1], nz = this->Divisions[2];
 
   // Phase 1: the frame.
   double frame[12];
@@ -321,20 +365,9 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
     }
     box.ToFrame(this->Padding, frame);
   }
-  switch (ffd::CheckFrame(frame))
+  if (!CheckFrame(this, frame))
   {
-    case ffd::FrameStatus::NonFinite:
-      vtkErrorMacro(<< "The " << this->GetFrameModeAsString()
-                    << " frame has a NaN or infinite component: give SetFrame() finite numbers.");
-      return 0;
-    case ffd::FrameStatus::ZeroVolume:
-      vtkErrorMacro(<< "The " << this->GetFrameModeAsString() << " frame has (nearly) zero volume: "
-                    << (this->FrameMode == EXPLICIT
-                           ? "give SetFrame() three linearly independent edge vectors S, T, U."
-                           : "the input is flat; set a Padding above 0 or an explicit frame."));
-      return 0;
-    case ffd::FrameStatus::Valid:
-      break;
+    return 0;
   }
   this->UpdateProgress(0.1);
   if (this->GetAbortExecute())

@@ -33,7 +33,8 @@
  * not matter). Every process must execute the filter then, an empty piece too.
  *
  * Non-finite input points are ignored. An empty input gives an empty output without an error. Divisions below
- * one or with more corners than an int64 counts, a flat or non-finite frame are errors.
+ * one or with more corners than an int64 counts, a flat or non-finite frame, or one whose volume overflows double
+ * precision (a huge Padding) are errors, checked in RequestData too.
  *
  * @sa vtkFFDBuildLattice vtkFFDDeform vtkFFDDataContract
  */

@@ -25,10 +25,22 @@ enum class FrameStatus
   Valid,
   NonFinite,  ///< a component is NaN or infinite
   ZeroVolume, ///< S, T, U are (nearly) linearly dependent: no inverse parameter map
+  OutOfRange, ///< S, T, U are so long or so short that their volume or dual basis is not a finite double
 };
 
 /// Relative volume |det(S,T,U)| / (|S||T||U|) under which a frame counts as flat.
 constexpr double MinimumRelativeFrameVolume = 1e-12;
+
+/// The dual basis of edges S, T, U (equation 2): the rows of d(s,t,u)/dX, in double precision.
+inline void DualBasis(const Vec3<double>& s, const Vec3<double>& t, const Vec3<double>& u, Vec3<double> dual[3])
+{
+  const Vec3<double> tu = Cross(t, u);
+  const Vec3<double> su = Cross(s, u);
+  const Vec3<double> st = Cross(s, t);
+  dual[0] = (1.0 / Dot(tu, s)) * tu;
+  dual[1] = (1.0 / Dot(su, t)) * su;
+  dual[2] = (1.0 / Dot(st, u)) * st;
+}
 
 /// Checks the 12 numbers X0, S, T, U of a frame. Host only: it runs once per update, not per point.
 inline FrameStatus CheckFrame(const double frame[12])
@@ -40,16 +52,54 @@ inline FrameStatus CheckFrame(const double frame[12])
       return FrameStatus::NonFinite;
     }
   }
-  const Vec3<double> s = Vec3<double>::From(frame + 3);
-  const Vec3<double> t = Vec3<double>::From(frame + 6);
-  const Vec3<double> u = Vec3<double>::From(frame + 9);
-  const double lengths = std::sqrt(Dot(s, s) * Dot(t, t) * Dot(u, u));
-  const double volume = std::fabs(Dot(Cross(s, t), u));
-  if (!(lengths > 0.0) || !std::isfinite(lengths) || volume <= MinimumRelativeFrameVolume * lengths)
+  const Vec3<double> edges[3] = { Vec3<double>::From(frame + 3), Vec3<double>::From(frame + 6),
+    Vec3<double>::From(frame + 9) };
+  // Flatness is relative, |det(S,T,U)| / (|S||T||U|): computed on the edges divided by their largest component,
+  // so that no product overflows or underflows whatever the frame's size.
+  Vec3<double> unit[3];
+  for (int e = 0; e < 3; ++e)
+  {
+    const double largest = std::fmax(std::fabs(edges[e].x), std::fmax(std::fabs(edges[e].y), std::fabs(edges[e].z)));
+    if (!(largest > 0.0))
+    {
+      return FrameStatus::ZeroVolume;
+    }
+    const Vec3<double> scaled = { edges[e].x / largest, edges[e].y / largest, edges[e].z / largest };
+    unit[e] = (1.0 / std::sqrt(Dot(scaled, scaled))) * scaled;
+  }
+  if (!(std::fabs(Dot(Cross(unit[0], unit[1]), unit[2])) > MinimumRelativeFrameVolume))
   {
     return FrameStatus::ZeroVolume;
   }
+  // The parameter map divides by the volume itself: it and the dual basis must be finite doubles.
+  Vec3<double> dual[3];
+  DualBasis(edges[0], edges[1], edges[2], dual);
+  for (const Vec3<double>& d : dual)
+  {
+    if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z) || (d.x == 0.0 && d.y == 0.0 && d.z == 0.0))
+    {
+      return FrameStatus::OutOfRange;
+    }
+  }
   return FrameStatus::Valid;
+}
+
+/// What is wrong with a frame of that status, for error messages ("The frame " + ...).
+inline const char* DescribeFrameStatus(FrameStatus status)
+{
+  switch (status)
+  {
+    case FrameStatus::NonFinite:
+      return "has a NaN or infinite component";
+    case FrameStatus::ZeroVolume:
+      return "has (nearly) zero volume: its edge vectors S, T, U are (nearly) linearly dependent";
+    case FrameStatus::OutOfRange:
+      return "has edge vectors so long or so short that its volume overflows or underflows double precision: "
+             "scale the data towards unit size";
+    case FrameStatus::Valid:
+      break;
+  }
+  return "is valid";
 }
 
 /// Half-width, in parameter units, of the band around the frame's faces that still counts as inside.
@@ -69,17 +119,10 @@ struct Frame
   /// The caller has checked the numbers with CheckFrame().
   static Frame FromArray(const double f[12])
   {
-    const Vec3<double> s = Vec3<double>::From(f + 3);
-    const Vec3<double> t = Vec3<double>::From(f + 6);
-    const Vec3<double> u = Vec3<double>::From(f + 9);
-    const Vec3<double> tu = Cross(t, u);
-    const Vec3<double> su = Cross(s, u);
-    const Vec3<double> st = Cross(s, t);
-    const Vec3<double> ds = (1.0 / Dot(tu, s)) * tu;
-    const Vec3<double> dt = (1.0 / Dot(su, t)) * su;
-    const Vec3<double> du = (1.0 / Dot(st, u)) * st;
+    Vec3<double> dual[3];
+    DualBasis(Vec3<double>::From(f + 3), Vec3<double>::From(f + 6), Vec3<double>::From(f + 9), dual);
     return { Vec3<Real>::From(f), Vec3<Real>::From(f + 3), Vec3<Real>::From(f + 6), Vec3<Real>::From(f + 9),
-      Vec3<Real>::From(&ds.x), Vec3<Real>::From(&dt.x), Vec3<Real>::From(&du.x) };
+      Vec3<Real>::From(&dual[0].x), Vec3<Real>::From(&dual[1].x), Vec3<Real>::From(&dual[2].x) };
   }
 
   /// Equation 2: (s, t, u) of a point.

@@ -13,8 +13,11 @@
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkIdList.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
 #include "vtkIntArray.h"
 #include "vtkNew.h"
+#include "vtkObjectFactory.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSMPTools.h"
@@ -651,6 +654,47 @@ TEST(vtkFFDVoxelize, DivisionsBelowOneAreAnError)
   }
 }
 
+namespace
+{
+/// vtkFFDVoxelize with RequestData callable alone: ParaView's executive still calls RequestData after
+/// RequestInformation failed, so RequestData must check the settings it computes with.
+class VoxelizeRequestDataOnly : public vtkFFDVoxelize
+{
+public:
+  static VoxelizeRequestDataOnly* New();
+  vtkTypeMacro(VoxelizeRequestDataOnly, vtkFFDVoxelize);
+
+  int Run(vtkPointSet* input, vtkUnstructuredGrid* output)
+  {
+    vtkNew<vtkInformation> inputInfo, outputInfo;
+    inputInfo->Set(vtkDataObject::DATA_OBJECT(), input);
+    outputInfo->Set(vtkDataObject::DATA_OBJECT(), output);
+    vtkNew<vtkInformationVector> inputs, outputs;
+    inputs->Append(inputInfo);
+    outputs->Append(outputInfo);
+    vtkInformationVector* inputPorts[1] = { inputs };
+    return this->RequestData(nullptr, inputPorts, outputs);
+  }
+};
+vtkStandardNewMacro(VoxelizeRequestDataOnly);
+} // namespace
+
+TEST(vtkFFDVoxelize, RequestDataAloneRefusesBadDivisions)
+{
+  vtkSmartPointer<vtkPolyData> cloud = PointCloud({ { 0, 0, 0 }, { 1, 1, 1 } });
+  for (const Voxel& n : { Voxel{ 0, 4, 4 }, Voxel{ 4, -1, 4 }, Voxel{ 4, 4, 0 }, Voxel{ VTK_INT_MAX, VTK_INT_MAX, 2 } })
+  {
+    vtkNew<VoxelizeRequestDataOnly> voxelize;
+    vtkNew<FFDTestErrorObserver> observer;
+    voxelize->AddObserver(vtkCommand::ErrorEvent, observer);
+    voxelize->SetDivisions(n[0], n[1], n[2]);
+    vtkNew<vtkUnstructuredGrid> output;
+    EXPECT_EQ(voxelize->Run(cloud, output), 0); // before the check there: SIGFPE in the voxel index
+    EXPECT_NE(observer->Errors.find("Divisions ("), std::string::npos) << observer->Errors;
+    EXPECT_EQ(output->GetNumberOfCells(), 0);
+  }
+}
+
 TEST(vtkFFDVoxelize, DivisionsBeyondA64BitIndexAreAnError)
 {
   // Voxels and corners are found by their linear index, an int64: (2^31)^2 * 3 corners overflow it.
@@ -684,6 +728,31 @@ TEST(vtkFFDVoxelize, BadExplicitFramesAreAnError)
     voxelize->SetFrameModeToExplicit();
     voxelize->SetFrame(o, s, t, u);
     ExpectFailure(voxelize, cloud, "NaN or infinite");
+  }
+  // Finite numbers whose volume overflows double precision were reported as a flat frame.
+  const double huge[3][3] = { { 1e308, 0, 0 }, { 0, 1e308, 0 }, { 0, 0, 1e308 } };
+  {
+    vtkNew<vtkFFDVoxelize> voxelize;
+    voxelize->SetFrameModeToExplicit();
+    voxelize->SetFrame(o, huge[0], huge[1], huge[2]);
+    ExpectFailure(voxelize, cloud, "overflows or underflows");
+  }
+}
+
+TEST(vtkFFDVoxelize, PaddingThatOverflowsTheFrameIsAnError)
+{
+  // SetPadding(inf) clamps to the largest double, whose frame overflows: the error names Padding, not flatness.
+  vtkSmartPointer<vtkPolyData> cloud = PointCloud({ { 0, 0, 0 }, { 1, 1, 1 } });
+  for (double padding : { std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN(), 1e308 })
+  {
+    for (int mode : { vtkFFDVoxelize::AXIS_ALIGNED, vtkFFDVoxelize::PRINCIPAL_AXES })
+    {
+      SCOPED_TRACE(padding);
+      vtkNew<vtkFFDVoxelize> voxelize;
+      voxelize->SetFrameMode(mode);
+      voxelize->SetPadding(padding);
+      ExpectFailure(voxelize, cloud, "set Padding (SetPadding()) to a finite fraction");
+    }
   }
 }
 

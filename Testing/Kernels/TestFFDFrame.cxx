@@ -220,6 +220,28 @@ TEST(FFDCheckFrame, NonFinite)
   }
 }
 
+TEST(FFDCheckFrame, OutOfRange)
+{
+  // Finite edges whose volume or dual basis is not a finite, nonzero double: the parameter map cannot be built.
+  ffdtest::Rng rng(208);
+  for (int trial = 0; trial < NumberOfFrames; ++trial)
+  {
+    double a[12];
+    ffdtest::FrameToArray(ffdtest::RandomFrame(rng), a);
+    for (double scale : { 1e250, 1e-250 })
+    {
+      double scaled[12];
+      for (int c = 0; c < 12; ++c)
+      {
+        scaled[c] = scale * a[c];
+      }
+      EXPECT_EQ(ffd::CheckFrame(scaled), ffd::FrameStatus::OutOfRange) << "scale " << scale;
+    }
+  }
+  const double huge[12] = { 0, 0, 0, 1e308, 0, 0, 0, 1e308, 0, 0, 0, 1e308 };
+  EXPECT_EQ(ffd::CheckFrame(huge), ffd::FrameStatus::OutOfRange);
+}
+
 TEST(FFDCheckFrame, ZeroVolume)
 {
   ffdtest::Rng rng(207);
