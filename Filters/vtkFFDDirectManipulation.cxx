@@ -4,6 +4,7 @@
 #include "vtkDoubleArray.h"
 #include "vtkFFDDeform.h"
 #include "vtkFFDGridDeformer.h"
+#include "vtkFFDInputChecks.h"
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDTetrahedralDeformer.h"
@@ -26,6 +27,62 @@
 #include <sstream>
 
 vtkStandardNewMacro(vtkFFDDirectManipulation);
+
+namespace
+{
+bool IsFinite(const double x[3])
+{
+  return std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
+}
+
+/// The targets' mesh points at rest, into `rest`; an empty string, or why the targets cannot be used.
+std::string ReadTargets(vtkIdTypeArray* ids, vtkPoints* positions, vtkPointSet* mesh, vtkPoints* rest)
+{
+  const vtkIdType count = ids->GetNumberOfValues();
+  rest->SetNumberOfPoints(count);
+  std::ostringstream why;
+  for (vtkIdType t = 0; t < count; ++t)
+  {
+    const vtkIdType id = ids->GetValue(t);
+    if (id < 0 || id >= mesh->GetNumberOfPoints())
+    {
+      why << "Target " << t << " names mesh point " << id << "; the mesh has " << mesh->GetNumberOfPoints()
+          << " points: give SetTargetPointIds() ids from 0 to " << mesh->GetNumberOfPoints() - 1 << ".";
+      return why.str();
+    }
+    double x[3], target[3];
+    mesh->GetPoint(id, x);
+    positions->GetPoint(t, target);
+    if (!IsFinite(x))
+    {
+      why << "Target " << t << " names mesh point " << id << ", whose coordinates (" << x[0] << ", " << x[1] << ", "
+          << x[2] << ") are not finite: it has no place in the lattice; remove it from SetTargetPointIds().";
+      return why.str();
+    }
+    if (!IsFinite(target))
+    {
+      why << "Target position " << t << " (" << target[0] << ", " << target[1] << ", " << target[2]
+          << ") is not finite: give SetTargetPositions() finite world coordinates.";
+      return why.str();
+    }
+    rest->SetPoint(t, x);
+  }
+  return why.str();
+}
+
+/// dP = W^+ (T - F), or W^T (W W^T + lambda I)^-1 (T - F) with lambda = `regularization` times mean(diag W W^T).
+Eigen::MatrixXd SolveMove(const Eigen::MatrixXd& w, const Eigen::MatrixXd& change, double regularization)
+{
+  if (regularization > 0)
+  {
+    Eigen::MatrixXd gram = w * w.transpose();
+    const double lambda = regularization * gram.diagonal().mean();
+    gram.diagonal().array() += lambda > 0 ? lambda : regularization;
+    return w.transpose() * gram.ldlt().solve(change);
+  }
+  return Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(w).solve(change);
+}
+} // namespace
 
 //------------------------------------------------------------------------------------------------------------
 vtkFFDDirectManipulation::vtkFFDDirectManipulation()
@@ -106,6 +163,21 @@ vtkTypeBool vtkFFDDirectManipulation::ProcessRequest(
 }
 
 //------------------------------------------------------------------------------------------------------------
+int vtkFFDDirectManipulation::RequestDataObject(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (!(vtkFFDCheckInput(this, inputVector[0], 0, "vtkPointSet", "the lattice",
+          "SetInputConnection() to the lattice to move, the output of vtkFFDBuildLattice or "
+          "vtkFFDBuildTetrahedralLattice.") &&
+        vtkFFDCheckInput(this, inputVector[1], 1, "vtkPointSet", "the mesh",
+          "SetMeshConnection() to the mesh at rest that the lattice deforms.", true)))
+  {
+    return vtkFFDEmptyOutputs(outputVector);
+  }
+  return this->Superclass::RequestDataObject(request, inputVector, outputVector);
+}
+
+//------------------------------------------------------------------------------------------------------------
 int vtkFFDDirectManipulation::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -139,21 +211,23 @@ int vtkFFDDirectManipulation::RequestData(
     return 0;
   }
 
+  if (!std::isfinite(this->Regularization) || this->Regularization < 0)
+  {
+    vtkErrorMacro(<< "Regularization is " << this->Regularization
+                  << ": give SetRegularization() a finite number >= 0 (0, the default: the pseudo-inverse).");
+    output->Initialize();
+    return 0;
+  }
+
   // The targets' rest points, and where the lattice takes them now.
   vtkNew<vtkPoints> rest;
   rest->SetDataTypeToDouble();
-  rest->SetNumberOfPoints(count);
-  for (vtkIdType t = 0; t < count; ++t)
+  const std::string unusable = ReadTargets(this->TargetPointIds, this->TargetPositions, mesh, rest);
+  if (!unusable.empty())
   {
-    const vtkIdType id = this->TargetPointIds->GetValue(t);
-    if (id < 0 || id >= mesh->GetNumberOfPoints())
-    {
-      vtkErrorMacro(<< "Target " << t << " names mesh point " << id << "; the mesh has " << mesh->GetNumberOfPoints()
-                    << " points.");
-      output->Initialize();
-      return 0;
-    }
-    rest->SetPoint(t, mesh->GetPoint(id));
+    vtkErrorMacro(<< unusable);
+    output->Initialize();
+    return 0;
   }
   vtkNew<vtkPolyData> targets;
   targets->SetPoints(rest);
@@ -218,10 +292,27 @@ int vtkFFDDirectManipulation::RequestData(
   {
     vtkWarningMacro(<< outside << " of the " << count << " targets lie outside the lattice: they cannot be moved.");
   }
+  // The distance from target t to where the lattice takes its point now.
+  auto apart = [&](vtkIdType t)
+  {
+    double target[3], at[3];
+    this->TargetPositions->GetPoint(t, target);
+    now->GetPoint(t, at);
+    return std::sqrt(vtkMath::Distance2BetweenPoints(target, at));
+  };
   std::map<vtkIdType, Eigen::Index> column;
   for (const Entry& e : entries)
   {
     column.emplace(e.ControlPoint, 0);
+  }
+  if (column.empty())
+  {
+    // No target inside: no control point can move them (and W would have no column to decompose).
+    for (vtkIdType t = 0; t < count; ++t)
+    {
+      this->MaximumTargetDistance = std::max(this->MaximumTargetDistance, apart(t));
+    }
+    return 1;
   }
   std::vector<vtkIdType> controlPoints;
   for (auto& c : column)
@@ -253,22 +344,12 @@ int vtkFFDDirectManipulation::RequestData(
     }
   }
 
-  // dP = W^+ (T - F), or W^T (W W^T + lambda I)^-1 (T - F).
-  Eigen::MatrixXd move;
-  if (this->Regularization > 0)
-  {
-    Eigen::MatrixXd gram = w * w.transpose();
-    const double lambda = this->Regularization * gram.diagonal().mean();
-    gram.diagonal().array() += lambda > 0 ? lambda : this->Regularization;
-    move = w.transpose() * gram.ldlt().solve(change);
-  }
-  else
-  {
-    move = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(w).solve(change);
-  }
+  const Eigen::MatrixXd move = SolveMove(w, change, this->Regularization);
   if (!move.allFinite())
   {
-    vtkErrorMacro(<< "The solve failed: set a Regularization above 0.");
+    vtkErrorMacro(<< "The solve failed with Regularization " << this->Regularization
+                  << (this->Regularization > 0 ? ": give SetRegularization() a smaller number."
+                                               : ": set a Regularization above 0."));
     output->Initialize();
     return 0;
   }
@@ -291,15 +372,8 @@ int vtkFFDDirectManipulation::RequestData(
   const Eigen::MatrixXd missed = change - w * move;
   for (vtkIdType t = 0; t < count; ++t)
   {
-    double distance = missed.row(t).norm();
-    if (cellOf[t] < 0)
-    {
-      double target[3], at[3];
-      this->TargetPositions->GetPoint(t, target);
-      now->GetPoint(t, at);
-      distance = std::sqrt(vtkMath::Distance2BetweenPoints(target, at));
-    }
-    this->MaximumTargetDistance = std::max(this->MaximumTargetDistance, distance);
+    this->MaximumTargetDistance =
+      std::max(this->MaximumTargetDistance, cellOf[t] < 0 ? apart(t) : missed.row(t).norm());
   }
   return 1;
 }

@@ -15,7 +15,10 @@
  * of diag W W^T): regularised least squares, which meets the targets less closely and moves less.
  *
  * Only control points whose support holds a target move (the columns of W); the others keep their coordinates
- * bit for bit. A target whose mesh point lies outside the lattice cannot be moved (a warning says how many).
+ * bit for bit. A target whose mesh point lies outside the lattice cannot be moved (a warning says how many;
+ * where none is inside, the output is the lattice as it is). An id that names no mesh point, a mesh point or a
+ * target position that is not finite, and a Regularization that is not a finite number >= 0 are errors that
+ * leave the output empty.
  * GetMaximumTargetDistance() is the largest distance between a target and its deformed point afterwards (0 up to
  * rounding where the targets can be met).
  *
@@ -70,6 +73,8 @@ protected:
   ~vtkFFDDirectManipulation() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
+  /// Checks the inputs first: one clear error where one is missing or of the wrong type.
+  int RequestDataObject(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   vtkTypeBool ProcessRequest(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 

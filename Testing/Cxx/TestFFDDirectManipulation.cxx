@@ -9,6 +9,7 @@
 // the frame's diagonal bounds both for the well-separated targets used here (kappa < 1e3 measured).
 
 #include "FFDTestErrorObserver.h"
+#include "FFDTestInputChecks.h"
 #include "FFDTestLattices.h"
 #include "FFDTestMeshes.h"
 
@@ -21,8 +22,10 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 #include <set>
+#include <vector>
 
 namespace
 {
@@ -324,7 +327,8 @@ TEST(vtkFFDDirectManipulation, RefusesBadTargets)
     int Positions;
     const char* Says;
   };
-  for (const Case& c : { Case{ cow->GetNumberOfPoints(), 1, "names mesh point" }, Case{ 3, 2, "one position per id" } })
+  for (const Case& c : { Case{ cow->GetNumberOfPoints(), 1, "names mesh point" }, Case{ -1, 1, "names mesh point" },
+         Case{ 3, 2, "one position per id" } })
   {
     Targets targets;
     targets.Ids->InsertNextValue(c.Id);
@@ -351,4 +355,97 @@ TEST(vtkFFDDirectManipulation, RefusesBadTargets)
   manipulate->SetTargetPositions(targets.Positions);
   manipulate->Update();
   EXPECT_NE(errors->Errors.find("SetMeshConnection"), std::string::npos) << errors->Errors;
+}
+
+// Issue 30, item 7: targets whose mesh points are all outside the lattice left W without a column, and Eigen's
+// decomposition of a count x 0 matrix crashed. Now nothing moves (the lattice as it is, bit for bit), a warning
+// says why, and the distance reported is each target's from its point, which keeps its place outside.
+TEST(vtkFFDDirectManipulation, TargetsAllOutsideTheLatticeMoveNothing)
+{
+  vtkSmartPointer<vtkPolyData> cow = ReadTestMesh("cow");
+  std::mt19937 rng(25);
+  const int n[3] = { 3, 3, 3 };
+  for (int form : { vtkFFDBuildLattice::DENSE, vtkFFDBuildLattice::SPARSE })
+  {
+    vtkSmartPointer<vtkPointSet> lattice =
+      ffdtest::MovedLattice(cow, vtkFFDBuildLattice::TRILINEAR, n, form, rng, 0.02);
+    const double size = ffdtest::Diagonal(ffdtest::FrameOf(lattice));
+    vtkSmartPointer<vtkPolyData> far = PointCloud({ { 10 * size, 0, 0 }, { 0, -10 * size, 3 * size } });
+    Targets targets;
+    for (vtkIdType id : { 0, 1 })
+    {
+      double x[3];
+      far->GetPoint(id, x);
+      targets.Ids->InsertNextValue(id);
+      targets.Positions->InsertNextPoint(x[0] + 0.1 * size * (id + 1), x[1], x[2]); // 0.1 and 0.2 size away
+    }
+    vtkNew<vtkFFDDirectManipulation> manipulate;
+    vtkNew<FFDTestErrorObserver> errors;
+    errors->WatchWithExecutive(manipulate);
+    vtkSmartPointer<vtkPointSet> moved = Manipulate(lattice, far, targets, manipulate);
+    EXPECT_EQ(errors->Errors, "");
+    EXPECT_NE(errors->Warnings.find("2 of the 2 targets lie outside the lattice"), std::string::npos)
+      << errors->Warnings;
+    ASSERT_EQ(moved->GetNumberOfPoints(), lattice->GetNumberOfPoints());
+    EXPECT_TRUE(ffdtest::SamePoints(moved, lattice));
+    EXPECT_EQ(manipulate->GetNumberOfMovedControlPoints(), 0);
+    EXPECT_NEAR(manipulate->GetMaximumTargetDistance(), 0.2 * size, 1e-14 * size);
+  }
+}
+
+// Issue 30, item 7: a target naming a mesh point with a non-finite coordinate crashed the solve (every target
+// such a point: W without a column). A non-finite target position, or a NaN Regularization, went on to a
+// non-finite solve. Each is an error that names the target or setting, with an empty output.
+TEST(vtkFFDDirectManipulation, RefusesNonFiniteTargetsAndSettings)
+{
+  vtkSmartPointer<vtkPolyData> cow = ReadTestMesh("cow");
+  std::mt19937 rng(26);
+  const int n[3] = { 3, 3, 3 };
+  vtkSmartPointer<vtkPointSet> lattice =
+    ffdtest::MovedLattice(cow, vtkFFDBuildLattice::TRILINEAR, n, vtkFFDBuildLattice::DENSE, rng, 0.0);
+  vtkNew<vtkPolyData> broken;
+  broken->DeepCopy(cow);
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  broken->GetPoints()->SetPoint(7, nan, 0, 0);
+  broken->GetPoints()->SetPoint(8, 0, inf, 0);
+  struct Case
+  {
+    std::vector<vtkIdType> Ids;
+    double Position;
+    double Regularization;
+    const char* Says;
+  };
+  for (const Case& c : { Case{ { 7 }, 0.0, 0.0, "names mesh point 7, whose coordinates" },
+         Case{ { 8, 7 }, 0.0, 0.0, "names mesh point 8, whose coordinates" },
+         Case{ { 9, 7 }, 0.0, 0.0, "Target 1 names mesh point 7" }, Case{ { 9 }, nan, 0.0, "Target position 0" },
+         Case{ { 9 }, -inf, 0.0, "Target position 0" }, Case{ { 9 }, 0.0, nan, "SetRegularization()" } })
+  {
+    Targets targets;
+    for (vtkIdType id : c.Ids)
+    {
+      targets.Ids->InsertNextValue(id);
+      targets.Positions->InsertNextPoint(c.Position, 0, 0);
+    }
+    vtkNew<vtkFFDDirectManipulation> manipulate;
+    manipulate->SetRegularization(c.Regularization);
+    vtkNew<FFDTestErrorObserver> errors;
+    errors->WatchWithExecutive(manipulate);
+    Manipulate(lattice, broken, targets, manipulate);
+    EXPECT_NE(errors->Errors.find(c.Says), std::string::npos) << errors->Errors;
+    EXPECT_EQ(manipulate->GetOutput()->GetNumberOfPoints(), 0) << c.Says;
+  }
+}
+
+// Issue 30, item 17: a missing or wrong-typed input failed with only the executive's "returned failure".
+TEST(vtkFFDDirectManipulation, SaysWhichInputIsMissingOrWrong)
+{
+  vtkSmartPointer<vtkPolyData> cow = ReadTestMesh("cow");
+  std::mt19937 rng(27);
+  const int n[3] = { 2, 2, 2 };
+  vtkNew<vtkFFDDirectManipulation> manipulate;
+  manipulate->SetInputData(
+    ffdtest::MovedLattice(cow, vtkFFDBuildLattice::TRILINEAR, n, vtkFFDBuildLattice::DENSE, rng, 0.0));
+  manipulate->SetMeshData(cow);
+  ffdtest::ExpectClearInputErrors(manipulate, 0, "the lattice", "SetInputConnection() to the lattice to move");
+  ffdtest::ExpectClearInputErrors(manipulate, 1, "the mesh", "SetMeshConnection()", true);
 }
