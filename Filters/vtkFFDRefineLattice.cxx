@@ -6,6 +6,7 @@
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDGridDeformer.h"
+#include "vtkFFDInputChecks.h"
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDPipelineKeys.h"
@@ -28,6 +29,7 @@
 #include "FFDRefinement.h"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 vtkStandardNewMacro(vtkFFDRefineLattice);
@@ -57,6 +59,30 @@ void Combine(const ffd::RefinementRow rows[3], const double* displacements, Id&&
   }
 }
 
+/**
+ * At least the bytes that the last of `levels` refinements of `lattice` (covering `voxels` voxels, in `form`)
+ * holds at once: its voxels' keys and index (20 bytes a voxel), its control points (position, RestPosition and
+ * the refined copy of the positions, Active and the ghost array: 74 bytes a point; a sparse lattice has at least
+ * as many as its voxels have points of their own) and a sparse lattice's cells (4 bytes a support point).
+ * Counted in double: 16 levels of a large lattice overflow any integer.
+ */
+double LastLevelBytes(const vtkFFDGridLattice& lattice, bool sparse, double voxels, int levels, double& points)
+{
+  const ffd::GridBasis basis = lattice.Basis;
+  const double scale = std::ldexp(1.0, levels), fineVoxels = voxels * scale * scale * scale;
+  const int degree = basis == ffd::GridBasis::CubicBSpline ? 1 : ffd::BezierDegree(basis);
+  points = sparse ? fineVoxels * degree * degree * degree : 1.0;
+  for (int a = 0; a < 3 && !sparse; ++a)
+  {
+    const double divisions = lattice.Divisions[a] * scale;
+    points *= basis == ffd::GridBasis::Bernstein ? divisions + 1
+      : basis == ffd::GridBasis::CubicBSpline    ? divisions + 3
+                                                 : degree * divisions + 1;
+  }
+  const double support = ffd::SupportSize(basis, lattice.Divisions[0]);
+  const double cells = sparse ? 4.0 * fineVoxels * (support * support * support + 1) : 0.0;
+  return 20.0 * fineVoxels + 74.0 * points + cells;
+}
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -105,6 +131,18 @@ vtkTypeBool vtkFFDRefineLattice::ProcessRequest(
 }
 
 //------------------------------------------------------------------------------------------------------------
+int vtkFFDRefineLattice::RequestDataObject(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (!(vtkFFDCheckInput(this, inputVector[0], 0, "vtkPointSet", "the lattice",
+        "SetInputConnection() to a grid lattice, the output of vtkFFDBuildLattice.")))
+  {
+    return vtkFFDEmptyOutputs(outputVector);
+  }
+  return this->Superclass::RequestDataObject(request, inputVector, outputVector);
+}
+
+//------------------------------------------------------------------------------------------------------------
 int vtkFFDRefineLattice::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -118,6 +156,15 @@ int vtkFFDRefineLattice::RequestData(
   {
     vtkErrorMacro(<< "The input is a tetrahedral lattice: refine it with vtkFFDBuildTetrahedralLattice's "
                      "SubdivisionLevels. This filter refines the grid lattices of vtkFFDBuildLattice.");
+    return 0;
+  }
+  if (this->Levels < 0 || this->Levels > 16)
+  {
+    vtkErrorMacro(<< "Levels is " << this->Levels << ": give SetLevels() 0 to 16.");
+    return 0;
+  }
+  if (!this->CheckLastLevelFits(input))
+  {
     return 0;
   }
   vtkSmartPointer<vtkPointSet> lattice = input;
@@ -141,6 +188,41 @@ int vtkFFDRefineLattice::RequestData(
   }
   output->ShallowCopy(lattice);
   return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDRefineLattice::CheckLastLevelFits(vtkPointSet* input)
+{
+  vtkFFDGridDeformer reader;
+  if (this->Levels == 0 || !reader.SetLattice(input).empty())
+  {
+    return true; // nothing to refine, or RefineOnce() says why it cannot
+  }
+  const vtkFFDGridLattice& lattice = reader.GetLattice();
+  const bool sparse = reader.GetSparseCells() != nullptr;
+  const double voxels = double(vtkFFDCoveredVoxels(reader, input).size() / 3);
+  double points;
+  const double bytes = LastLevelBytes(lattice, sparse, voxels, this->Levels, points);
+  const double available = vtkFFDAvailableMemory();
+  if (bytes <= available)
+  {
+    return true;
+  }
+  int fit = this->Levels - 1;
+  double unused;
+  while (fit > 0 && LastLevelBytes(lattice, sparse, voxels, fit, unused) > available)
+  {
+    --fit;
+  }
+  const double scale = std::ldexp(1.0, this->Levels);
+  const int* n = lattice.Divisions;
+  vtkErrorMacro(<< "Levels " << this->Levels << " refine the " << n[0] << "x" << n[1] << "x" << n[2] << " "
+                << vtkFFDBuildLattice::GetBasisAsString(int(lattice.Basis)) << " lattice to " << n[0] * scale << "x"
+                << n[1] * scale << "x" << n[2] * scale << " divisions (" << voxels * scale * scale * scale
+                << " voxels, " << points << " control points), which needs at least " << vtkFFDFormatBytes(bytes)
+                << " of memory, but only " << vtkFFDFormatBytes(available) << " is available: set fewer Levels "
+                << "(SetLevels(); at most " << fit << " fit here).");
+  return false;
 }
 
 //------------------------------------------------------------------------------------------------------------

@@ -45,6 +45,8 @@ protected:
   /// The output's extent is the refined lattice's, known in RequestData only.
   int ExecuteInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int ComputeInputUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  /// Checks the inputs first: one clear error where one is missing or of the wrong type.
+  int RequestDataObject(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   vtkTypeBool ProcessRequest(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
@@ -53,6 +55,10 @@ protected:
 private:
   vtkFFDRefineLattice(const vtkFFDRefineLattice&) = delete;
   void operator=(const vtkFFDRefineLattice&) = delete;
+
+  /// False, after reporting the size and the Levels that fit, where the last level needs more memory than the
+  /// system has: checked before the first level is refined.
+  bool CheckLastLevelFits(vtkPointSet* input);
 
   /// `lattice` refined once, or null after reporting an error.
   vtkSmartPointer<vtkPointSet> RefineOnce(vtkPointSet* lattice);

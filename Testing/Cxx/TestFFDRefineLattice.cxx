@@ -8,6 +8,7 @@
 // (the issue's requirement), the perturbation being 5% of the diagonal.
 
 #include "FFDTestErrorObserver.h"
+#include "FFDTestInputChecks.h"
 #include "FFDTestLattices.h"
 #include "FFDTestMeshes.h"
 #include "FFDTestTetrahedra.h"
@@ -270,4 +271,41 @@ TEST(vtkFFDRefineLattice, RefusesWhatItCannotRefine)
   vtkSmartPointer<vtkPointSet> lattice =
     MovedLattice(cow, vtkFFDBuildLattice::TRILINEAR, degree17, vtkFFDBuildLattice::SPARSE, rng);
   EXPECT_EQ(LargestDistance(Refine(lattice, 0), lattice), 0.0);
+}
+
+// Issue 30, item 17: a missing or wrong-typed input failed with only the executive's "returned failure".
+TEST(vtkFFDRefineLattice, SaysWhichInputIsMissingOrWrong)
+{
+  vtkSmartPointer<vtkPolyData> cow = ReadTestMesh("cow");
+  std::mt19937 rng(30);
+  const int n[3] = { 2, 2, 2 };
+  vtkNew<vtkFFDRefineLattice> refine;
+  refine->SetInputData(
+    ffdtest::MovedLattice(cow, vtkFFDBuildLattice::TRILINEAR, n, vtkFFDBuildLattice::DENSE, rng, 0.01));
+  ffdtest::ExpectClearInputErrors(refine, 0, "the lattice", "SetInputConnection() to a grid lattice");
+}
+
+// Issue 30, item 10: Levels 16 on a 4 x 4 x 4 lattice (1.8e16 voxels at the last level) refined level after level
+// until the memory ran out (12 GB in 40 s and on). The last level's size is checked before the first is refined:
+// an error with the sizes and the Levels that fit, at once, with an empty output.
+TEST(vtkFFDRefineLattice, RefusesLevelsWhoseLatticeCannotFitBeforeRefining)
+{
+  vtkSmartPointer<vtkPolyData> cow = ReadTestMesh("cow");
+  std::mt19937 rng(34);
+  const int n[3] = { 4, 4, 4 };
+  for (int basis : { vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::CUBIC_BSPLINE })
+  {
+    for (int form : { vtkFFDBuildLattice::DENSE, vtkFFDBuildLattice::SPARSE })
+    {
+      vtkNew<vtkFFDRefineLattice> refine;
+      refine->SetInputData(MovedLattice(cow, basis, n, form, rng, 0.01));
+      refine->SetLevels(16);
+      const std::string errors = ffdtest::UpdateErrors(refine);
+      const std::string said = std::string("Levels 16 refine the 4x4x4 ") +
+        vtkFFDBuildLattice::GetBasisAsString(basis) + " lattice to 262144x262144x262144 divisions";
+      EXPECT_NE(errors.find(said), std::string::npos) << errors;
+      EXPECT_NE(errors.find("set fewer Levels (SetLevels(); at most "), std::string::npos) << errors;
+      EXPECT_EQ(refine->GetOutput()->GetNumberOfPoints(), 0);
+    }
+  }
 }
