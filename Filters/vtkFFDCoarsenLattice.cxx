@@ -7,6 +7,7 @@
 #include "vtkFFDDataContract.h"
 #include "vtkFFDDeform.h"
 #include "vtkFFDGridDeformer.h"
+#include "vtkFFDInputChecks.h"
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDPipelineKeys.h"
@@ -25,6 +26,7 @@
 
 #include "FFDLeastSquares.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -72,6 +74,31 @@ std::vector<int> SecondDifferences(const vtkFFDGridDeformer& reader, vtkPointSet
     }
   }
   return triples;
+}
+
+bool IsFinite(const double x[3])
+{
+  return std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
+}
+
+/// 1 for each point whose rest (`mesh`) and deformed (`target`) positions are both finite, else 0; `first` is
+/// the first point that is not (-1: none).
+std::vector<char> FinitePoints(vtkPointSet* mesh, vtkPointSet* target, vtkIdType& first)
+{
+  std::vector<char> finite(std::size_t(mesh->GetNumberOfPoints()));
+  first = -1;
+  for (vtkIdType p = 0; p < mesh->GetNumberOfPoints(); ++p)
+  {
+    double x[3], y[3];
+    mesh->GetPoint(p, x);
+    target->GetPoint(p, y);
+    finite[p] = IsFinite(x) && IsFinite(y);
+    if (!finite[p] && first < 0)
+    {
+      first = p;
+    }
+  }
+  return finite;
 }
 } // namespace
 
@@ -141,6 +168,22 @@ vtkTypeBool vtkFFDCoarsenLattice::ProcessRequest(
 }
 
 //------------------------------------------------------------------------------------------------------------
+int vtkFFDCoarsenLattice::RequestDataObject(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (!(vtkFFDCheckInput(this, inputVector[0], 0, "vtkPointSet", "the lattice",
+          "SetInputConnection() to a grid lattice, the output of vtkFFDBuildLattice.") &&
+        vtkFFDCheckInput(this, inputVector[1], 1, "vtkPointSet", "the mesh",
+          "SetMeshConnection() to the mesh whose points the fit runs over.") &&
+        vtkFFDCheckInput(this, inputVector[2], 2, "vtkPointSet", "the deformed mesh",
+          "SetDeformedMeshConnection() to the mesh deformed, or to nothing.", true)))
+  {
+    return vtkFFDEmptyOutputs(outputVector);
+  }
+  return this->Superclass::RequestDataObject(request, inputVector, outputVector);
+}
+
+//------------------------------------------------------------------------------------------------------------
 int vtkFFDCoarsenLattice::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -169,6 +212,12 @@ int vtkFFDCoarsenLattice::RequestData(
   if (!why.empty())
   {
     vtkErrorMacro(<< "Cannot coarsen the input: " << why);
+    return 0;
+  }
+  if (!(this->Regularization >= 0 && this->Regularization <= 1))
+  {
+    vtkErrorMacro(<< "Regularization is " << this->Regularization
+                  << ": give SetRegularization() a number from 0 to 1 (default 1e-6).");
     return 0;
   }
   const vtkFFDGridLattice& fine = reader.GetLattice();
@@ -208,6 +257,22 @@ int vtkFFDCoarsenLattice::RequestData(
       vtkErrorMacro(<< "Could not deform the mesh by the input lattice (see the error above).");
       return 0;
     }
+  }
+  // A point without a finite rest or deformed position has no displacement to fit: it is left out, and said so.
+  vtkIdType firstNotFinite;
+  const std::vector<char> finite = FinitePoints(mesh, target, firstNotFinite);
+  const vtkIdType numFinite = std::count(finite.begin(), finite.end(), 1);
+  if (numFinite == 0)
+  {
+    vtkErrorMacro(<< "None of the mesh's " << mesh->GetNumberOfPoints()
+                  << " points has a finite position, at rest and deformed: there is nothing to fit.");
+    return 0;
+  }
+  if (firstNotFinite >= 0)
+  {
+    vtkWarningMacro(<< mesh->GetNumberOfPoints() - numFinite << " of the mesh's " << mesh->GetNumberOfPoints()
+                    << " points (the first: point " << firstNotFinite << ") have a NaN or infinite coordinate at "
+                    << "rest or deformed: the fit and its residuals leave them out.");
   }
   this->UpdateProgress(0.1);
 
@@ -249,7 +314,7 @@ int vtkFFDCoarsenLattice::RequestData(
   std::vector<vtkIdType> rowPoint;
   for (vtkIdType p = 0; p < numPoints; ++p)
   {
-    if (cellOf[p] >= 0)
+    if (cellOf[p] >= 0 && finite[p])
     {
       rowPoint.push_back(p);
     }
@@ -310,8 +375,8 @@ int vtkFFDCoarsenLattice::RequestData(
   }
   this->UpdateProgress(0.9);
 
-  // The output: the coarse lattice moved by X; the residual over every mesh point (those outside the coarse
-  // lattice keep their place).
+  // The output: the coarse lattice moved by X; the residual over every finite mesh point (those outside the
+  // coarse lattice keep their place).
   vtkNew<vtkPoints> moved;
   moved->SetDataTypeToDouble();
   moved->DeepCopy(coarse->GetPoints());
@@ -326,6 +391,10 @@ int vtkFFDCoarsenLattice::RequestData(
   std::size_t r = 0;
   for (vtkIdType p = 0; p < numPoints; ++p)
   {
+    if (!finite[p])
+    {
+      continue;
+    }
     double from[3], to[3], e2 = 0;
     points->GetPoint(p, from);
     target->GetPoint(p, to);
@@ -339,7 +408,7 @@ int vtkFFDCoarsenLattice::RequestData(
     sum += e2;
     worst = std::max(worst, e2);
   }
-  this->ResidualRMS = std::sqrt(sum / double(numPoints));
+  this->ResidualRMS = std::sqrt(sum / double(numFinite));
   this->MaximumResidual = std::sqrt(worst);
 
   output->ShallowCopy(coarse);

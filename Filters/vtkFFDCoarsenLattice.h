@@ -27,6 +27,10 @@
  * reproduces that deformation (d_p its point p minus input 1's) instead of the input lattice's, which gives only
  * the frame, the basis and the form; e.g. the result of vtkFFDDeformBlocks, a base lattice with its details.
  *
+ * A mesh point with a NaN or infinite coordinate, at rest or deformed, has no displacement to fit: it is left out
+ * of the fit and of the residuals (vtkFFDVoxelize and vtkFFDDeform leave such points out and in place too), and a
+ * warning says how many there are; a mesh without any finite point is an error.
+ *
  * @sa vtkFFDRefineLattice vtkFFDBuildLattice
  */
 #ifndef vtkFFDCoarsenLattice_h
@@ -84,6 +88,8 @@ protected:
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int ExecuteInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int ComputeInputUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  /// Checks the inputs first: one clear error where one is missing or of the wrong type.
+  int RequestDataObject(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   vtkTypeBool ProcessRequest(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 

@@ -4,6 +4,7 @@
 // reference's bases; the reported residual is the distance between the two deformations.
 
 #include "FFDTestErrorObserver.h"
+#include "FFDTestInputChecks.h"
 #include "FFDTestLattices.h"
 #include "FFDTestMeshes.h"
 
@@ -16,8 +17,10 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 
 namespace
 {
@@ -332,6 +335,8 @@ TEST(vtkFFDCoarsenLattice, RefusesWhatItCannotCoarsen)
     // A 4^3 cubic B-spline lattice has control points that no point of the cow weighs, or not enough to
     // determine: without regularisation there is no unique fit.
     { bspline, cow, -1, "undetermined", 0.0 },
+    // Issue 30, item 1: a NaN passed the setter's clamp and failed the solve with the message above.
+    { sparse, cow, -1, "give SetRegularization() a number from 0 to 1", std::numeric_limits<double>::quiet_NaN() },
   };
   for (const Case& c : cases)
   {
@@ -385,4 +390,86 @@ TEST(vtkFFDCoarsenLattice, FitsADeformedMeshAsTheLatticeThatDeformedIt)
   mismatched->SetDeformedMeshData(bear);
   Coarsen(fine, cow, mismatched);
   EXPECT_NE(errors->Errors.find("same points"), std::string::npos) << errors->Errors;
+}
+
+// Issue 30, item 17: a missing or wrong-typed input failed with only the executive's "returned failure".
+TEST(vtkFFDCoarsenLattice, SaysWhichInputIsMissingOrWrong)
+{
+  vtkSmartPointer<vtkPolyData> cow = ReadTestMesh("cow");
+  std::mt19937 rng(31);
+  const int n[3] = { 4, 4, 4 };
+  vtkNew<vtkFFDCoarsenLattice> coarsen;
+  coarsen->SetInputData(MovedLattice(cow, vtkFFDBuildLattice::TRILINEAR, n, vtkFFDBuildLattice::DENSE, rng, 0.01));
+  coarsen->SetMeshData(cow);
+  ffdtest::ExpectClearInputErrors(coarsen, 0, "the lattice", "SetInputConnection() to a grid lattice");
+  ffdtest::ExpectClearInputErrors(coarsen, 1, "the mesh", "SetMeshConnection()");
+  ffdtest::ExpectClearInputErrors(coarsen, 2, "the deformed mesh", "SetDeformedMeshConnection()", true);
+}
+
+// Issue 30, item 16: a mesh point with a NaN coordinate made the residuals NaN and the fit reported success; one
+// deformed to NaN (input 2) failed the solve with a message about Regularization. Such points are left out of the
+// fit and of the residuals, with a warning: the fit is the one without them, bit for bit, and its residuals too.
+TEST(vtkFFDCoarsenLattice, LeavesNonFinitePointsOutAndSaysSo)
+{
+  vtkSmartPointer<vtkPolyData> cow = ReadTestMesh("cow");
+  std::mt19937 rng(35);
+  const int n[3] = { 4, 4, 4 };
+  vtkSmartPointer<vtkPointSet> fine =
+    MovedLattice(cow, vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, n, vtkFFDBuildLattice::DENSE, rng, 0.02);
+  vtkNew<vtkFFDCoarsenLattice> clean;
+  vtkSmartPointer<vtkPointSet> want = Coarsen(fine, cow, clean);
+  ASSERT_GT(want->GetNumberOfPoints(), 0);
+
+  // The cow and two more points, after its own (so that the rows of the fit are the same), NaN and infinite.
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const vtkIdType count = cow->GetNumberOfPoints();
+  vtkNew<vtkPolyData> broken;
+  broken->DeepCopy(cow);
+  broken->GetPoints()->InsertNextPoint(nan, 0, 0);
+  broken->GetPoints()->InsertNextPoint(0, 0, -inf);
+  vtkNew<vtkFFDCoarsenLattice> coarsen;
+  vtkNew<FFDTestErrorObserver> errors;
+  errors->WatchWithExecutive(coarsen);
+  vtkSmartPointer<vtkPointSet> got = Coarsen(fine, broken, coarsen);
+  EXPECT_EQ(errors->Errors, "");
+  const std::string said = "2 of the mesh's " + std::to_string(count + 2) + " points (the first: point " +
+    std::to_string(count) + ") have a NaN or infinite coordinate";
+  EXPECT_NE(errors->Warnings.find(said), std::string::npos) << errors->Warnings;
+  ASSERT_EQ(got->GetNumberOfPoints(), want->GetNumberOfPoints());
+  EXPECT_TRUE(ffdtest::SamePoints(got, want));
+  EXPECT_EQ(coarsen->GetResidualRMS(), clean->GetResidualRMS());
+  EXPECT_EQ(coarsen->GetMaximumResidual(), clean->GetMaximumResidual());
+
+  // A point deformed to NaN (input 2): left out, the fit and residuals finite.
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(cow);
+  deform->SetLatticeData(fine);
+  deform->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
+  deform->Update();
+  vtkNew<vtkPolyData> deformed;
+  deformed->DeepCopy(deform->GetOutputDataObject(0));
+  deformed->GetPoints()->SetPoint(5, nan, nan, nan);
+  vtkNew<vtkFFDCoarsenLattice> fromMesh;
+  vtkNew<FFDTestErrorObserver> meshErrors;
+  meshErrors->WatchWithExecutive(fromMesh);
+  fromMesh->SetDeformedMeshData(deformed);
+  got = Coarsen(fine, cow, fromMesh);
+  EXPECT_EQ(meshErrors->Errors, "");
+  EXPECT_NE(meshErrors->Warnings.find("(the first: point 5)"), std::string::npos) << meshErrors->Warnings;
+  EXPECT_EQ(got->GetNumberOfPoints(), want->GetNumberOfPoints());
+  EXPECT_TRUE(std::isfinite(fromMesh->GetResidualRMS()) && std::isfinite(fromMesh->GetMaximumResidual()));
+
+  // No finite point at all: an error.
+  vtkNew<vtkPolyData> none;
+  none->DeepCopy(broken);
+  for (vtkIdType p = 0; p < none->GetNumberOfPoints(); ++p)
+  {
+    none->GetPoints()->SetPoint(p, nan, nan, nan);
+  }
+  vtkNew<vtkFFDCoarsenLattice> nothing;
+  vtkNew<FFDTestErrorObserver> nothingErrors;
+  nothingErrors->WatchWithExecutive(nothing);
+  Coarsen(fine, none, nothing);
+  EXPECT_NE(nothingErrors->Errors.find("has a finite position"), std::string::npos) << nothingErrors->Errors;
+  EXPECT_EQ(nothing->GetOutput()->GetNumberOfPoints(), 0);
 }
