@@ -169,6 +169,12 @@ int vtkFFDBuildDetailLattice::RequestData(
   {
     return 1;
   }
+  if (!(this->SecondDerivativeThreshold >= 0))
+  {
+    vtkErrorMacro(<< "SecondDerivativeThreshold is " << this->SecondDerivativeThreshold
+                  << ": give SetSecondDerivativeThreshold() a number >= 0 (0, the default: off).");
+    return 0;
+  }
   if (vtkFFDTetrahedralDeformer::IsTetrahedralLattice(input))
   {
     vtkErrorMacro(<< "The input is a tetrahedral lattice: refine it with vtkFFDBuildTetrahedralLattice's "

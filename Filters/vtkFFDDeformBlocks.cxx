@@ -5,6 +5,7 @@
 #include "vtkDataArray.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDDeform.h"
+#include "vtkFFDInputChecks.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkFieldData.h"
@@ -79,6 +80,20 @@ vtkTypeBool vtkFFDDeformBlocks::ProcessRequest(
 {
   return vtkFFDCatchAllocationFailure(
     this, outputVector, [&] { return this->Superclass::ProcessRequest(request, inputVector, outputVector); });
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDDeformBlocks::RequestDataObject(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (!(vtkFFDCheckInput(this, inputVector[0], 0, "vtkPointSet", "the mesh",
+          "SetInputConnection() to the mesh to deform (a vtkPolyData, vtkUnstructuredGrid or other vtkPointSet).") &&
+        vtkFFDCheckInput(
+          this, inputVector[1], 1, "vtkPointSet", "the lattices", "AddLatticeConnection() for each lattice.")))
+  {
+    return vtkFFDEmptyOutputs(outputVector);
+  }
+  return this->Superclass::RequestDataObject(request, inputVector, outputVector);
 }
 
 //------------------------------------------------------------------------------------------------------------

@@ -7,6 +7,7 @@
 #include "vtkFFDDeform.h"
 #include "vtkFFDForInChunks.h"
 #include "vtkFFDGridDeformer.h"
+#include "vtkFFDInputChecks.h"
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDSparseLattice.h"
@@ -267,6 +268,21 @@ vtkTypeBool vtkFFDInverseDeform::ProcessRequest(
 }
 
 //------------------------------------------------------------------------------------------------------------
+int vtkFFDInverseDeform::RequestDataObject(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (!(vtkFFDCheckInput(this, inputVector[0], 0, "vtkPointSet", "the deformed points",
+          "SetInputConnection() to the deformed mesh or points (a vtkPolyData, vtkUnstructuredGrid or other "
+          "vtkPointSet).") &&
+        vtkFFDCheckInput(this, inputVector[1], 1, "vtkPointSet", "the lattice",
+          "SetLatticeConnection() to the lattice that deformed them.")))
+  {
+    return vtkFFDEmptyOutputs(outputVector);
+  }
+  return this->Superclass::RequestDataObject(request, inputVector, outputVector);
+}
+
+//------------------------------------------------------------------------------------------------------------
 int vtkFFDInverseDeform::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -280,6 +296,18 @@ int vtkFFDInverseDeform::RequestData(
     return 0;
   }
   output->Initialize();
+  if (!std::isfinite(this->Tolerance) || this->Tolerance < 0)
+  {
+    vtkErrorMacro(<< "Tolerance is " << this->Tolerance
+                  << ": give SetTolerance() a finite number >= 0 (default 1e-12, relative to the frame's diagonal).");
+    return 0;
+  }
+  if (this->MaximumNumberOfIterations < 1)
+  {
+    vtkErrorMacro(<< "MaximumNumberOfIterations is " << this->MaximumNumberOfIterations
+                  << ": give SetMaximumNumberOfIterations() 1 or more (default 50).");
+    return 0;
+  }
   vtkPoints* points = input->GetPoints();
   if (!points || points->GetNumberOfPoints() == 0)
   {

@@ -74,6 +74,8 @@ protected:
   ~vtkFFDInverseDeform() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
+  /// Checks the inputs first: one clear error where one is missing or of the wrong type.
+  int RequestDataObject(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   vtkTypeBool ProcessRequest(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 

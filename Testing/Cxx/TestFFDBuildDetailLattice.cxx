@@ -17,6 +17,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 #include <set>
 
@@ -262,4 +263,15 @@ TEST(vtkFFDBuildDetailLattice, RefusesWhatItCannotRefine)
     EXPECT_NE(errors->Errors.find(c.Says), std::string::npos) << errors->Errors;
     EXPECT_EQ(detail->GetOutput()->GetNumberOfPoints(), 0);
   }
+
+  // Issue 30, item 1: a NaN threshold passed the setter's clamp and turned the threshold off without a word.
+  vtkNew<vtkFFDBuildDetailLattice> detail;
+  vtkNew<FFDTestErrorObserver> errors;
+  errors->WatchWithExecutive(detail);
+  detail->SetInputData(trilinear);
+  detail->SetSecondDerivativeThreshold(std::numeric_limits<double>::quiet_NaN());
+  detail->Update();
+  EXPECT_NE(errors->Errors.find("give SetSecondDerivativeThreshold() a number >= 0"), std::string::npos)
+    << errors->Errors;
+  EXPECT_EQ(detail->GetOutput()->GetNumberOfPoints(), 0);
 }

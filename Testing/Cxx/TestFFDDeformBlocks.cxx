@@ -5,6 +5,7 @@
 // (vtkFFDDeform applied to a lattice).
 
 #include "FFDTestErrorObserver.h"
+#include "FFDTestInputChecks.h"
 #include "FFDTestLattices.h"
 #include "FFDTestMeshes.h"
 
@@ -367,4 +368,18 @@ TEST(vtkFFDDeformBlocks, HierarchicalFFDDeformsAFineLatticeByACoarseOne)
     worst = std::max(worst, std::sqrt(vtkMath::Distance2BetweenPoints(y, z)));
   }
   EXPECT_LE(worst, 1e-12 * std::hypot(size[0], size[1], size[2]));
+}
+
+// Issue 30, item 17: a missing or wrong-typed input failed with only the executive's "returned failure".
+TEST(vtkFFDDeformBlocks, SaysWhichInputIsMissingOrWrong)
+{
+  vtkSmartPointer<vtkPolyData> cow = ReadTestMesh("cow");
+  std::mt19937 rng(33);
+  const int n[3] = { 2, 2, 2 };
+  vtkNew<vtkFFDDeformBlocks> blocks;
+  blocks->SetInputData(cow);
+  blocks->AddLatticeData(
+    ffdtest::MovedLattice(cow, vtkFFDBuildLattice::TRILINEAR, n, vtkFFDBuildLattice::DENSE, rng, 0.01));
+  ffdtest::ExpectClearInputErrors(blocks, 0, "the mesh", "SetInputConnection() to the mesh to deform");
+  ffdtest::ExpectClearInputErrors(blocks, 1, "the lattices", "AddLatticeConnection()");
 }

@@ -13,6 +13,7 @@
 // way rounding within a few eps d): 1e-12 d.
 
 #include "FFDTestErrorObserver.h"
+#include "FFDTestInputChecks.h"
 #include "FFDTestLattices.h"
 #include "FFDTestMeshes.h"
 
@@ -466,4 +467,26 @@ TEST(vtkFFDInverseDeform, KeepsOutsidePointsAndRefusesBadInput)
   vtkNew<FFDTestErrorObserver> badTetrahedraObserver;
   Inverted(mesh, tetrahedra, badTetrahedra, badTetrahedraObserver);
   EXPECT_NE(badTetrahedraObserver->Errors.find("RestPosition"), std::string::npos) << badTetrahedraObserver->Errors;
+
+  // Issue 30, item 1: a NaN Tolerance passed the setter's clamp, and no point could converge.
+  vtkNew<vtkFFDInverseDeform> nanTolerance;
+  nanTolerance->SetTolerance(nan);
+  vtkNew<FFDTestErrorObserver> nanObserver;
+  Inverted(mesh, lattice, nanTolerance, nanObserver);
+  EXPECT_NE(nanObserver->Errors.find("give SetTolerance() a finite number"), std::string::npos) << nanObserver->Errors;
+  EXPECT_EQ(nanTolerance->GetOutput()->GetNumberOfPoints(), 0);
+}
+
+// Issue 30, item 17: a missing or wrong-typed input failed with only the executive's "returned failure".
+TEST(vtkFFDInverseDeform, SaysWhichInputIsMissingOrWrong)
+{
+  vtkSmartPointer<vtkPolyData> cow = ReadTestMesh("cow");
+  std::mt19937 rng(32);
+  const int n[3] = { 2, 2, 2 };
+  vtkNew<vtkFFDInverseDeform> inverse;
+  inverse->SetInputData(cow);
+  inverse->SetLatticeData(
+    ffdtest::MovedLattice(cow, vtkFFDBuildLattice::TRILINEAR, n, vtkFFDBuildLattice::DENSE, rng, 0.01));
+  ffdtest::ExpectClearInputErrors(inverse, 0, "the deformed points", "SetInputConnection() to the deformed mesh");
+  ffdtest::ExpectClearInputErrors(inverse, 1, "the lattice", "SetLatticeConnection()");
 }
