@@ -31,7 +31,22 @@ vtkStandardNewMacro(vtkFFDLatticeRepresentation);
 struct vtkFFDLatticeRepresentation::vtkInternals
 {
   vtkNew<vtkFFDLatticeActor> LatticeActor;
-  std::set<vtkIdType> Selection; // ordered: GetSelectedControlPoints() lists ids in increasing order
+  std::set<vtkIdType> Selection;     // ordered: GetSelectedControlPoints() lists ids in increasing order
+  vtkIdType SelectionPointCount = 0; // the lattice's number of points when the selection was made
+
+  /// Drops the selection once `lattice`'s number of points is no longer the one it was made on (the lattice
+  /// re-executed upstream, or its points replaced): its ids then name other points or none, which a move would
+  /// write out of bounds. True when it was dropped.
+  bool DropStaleSelection(vtkPointSet* lattice)
+  {
+    const vtkIdType count = lattice && lattice->GetPoints() ? lattice->GetNumberOfPoints() : 0;
+    if (this->Selection.empty() || count == this->SelectionPointCount)
+    {
+      return false;
+    }
+    this->Selection.clear();
+    return true;
+  }
 
   // The selected control points, drawn as spheres larger than the lattice actor's, around them.
   vtkNew<vtkPolyData> SelectedPoints;
@@ -260,6 +275,8 @@ bool vtkFFDLatticeRepresentation::SelectControlPoint(vtkIdType id)
   {
     return false;
   }
+  this->Internals->DropStaleSelection(this->Lattice);
+  this->Internals->SelectionPointCount = this->Lattice->GetNumberOfPoints();
   if (this->Internals->Selection.insert(id).second)
   {
     this->Modified();
@@ -300,12 +317,14 @@ void vtkFFDLatticeRepresentation::ClearSelection()
 //------------------------------------------------------------------------------
 bool vtkFFDLatticeRepresentation::IsControlPointSelected(vtkIdType id) const
 {
+  this->Internals->DropStaleSelection(this->Lattice);
   return this->Internals->Selection.count(id) > 0;
 }
 
 //------------------------------------------------------------------------------
 vtkIdType vtkFFDLatticeRepresentation::GetNumberOfSelectedControlPoints() const
 {
+  this->Internals->DropStaleSelection(this->Lattice);
   return static_cast<vtkIdType>(this->Internals->Selection.size());
 }
 
@@ -317,6 +336,7 @@ void vtkFFDLatticeRepresentation::GetSelectedControlPoints(vtkIdList* ids) const
     return;
   }
   ids->Reset();
+  this->Internals->DropStaleSelection(this->Lattice);
   for (vtkIdType id : this->Internals->Selection)
   {
     ids->InsertNextId(id);
@@ -326,6 +346,10 @@ void vtkFFDLatticeRepresentation::GetSelectedControlPoints(vtkIdList* ids) const
 //------------------------------------------------------------------------------
 bool vtkFFDLatticeRepresentation::MoveSelectedControlPoints(const double delta[3])
 {
+  if (this->Internals->DropStaleSelection(this->Lattice))
+  {
+    this->Modified();
+  }
   if (!this->Lattice || !this->Lattice->GetPoints() || this->Internals->Selection.empty())
   {
     return false;
@@ -415,7 +439,8 @@ void vtkFFDLatticeRepresentation::StartWidgetInteraction(double eventPosition[2]
   const bool meshPoint = this->ManipulationMode == MESH_POINTS;
   vtkPointSet* deformed = meshPoint ? this->GetDeformedMesh() : nullptr;
   if (!this->Lattice || !this->Renderer ||
-    (meshPoint ? !deformed || this->HoveredMeshPoint < 0 : this->HoveredControlPoint < 0))
+    (meshPoint ? !deformed || this->HoveredMeshPoint < 0 || this->HoveredMeshPoint >= deformed->GetNumberOfPoints()
+               : !this->IsPickable(this->HoveredControlPoint)))
   {
     return;
   }
@@ -503,15 +528,13 @@ void vtkFFDLatticeRepresentation::BuildRepresentation()
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   vtkNew<vtkCellArray> vertices;
+  in.DropStaleSelection(this->Lattice);
   if (this->Lattice)
   {
     for (vtkIdType id : in.Selection)
     {
-      if (id < this->Lattice->GetNumberOfPoints())
-      {
-        const vtkIdType p = points->InsertNextPoint(this->Lattice->GetPoint(id));
-        vertices->InsertNextCell(1, &p);
-      }
+      const vtkIdType p = points->InsertNextPoint(this->Lattice->GetPoint(id));
+      vertices->InsertNextCell(1, &p);
     }
     // The highlight encloses the control point's sphere, whatever size the lattice actor gives it.
     in.LatticeActor->GetBounds();

@@ -124,7 +124,9 @@ public:
   ///@{
   /**
    * The selection: the control points that a drag moves. SelectControlPoint() refuses (returns false) an id
-   * out of range, or a culled control point unless PickCulledPoints is on.
+   * out of range, or a culled control point unless PickCulledPoints is on. The selection is dropped once the
+   * lattice's number of points changes (re-executed upstream, or its points replaced): its ids would name
+   * other points, or none.
    */
   bool SelectControlPoint(vtkIdType id);
   void DeselectControlPoint(vtkIdType id);

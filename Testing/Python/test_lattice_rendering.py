@@ -284,6 +284,28 @@ class LatticeWidgetTest(unittest.TestCase):
         self.assertTrue(self.rep.ResetLatticeToRest())
         self.assertEqual(self.lattice.GetPoint(chosen), tuple(before))
 
+    def test_selection_is_dropped_when_the_lattice_changes_size(self):
+        """Issue 30, item 16: ids selected before the lattice's points shrank were kept, and
+        MoveSelectedControlPoints() wrote past the end of its points. The selection is dropped once the number of
+        points changes; nothing moves and nothing is written."""
+        self.enable(self.lattice)
+        active = np.flatnonzero(vtk_to_numpy(self.lattice.GetPointData().GetArray("Active")))
+        first, last = int(active[0]), int(active[-1])
+        self.assertTrue(self.rep.SelectControlPoint(first) and self.rep.SelectControlPoint(last))
+        _, _, smaller = sphere_lattice((2, 2, 2))  # 27 points: `last` is past its end
+        self.assertLess(smaller.GetNumberOfPoints(), last)
+        self.lattice.ShallowCopy(smaller)  # as a pipeline re-executing into the same object would
+        before = vtk_to_numpy(self.lattice.GetPoints().GetData()).copy()
+        self.assertFalse(self.rep.MoveSelectedControlPoints((0.1, 0.2, 0.3)))
+        np.testing.assert_array_equal(vtk_to_numpy(self.lattice.GetPoints().GetData()), before)
+        self.assertEqual(self.rep.GetNumberOfSelectedControlPoints(), 0)
+        self.assertFalse(self.rep.IsControlPointSelected(first))
+        self.window.Render()  # the highlight names no point past the end either
+        # Selecting anew on the smaller lattice works as before.
+        self.assertTrue(self.rep.SelectControlPoint(first))
+        self.assertTrue(self.rep.MoveSelectedControlPoints((0.1, 0.2, 0.3)))
+        np.testing.assert_allclose(np.array(self.lattice.GetPoint(first)) - before[first], (0.1, 0.2, 0.3), atol=1e-15)
+
     def click(self, position, shift=False):
         self.event(vtkCommand.MouseMoveEvent, position, shift)
         self.event(vtkCommand.LeftButtonPressEvent, position, shift)
