@@ -5,7 +5,8 @@ written to .off, .vtp and .ply files: `build` writes the lattice of the same vox
 in-process, and `deform` of it, or of a lattice moved in-process and saved, gives the points of the in-process
 vtkFFDDeform. Both sides run the same filters on the same inputs (the files keep float64 exactly), so the
 tolerance is 0: bit for bit. Also: `info`'s counts, `convert` round trips, vtkffd.meshio's OFF files (read back bit
-for bit, comments, colours, malformed files), --help, bad input (one line naming the problem, no traceback), and
+for bit, comments, colours, malformed files), --help, bad input (one line naming the problem, no traceback: files
+cut short or garbled, numbers out of range), writes that fail part-way (the file that was there is kept), and
 --quiet (nothing on stderr).
 
 Run with Debian's /usr/bin/python3, PYTHONPATH=<build>/lib/python3/dist-packages and VOXELFFD_MESH_DIR set to the
@@ -13,6 +14,7 @@ folder of the meshes (ctest does both). Exits non-zero when a test fails.
 """
 import os
 import re
+import resource
 import subprocess
 import sys
 import tempfile
@@ -111,11 +113,15 @@ class TestCommandLine(unittest.TestCase):
     def path(cls, name):
         return os.path.join(cls.folder.name, name)
 
-    def run_command(self, *arguments):
-        """Runs `python3 -m vtkffd ARGUMENTS` in the test folder; returns (exit status, stdout, stderr)."""
+    def run_command(self, *arguments, file_size_limit=None):
+        """Runs `python3 -m vtkffd ARGUMENTS` in the test folder; returns (exit status, stdout, stderr). With
+        `file_size_limit`, writes past that many bytes of a file fail (RLIMIT_FSIZE; Python ignores SIGXFSZ), as
+        on a disk that fills up part-way, for root too."""
+        limit = None if file_size_limit is None else (
+            lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (file_size_limit, file_size_limit)))
         result = subprocess.run([sys.executable, "-m", "vtkffd", *arguments], cwd=self.folder.name,
                                 env=dict(os.environ, PYTHONPATH=PACKAGE_PARENT), capture_output=True, text=True,
-                                timeout=120)
+                                timeout=120, preexec_fn=limit)
         return result.returncode, result.stdout, result.stderr
 
     def succeed(self, *arguments):
@@ -306,6 +312,100 @@ class TestCommandLine(unittest.TestCase):
                 else:
                     self.assertEqual(len(lines), 1, err)
                 self.assertIn(problem, lines[-1])
+
+    def test_files_cut_short_or_garbled_and_numbers_out_of_range(self):
+        """One line and exit status 1 (2 for a usage error), no traceback, no output file: random bytes in a mesh's
+        name (STL, OBJ: VTK passes its message as None), files cut short (a binary PLY crashes VTK's reader, a
+        legacy VTK file gives a warning only, or crashes VTK's reader when cut in an array's header, PyGeM's lines
+        left out read as zeros), sizes beyond memory or VTK's int, padding and frames that overflow, a lattice
+        that is not finite written where no reader takes it back."""
+        Build = vtkffd.vtkFFDBuildLattice
+        random = np.random.default_rng(30).integers(0, 256, 20000, dtype=np.uint8).tobytes()
+        files = {"random.stl": random, "random.obj": random}
+        for name in ("bear.ply", "bear.vtp"):
+            meshio.write_mesh(self.mesh, self.path("whole" + name[-4:]), name[-4:])
+        meshio.write_mesh(self.mesh, self.path("whole.vtk"))
+        with open(self.path("whole.ply"), "rb") as stream:
+            files["cut.ply"] = stream.read()[:5000]
+        with open(self.path("whole.vtk"), "rb") as stream:
+            files["cut_mesh.vtk"] = stream.read()[:-1000]
+        dense = own_copy(build_in_process(self.mesh, Build.BERNSTEIN, (2, 2, 2)).GetOutput())
+        interchange.write_lattice(dense, self.path("dense.vtk"))
+        with open(self.path("dense.vtk"), "rb") as stream:
+            whole = stream.read()
+        files["cut_in_field_data.vtk"] = whole[:whole.index(b"FIELD FieldData") + 7]
+        interchange.write_lattice(dense, self.path("dense.prm"))
+        with open(self.path("dense.prm"), "rb") as stream:
+            whole = stream.read()
+        files["cut.prm"] = whole[:whole.index(b"\n", whole.index(b"parameter z")) + 1]
+        files["huge.prm"] = whole.replace(b"n control points x: 3", b"n control points x: 2147483647")
+        files["huge.off"] = b"OFF\n3 1 0\n-1e308 0 0\n1e308 0 0\n0 1 0\n3 0 1 2\n"
+        for name, data in files.items():
+            with open(self.path(name), "wb") as stream:
+                stream.write(data)
+        vtk_to_numpy(dense.GetPoints().GetData())[4] = np.nan
+        bspline = own_copy(build_in_process(self.mesh, Build.CUBIC_BSPLINE, (2, 2, 2), Build.DENSE).GetOutput())
+        vtk_to_numpy(bspline.GetPoints().GetData())[4] = np.inf
+        meshio.write_mesh(dense, self.path("nan.vts"))  # as a user would, past write_lattice's check
+        meshio.write_mesh(bspline, self.path("inf.vts"))
+        cases = (  # arguments, exit status, what the message names
+            (("build", "random.stl", "-o", "bad_out.vts"), 1, "random.stl: not an STL file"),
+            (("build", "random.obj", "-o", "bad_out.vts"), 1, "random.obj"),
+            (("build", "cut.ply", "-o", "bad_out.vts"), 1, "cut.ply: cut short"),
+            (("build", "cut_mesh.vtk", "-o", "bad_out.vts"), 1, "cut_mesh.vtk: Error reading binary data"),
+            (("deform", "bear.off", "cut_in_field_data.vtk", "-o", "bad_out.vtp"), 1, "crashes"),
+            (("info", "cut.prm"), 1, "'parameter z' lists 1 of the 27 control points"),
+            (("info", "huge.prm"), 1, "GB needed"),
+            (("convert", "nan.vts", "-o", "bad_out.prm"), 1, "control point 4 is not finite"),
+            (("convert", "inf.vts", "-o", "bad_out.tfm"), 1, "control point 4 is not finite"),
+            (("build", "bear.off", "-o", "bad_out.vts", "--divisions", "4294967296"), 2, "at most 2147483647"),
+            (("build", "bear.off", "-o", "bad_out.vts", "--padding", "inf"), 2, "--padding: inf: a finite number"),
+            (("build", "bear.off", "-o", "bad_out.vts", "--padding", "1e308"), 1, "--padding 1e+308"),
+            (("build", "huge.off", "-o", "bad_out.vts"), 1, "huge.off: its points span"))
+        for arguments, status, problem in cases:
+            with self.subTest(arguments=" ".join(arguments)):
+                got, out, err = self.run_command(*arguments, "-q")
+                self.assertEqual(got, status, err)
+                self.assertNotIn("Traceback", err)
+                lines = err.splitlines()
+                if status == 2:  # a usage error shows the usage above its line, as argparse does
+                    self.assertTrue(lines[0].startswith("usage: "), err)
+                else:
+                    self.assertEqual(len(lines), 1, err)
+                self.assertIn(problem, lines[-1])
+                self.assertFalse([name for name in os.listdir(self.folder.name) if name.startswith("bad_out")])
+
+    def test_a_failed_write_leaves_the_file_that_was_there(self):
+        """Every output format, written by a command whose writes of a file fail past 2,000 bytes (a disk that
+        fills up): exit status 1, one line naming the output, the file that was there unchanged, nothing left
+        beside it. Each output is larger than that when the write succeeds."""
+        Build = vtkffd.vtkFFDBuildLattice
+        for name, lattice in (("dense.vts", build_in_process(self.mesh, Build.BERNSTEIN, (2, 3, 4))),
+                              ("bspline.vts", build_in_process(self.mesh, Build.CUBIC_BSPLINE, (5, 5, 5), Build.DENSE)),
+                              ("sparse.vtu", build_in_process(self.mesh, Build.TRILINEAR, (6, 6, 6)))):
+            interchange.write_lattice(lattice.GetOutput(), self.path(name))
+        limit = 2000
+        commands = [("deform", "bear.off", "dense.vts", "-o", "full_disk" + extension)
+                    for extension in (".vtp", ".vtk", ".stl", ".ply", ".obj", ".off")]
+        commands += [("convert", "dense.vts", "-o", "full_disk.prm"), ("convert", "bspline.vts", "-o", "full_disk.tfm"),
+                     ("convert", "sparse.vtu", "-o", "full_disk.vdb"), ("convert", "sparse.vtu", "-o", "full_disk.vtu"),
+                     ("convert", "dense.vts", "-o", "full_disk.vts"),
+                     ("convert", "sparse.vtu", "-o", "full_disk_lattice.vtk")]
+        for arguments in commands:
+            output = self.path(arguments[-1])
+            with self.subTest(arguments=" ".join(arguments)):
+                self.succeed(*arguments, "-q")
+                self.assertGreater(os.path.getsize(output), limit)
+                with open(output, "wb") as stream:
+                    stream.write(b"the file that was there\n")
+                files = sorted(os.listdir(self.folder.name))
+                status, out, err = self.run_command(*arguments, "-q", file_size_limit=limit)
+                self.assertEqual(status, 1, err)
+                self.assertEqual(len(err.splitlines()), 1, err)
+                self.assertIn(arguments[-1], err)
+                with open(output, "rb") as stream:
+                    self.assertEqual(stream.read(), b"the file that was there\n")
+                self.assertEqual(sorted(os.listdir(self.folder.name)), files)
 
     def test_quiet_says_nothing(self):
         for quiet in (True, False):

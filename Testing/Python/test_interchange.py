@@ -35,10 +35,11 @@ from vtkmodules.vtkCommonCore import vtkPoints
 from vtkmodules.vtkCommonDataModel import VTK_TETRA, vtkImageData, vtkUnstructuredGrid
 from vtkmodules.vtkFiltersGeneral import vtkTransformFilter
 from vtkmodules.vtkFiltersHybrid import vtkBSplineTransform, vtkGridTransform
+from vtkmodules.vtkIOLegacy import vtkDataSetWriter
 from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridWriter
 
 import vtkffd
-from vtkffd import interchange
+from vtkffd import interchange, meshio
 from ffdtesting import bbox_diagonal, build_lattice, points_of, read_mesh  # the same folder
 
 Build = vtkffd.vtkFFDBuildLattice
@@ -420,6 +421,22 @@ parameter z: 2   0   0   -0.1
         with self.assertRaises(FileNotFoundError):
             interchange.read_prm(self.path("missing.prm"))
 
+    def test_files_cut_short_and_sizes_beyond_memory_are_errors(self):
+        # write_prm lists every control point for each axis, as PyGeM does: a cut in the middle of a number leaves
+        # a number (-0.2 -> -0.), a cut at a line's end a shorter list, whose missing lines would read as zeros.
+        lattice = interchange.lattice_at_rest([0, 0, 0, 2, 0, 0, 0, 3, 0, 0, 0, 1], [2, 3, 1], Build.BERNSTEIN)
+        move(lattice, self.rng, 0.1)
+        interchange.write_prm(lattice, self.path("whole.prm"))
+        whole = read_text(self.path("whole.prm"))
+        self.assertRegex(whole, r"\.\d{4,}\n$")  # a cut 3 characters before the end leaves a number
+        cut_in_z = whole.index("\n", whole.index("parameter z")) + 1
+        for text, words in ((whole[:-3], "does not end with a line break"),
+                            (whole[:cut_in_z], "'parameter z' lists 1 of the 24 control points"),
+                            (whole.replace("n control points x: 3", "n control points x: 2147483647"),
+                             "GB needed")):
+            with self.assertRaisesRegex(ValueError, words, msg=words):
+                interchange.read_prm(self.write_text("cut.prm", text))
+
 
 class TestVTKTransforms(InterchangeTest):
     def part_of_the_bear(self, basis, divisions, mirrored=False):
@@ -778,6 +795,78 @@ class TestFiles(InterchangeTest):
         with self.assertRaisesRegex(ValueError, "holds a vtkUnstructuredGrid|cannot read a lattice"):
             os.rename(self.path("voxels.vtu"), self.path("voxels.vts"))  # an unstructured grid in a .vts
             interchange.read_lattice(self.path("voxels.vts"))
+
+    def test_files_cut_short_or_garbled_are_errors(self):
+        # Legacy VTK reports a binary file cut short by a warning alone (its lattice then moves the bear by 1e273).
+        sparse = sparse_lattice(self.bear, (4, 4, 4), Build.CUBIC_BSPLINE)
+        interchange.write_lattice(sparse, self.path("whole.vtk"))
+        with open(self.path("whole.vtk"), "rb") as stream:
+            whole = stream.read()
+        with open(self.path("cut.vtk"), "wb") as stream:
+            stream.write(whole[:-100])  # in the last array: the lattice's points and RestPosition are whole
+        with self.assertRaisesRegex(ValueError, "cannot read a lattice from .*cut.vtk: Error reading binary data"):
+            interchange.read_lattice(self.path("cut.vtk"))
+        # A RestPosition shorter than the points (legacy VTK's reader takes it), a cell that names a point the
+        # lattice lacks (the filters would read past the points).
+        short = vtkUnstructuredGrid()
+        short.DeepCopy(sparse)
+        rest = short.GetPointData().GetArray("RestPosition")
+        rest.SetNumberOfTuples(rest.GetNumberOfTuples() - 1)
+        garbled = vtkUnstructuredGrid()
+        garbled.DeepCopy(sparse)
+        vtk_to_numpy(garbled.GetCells().GetConnectivityArray())[5] = garbled.GetNumberOfPoints()
+        for lattice, name, words in ((short, "short.vtk", "holds no lattice"),
+                                     (garbled, "garbled.vtu", "names point %d, but there are %d" % (
+                                         (sparse.GetNumberOfPoints(),) * 2))):
+            writer = vtkDataSetWriter() if name.endswith(".vtk") else vtkXMLUnstructuredGridWriter()
+            writer.SetInputData(lattice)
+            writer.SetFileName(self.path(name))
+            writer.Write()
+            with self.assertRaisesRegex(ValueError, words, msg=name):
+                interchange.read_lattice(self.path(name))
+
+    def test_a_lattice_that_is_not_finite_is_not_written(self):
+        # What the readers refuse: .prm and .tfm files of NaN weights, lattices of NaN points in VTK's files.
+        cases = ((principal_axes_lattice(self.bear, (2, 2, 2), Build.BERNSTEIN), ("a.prm", "a.vts", "a.vtk")),
+                 (principal_axes_lattice(self.bear, (2, 3, 2), Build.CUBIC_BSPLINE), ("a.tfm",)),
+                 (sparse_lattice(self.bear, (4, 4, 4), Build.CUBIC_BSPLINE), ("a.vtu", "a.vdb")))
+        for lattice, names in cases:
+            vtk_to_numpy(lattice.GetPoints().GetData())[3] = np.nan
+            for name in names:
+                self.write_text(name, "the file that was there\n")
+                with self.assertRaisesRegex(ValueError, "point of control point 3 is not finite", msg=name):
+                    interchange.write_lattice(lattice, self.path(name))
+                self.assertEqual(read_text(self.path(name)), "the file that was there\n", name)
+
+    def test_writes_are_all_or_nothing(self):
+        """write_atomically (every writer of vtkffd.interchange and vtkffd.meshio): a write that fails part-way
+        leaves the file that was there and nothing beside it, and says which file; one that succeeds keeps a
+        symbolic link and the file's permissions. The command line's test fills the disk under every format."""
+        self.write_text("old.vts", "the file that was there\n")
+        os.chmod(self.path("old.vts"), 0o640)
+        os.symlink("old.vts", self.path("link.vts"))
+
+        def fail_part_way(temporary):
+            with open(temporary, "w") as stream:
+                stream.write("half a lattice")
+            raise OSError(f"{temporary}: the disk is full")
+
+        with self.assertRaisesRegex(OSError, "^%s: the disk is full$" % self.path("link.vts")):
+            meshio.write_atomically(self.path("link.vts"), fail_part_way)
+        self.assertEqual(sorted(os.listdir(self.folder.name)), ["link.vts", "old.vts"])
+        self.assertEqual(read_text(self.path("old.vts")), "the file that was there\n")
+        lattice = build_lattice(self.bear, (2, 2, 2), Build.TRILINEAR)[2]
+        interchange.write_lattice(lattice, self.path("link.vts"))
+        self.assertTrue(os.path.islink(self.path("link.vts")))
+        self.assertEqual(os.stat(self.path("old.vts")).st_mode & 0o777, 0o640)
+        np.testing.assert_array_equal(points_of(interchange.read_lattice(self.path("old.vts"))), points_of(lattice))
+        self.assertEqual(sorted(os.listdir(self.folder.name)), ["link.vts", "old.vts"])
+        # A folder that does not exist, and a path that is a folder.
+        os.mkdir(self.path("folder.vts"))
+        for name, words in (("missing/a.vts", "No such file"), ("folder.vts", "not a regular file")):
+            with self.assertRaisesRegex(OSError, words, msg=name) as caught:
+                interchange.write_lattice(lattice, self.path(name))
+            self.assertEqual(caught.exception.filename, self.path(name))
 
 
 if __name__ == "__main__":

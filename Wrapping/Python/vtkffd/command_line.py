@@ -2,16 +2,18 @@
 """The command line `python3 -m vtkffd`: build a lattice around a mesh, deform a mesh by a lattice (or map it back),
 describe or convert a lattice file. main() is its entry point; README, "Command line", shows it at work.
 
-Meshes are read and written by vtkffd.meshio, lattices by vtkffd.interchange, each by its file's extension. A
-user's mistake (a missing file, an unknown extension, options that do not fit, a filter's error) ends in one line
-on stderr and exit status 1 (2 for a usage error), never in a traceback.
+Meshes are read and written by vtkffd.meshio, lattices by vtkffd.interchange, each by its file's extension; a
+write that fails leaves the file that was there. A user's mistake (a missing file, an unknown extension, a file
+cut short or garbled, options that do not fit, a filter's error, a write that fails) ends in one line on stderr and
+exit status 1 (2 for a usage error), never in a traceback.
 """
 import argparse
+import math
 import sys
 
 import numpy as np
 from vtkmodules.util.numpy_support import vtk_to_numpy
-from vtkmodules.vtkCommonCore import vtkCommand, vtkLogger, vtkOutputWindow
+from vtkmodules.vtkCommonCore import reference, vtkCommand, vtkLogger, vtkOutputWindow
 from vtkmodules.vtkCommonExecutionModel import vtkAlgorithm
 from vtkmodules.vtkFiltersGeneral import vtkImageDataToPointSet
 
@@ -136,6 +138,27 @@ def read_point_set(path):
     return points.GetOutput()
 
 
+def check_frame(mesh, arguments):
+    """Raises CommandError when the frame around the mesh's finite points, grown by the padding, has sides that
+    float64 cannot hold (vtkFFDVoxelize would call it flat): the mesh's extent, or its largest side times
+    1 + 2 padding (times sqrt(3), the most a principal-axes box can grow over the axis-aligned one)."""
+    points = vtk_to_numpy(mesh.GetPoints().GetData()).astype(np.float64)
+    points = points[np.all(np.isfinite(points), axis=1)]
+    if not len(points):
+        return  # vtkFFDVoxelize's error
+    with np.errstate(over="ignore"):
+        low, high = points.min(axis=0), points.max(axis=0)
+        extent = high - low
+        side = extent.max() * (1.0 + 2.0 * arguments.padding) * (math.sqrt(3.0) if arguments.frame == "principal"
+                                                                 else 1.0)
+    if not np.all(np.isfinite(extent)):
+        raise CommandError(f"{arguments.mesh}: its points span from {low.tolist()} to {high.tolist()}, farther than "
+                           "float64 holds a frame's sides: scale the mesh down")
+    if not math.isfinite(side):
+        raise CommandError(f"--padding {arguments.padding:g}: the frame's sides, {extent.max():g} grown by twice the "
+                           "padding, overflow float64: give a smaller padding")
+
+
 def build(arguments, console):
     interchange.lattice_extension(arguments.output)  # a lattice file: fail before the work
     mesh = read_point_set(arguments.mesh)
@@ -149,6 +172,7 @@ def build(arguments, console):
         summary = (f"{lattice.GetNumberOfCells()} tetrahedra from a hull of {builder.GetNumberOfHullFaces()} "
                    f"triangles, {lattice.GetNumberOfPoints()} nodes ({builder.GetNumberOfActiveNodes()} active)")
     else:
+        check_frame(mesh, arguments)
         voxelize = vtkffd.vtkFFDVoxelize()
         voxelize.SetInputData(mesh)
         voxelize.SetDivisions(*arguments.divisions)
@@ -218,9 +242,10 @@ def describe(lattice):
         else:
             kind = (f"grid, sparse: a {lattice.GetClassName()} of the active control points and "
                     f"{lattice.GetNumberOfCells()} cells, one per active voxel")
-        basis, divisions, frame = field.GetArray(Contract.BasisArrayName()), [0] * 3, [0.0] * 12
+        basis, divisions, frame = reference(0), [0] * 3, [0.0] * 12
         rows = [("kind", kind),
-                ("basis", name_of(BASES, int(basis.GetTuple1(0)), "malformed") if basis else "missing"),
+                ("basis", name_of(BASES, int(basis), "malformed") if Contract.GetBasis(lattice, basis)
+                 else "missing or malformed"),
                 ("divisions", " x ".join(map(str, divisions)) if Contract.GetDivisions(lattice, divisions)
                  else "missing or malformed")]
         if Contract.GetFrame(lattice, frame):
@@ -274,25 +299,28 @@ def build_defaults(tetrahedral):
             "padding": voxelize.GetPadding()}
 
 
+INT_MAX = 2**31 - 1  # VTK's int settings (vtkFFDVoxelize's Divisions)
+
+
 def positive_int(text):
-    """A whole number, at least 1 (an argparse type)."""
+    """A whole number, at least 1 and at most VTK's int (an argparse type)."""
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{value}: at least 1 voxel per axis")
+    if not 1 <= value <= INT_MAX:
+        raise argparse.ArgumentTypeError(f"{value}: at least 1 voxel per axis, at most {INT_MAX}")
     return value
 
 
 def nonnegative_float(text):
-    """A number, at least 0 (an argparse type)."""
+    """A finite number, at least 0 (an argparse type)."""
     try:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not value >= 0.0:
-        raise argparse.ArgumentTypeError(f"{value}: at least 0")
+    if not 0.0 <= value < math.inf:
+        raise argparse.ArgumentTypeError(f"{value}: a finite number, at least 0")
     return value
 
 
@@ -425,5 +453,8 @@ def main(argv=None):
     except OSError as error:  # a file that cannot be opened, read or written
         print(f"{PROG}: error: {error.filename}: {error.strerror}" if error.filename else f"{PROG}: error: {error}",
               file=sys.stderr)
+        return 1
+    except MemoryError:  # what no size check foresaw
+        print(f"{PROG}: error: out of memory running {arguments.command}", file=sys.stderr)
         return 1
     return 0

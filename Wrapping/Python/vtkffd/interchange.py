@@ -15,9 +15,11 @@ Every export takes a dense or sparse grid lattice of the format's basis. A spars
 displacement: the exported deformation then equals the lattice's over the lattice's active voxels, which hold
 every point of the mesh it was built over, and may differ elsewhere.
 
-A malformed file, a transform that is no lattice, or a lattice a format cannot hold (another basis, a tetrahedral
-lattice, a frame that the format cannot orient) raises ValueError with the reason, in one line (VTK's errors are
-caught by vtkffd.meshio.checked); a missing file raises FileNotFoundError.
+A malformed file (cut short, garbled, or sizes that do not add up), a transform that is no lattice, or a lattice a
+format cannot hold (another basis, a tetrahedral lattice, a frame that the format cannot orient, points that are
+not finite) raises ValueError with the reason, in one line (VTK's errors are caught by vtkffd.meshio.checked); a
+missing file raises FileNotFoundError. Files are written all or nothing (vtkffd.meshio.write_atomically): a write
+that fails raises OSError and leaves the file that was there.
 """
 import configparser
 import math
@@ -81,6 +83,13 @@ def lattice_at_rest(frame, divisions, basis):
     divisions = [int(n) for n in divisions]
     if int(basis) not in (BERNSTEIN, TRILINEAR, TRIQUADRATIC_BEZIER, TRICUBIC_BEZIER, CUBIC_BSPLINE):
         raise ValueError("unknown basis %r: vtkFFDBuildLattice's are 0 (BERNSTEIN) to 4 (CUBIC_BSPLINE)" % (basis,))
+    axes = frame[3:].reshape(3, 3)
+    if not np.all(np.isfinite(np.linalg.norm(axes, axis=1))) or not np.isfinite(np.linalg.det(axes)):
+        raise ValueError("the frame's edges S, T, U (%s) are too long: their lengths or the frame's volume overflow "
+                         "float64" % axes.tolist())
+    # The voxel image's index takes some 72 bytes a voxel (numpy's grids and the VTK array); the builder checks
+    # the lattice it makes.
+    _require_memory(72.0 * math.prod(divisions), "a dense lattice of %s divisions" % divisions)
     # The builder reads only the field arrays and VoxelIndex: an image of the voxels, each listed once.
     voxels = vtkImageData()
     voxels.SetDimensions(divisions[0] + 1, divisions[1] + 1, divisions[2] + 1)
@@ -104,6 +113,21 @@ def lattice_at_rest(frame, divisions, basis):
     lattice = vtkStructuredGrid()
     lattice.DeepCopy(output)
     return lattice
+
+
+def _require_memory(size, what):
+    """Raises ValueError when `size` bytes for `what` exceed the memory the system can still give (MemAvailable,
+    as vtkFFDMemory.h reads it for the filters): a size read from a file or set by a user, checked before numpy
+    allocates it (Linux lets a process reserve far more than it can touch)."""
+    available = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    try:
+        with open("/proc/meminfo") as meminfo:
+            available = next(int(line.split()[1]) * 1024 for line in meminfo if line.startswith("MemAvailable:"))
+    except (OSError, StopIteration, ValueError, IndexError):
+        pass
+    if size > available:
+        raise ValueError("%s: %.3g GB needed, more than the %.3g GB of memory available" % (what, size / 2**30,
+                                                                                          available / 2**30))
 
 
 def _lattice_with_displacements(frame, divisions, basis, displacement):
@@ -140,6 +164,7 @@ def _grid_lattice(lattice, where):
     if rest is None or rest.GetNumberOfComponents() != 3 or lattice.GetPoints() is None or \
             rest.GetNumberOfTuples() != lattice.GetNumberOfPoints():
         raise ValueError("%s: the lattice has no RestPosition of 3 components per point" % where)
+    _require_finite(lattice, where)
     counts = _control_points_per_axis(basis, divisions)
     moved = vtk_to_numpy(lattice.GetPoints().GetData()).astype(np.float64) - vtk_to_numpy(rest)
     if isinstance(lattice, vtkStructuredGrid):
@@ -159,6 +184,18 @@ def _grid_lattice(lattice, where):
         displacement = np.zeros((counts[2], counts[1], counts[0], 3))
         displacement[index[:, 2], index[:, 1], index[:, 0]] = moved
     return np.array(frame).reshape(4, 3), np.array(divisions), basis, displacement
+
+
+def _require_finite(lattice, where):
+    """Raises ValueError, naming `where`, when a point or RestPosition of the lattice (whose RestPosition has one
+    3-vector per point) is not finite: no reader, ours included, takes such a lattice back."""
+    for name, values in (("point", lattice.GetPoints().GetData()),
+                         (vtkFFDDataContract.RestPositionArrayName(), lattice.GetPointData().GetArray(
+                             vtkFFDDataContract.RestPositionArrayName()))):
+        bad = np.flatnonzero(~np.all(np.isfinite(vtk_to_numpy(values)), axis=1))
+        if len(bad):
+            raise ValueError("%s: the %s of control point %d is not finite (%d control points have NaN or infinite "
+                             "coordinates): move them to finite positions first" % (where, name, bad[0], len(bad)))
 
 
 def _require_basis(basis, wanted, what):
@@ -224,9 +261,14 @@ def read_prm(path):
         raise FileNotFoundError("no PyGeM parameter file at %s" % path)
     config = configparser.RawConfigParser()  # as PyGeM reads it
     try:
-        config.read(path, encoding="utf-8")
+        with open(path, encoding="utf-8") as stream:
+            text = stream.read()
+        config.read_string(text, source=path)
     except (configparser.Error, UnicodeDecodeError) as error:
         raise ValueError("%s is not a PyGeM parameter file: %s" % (path, " ".join(str(error).split()))) from None
+    if text and not text.endswith("\n"):  # PyGeM's files and ours end with one; a cut in a number reads as one
+        raise ValueError("%s does not end with a line break: a file cut short? (if it is whole, end it with one)" %
+                         path)
 
     def value(section, key, kind):
         try:
@@ -251,7 +293,9 @@ def read_prm(path):
             path, counts))
     if 0.0 in lengths:
         raise ValueError("%s: a box length of 0 makes a flat box" % path)
+    _require_memory(24.0 * math.prod(counts), "%s: %s control points" % (path, "x".join(map(str, counts))))
     weights = np.zeros((3, counts[0], counts[1], counts[2]))  # PyGeM's array_mu_x, _y, _z, indexed [i, j, k]
+    listed = np.zeros(weights.shape, dtype=bool)
     for c, axis in enumerate("xyz"):
         try:
             text = config.get("Parameters weights", "parameter " + axis)
@@ -275,6 +319,15 @@ def read_prm(path):
                 raise ValueError("%s: 'parameter %s' line %r has a weight that is not finite" % (
                     path, axis, line.strip()))
             weights[c, i, j, k] = weight  # a repeated line overrides, as in PyGeM
+            listed[c, i, j, k] = True
+    # Lines left out are zero, but PyGeM and write_prm list every control point: a file that lists all of them
+    # for one axis and not for another was cut short.
+    complete = listed.reshape(3, -1).all(axis=1)
+    if complete.any() and not complete.all():
+        axis = "xyz"[int(np.argmin(complete))]
+        raise ValueError("%s: 'parameter %s' lists %d of the %d control points, while 'parameter %s' lists them all: "
+                         "a file cut short?" % (path, axis, listed["xyz".index(axis)].sum(), listed[0].size,
+                                                "xyz"[int(np.argmax(complete))]))
     edges = _pygem_rotation(angles) * np.array(lengths)  # columns: S, T, U
     frame = np.concatenate([origin, edges[:, 0], edges[:, 1], edges[:, 2]])
     # mu[c][i, j, k] -> [k, j, i, c], then each weight along its own edge.
@@ -323,8 +376,17 @@ def write_prm(lattice, path):
                 for i in range(counts[0]) for j in range(counts[1]) for k in range(counts[2])]
         lines.append("parameter %s: %s" % (axis, rows[0]))
         lines += ["             " + row for row in rows[1:]]  # indented: configparser's continuation lines
-    with open(path, "w", encoding="utf-8") as stream:
-        stream.write("\n".join(lines) + "\n")
+    _write_text(path, "\n".join(lines) + "\n")
+
+
+def _write_text(path, text):
+    """Writes `text` into the file `path`, UTF-8, all or nothing (vtkffd.meshio.write_atomically)."""
+
+    def write(temporary):
+        with open(temporary, "w", encoding="utf-8") as stream:
+            stream.write(text)
+
+    meshio.write_atomically(path, write)
 
 
 # --- VTK's transforms -------------------------------------------------------------------------------------------
@@ -554,11 +616,10 @@ def read_tfm(path):
         raise ValueError("%s: grid spacing %s; ITK's spacings are positive" % (path, spacing.tolist()))
     if abs(np.linalg.det(direction)) < 1e-12:
         raise ValueError("%s: the grid's direction matrix %s is singular" % (path, direction.tolist()))
+    if 3 * np.prod(size) != parameters.size:  # in float64, before a size of 1e300 becomes an integer
+        raise ValueError("%s: a grid of %s nodes has %.17g parameters (3 per node), this one %d" % (
+            path, size.tolist(), 3 * np.prod(size), parameters.size))
     size = size.astype(np.int64)
-    nodes = int(np.prod(size))
-    if parameters.size != 3 * nodes:
-        raise ValueError("%s: a grid of %s nodes has %d parameters (3 per node), this one %d" % (
-            path, size.tolist(), 3 * nodes, parameters.size))
     divisions = size - 3
     axes = direction * (spacing * divisions)  # columns: S, T, U
     frame = np.concatenate([origin + direction @ spacing, axes[:, 0], axes[:, 1], axes[:, 2]])
@@ -581,10 +642,9 @@ def write_tfm(lattice, path):
     size = divisions + 3
     parameters = np.concatenate([displacement[..., c].ravel() for c in range(3)])
     fixed = np.concatenate([size, origin, spacing, direction.ravel()])  # ravel: row-major, as ITK stores it
-    with open(path, "w", encoding="utf-8") as stream:
-        stream.write("#Insight Transform File V1.0\n#Transform 0\nTransform: BSplineTransform_double_3_3\n")
-        stream.write("Parameters: " + " ".join(_number(x) for x in parameters) + "\n")
-        stream.write("FixedParameters: " + " ".join(_number(x) for x in fixed) + "\n")
+    _write_text(path, "#Insight Transform File V1.0\n#Transform 0\nTransform: BSplineTransform_double_3_3\n"
+                "Parameters: " + " ".join(_number(x) for x in parameters) + "\n"
+                "FixedParameters: " + " ".join(_number(x) for x in fixed) + "\n")
 
 
 # --- files by extension -----------------------------------------------------------------------------------------
@@ -602,31 +662,20 @@ def lattice_extension(path):
     return extension
 
 
-def _check_header(path, extension):
-    """Refuses a file that is not of its extension's kind before VTK's readers parse it (their parsers report to
-    the log, not to the reader's observers)."""
-    magic = {".vts": b"<", ".vtu": b"<", ".vtk": b"# vtk DataFile"}.get(extension)
-    if magic is None:
-        return
-    with open(path, "rb") as stream:
-        head = stream.read(64).lstrip()
-    if not head.startswith(magic):
-        raise ValueError("cannot read a lattice from %s: it is not a VTK %s file" % (
-            path, "XML" if magic == b"<" else "legacy"))
-
-
 def _require_lattice_arrays(data, path):
     rest = data.GetPointData().GetArray(vtkFFDDataContract.RestPositionArrayName())
-    if rest is None or rest.GetNumberOfComponents() != 3:
-        raise ValueError("%s holds no lattice: its points have no RestPosition of 3 components (README, "
+    if data.GetPoints() is None or rest is None or rest.GetNumberOfComponents() != 3 or \
+            rest.GetNumberOfTuples() != data.GetNumberOfPoints():
+        raise ValueError("%s holds no lattice: its points have no RestPosition of 3 components each (README, "
                          "\"Data contract\")" % path)
 
 
 def read_lattice(path):
     """A lattice from a file, by its extension: .vts (dense, VTK XML), .vtu (sparse or tetrahedral, VTK XML), .vtk
     (either, VTK legacy), each read by vtkffd.meshio's reader of the extension, .vdb (sparse, vtkFFDVDBReader),
-    .prm (read_prm), .tfm (read_tfm). ValueError for another extension, a file its reader refuses, or a data set
-    that is no lattice (no RestPosition)."""
+    .prm (read_prm), .tfm (read_tfm). ValueError for another extension, a file its reader refuses (VTK's warnings
+    included: a legacy file cut short gives only one), a data set that is no lattice (no RestPosition of one
+    3-vector per point), or cells that name points it does not have."""
     extension = lattice_extension(path)
     if not os.path.isfile(path):
         raise FileNotFoundError("no lattice file at %s" % path)
@@ -634,15 +683,16 @@ def read_lattice(path):
         return read_prm(path)
     if extension == ".tfm":
         return read_tfm(path)
-    _check_header(path, extension)
+    failure = "cannot read a lattice from %s" % path
+    meshio.check_header(path, extension, failure)
     reader = vtkFFDVDBReader() if extension == ".vdb" else meshio.VTK_FORMATS[extension][0]()
     reader.SetFileName(path)
-    meshio.checked(reader, reader.Update, "cannot read a lattice from %s" % path, ValueError)
+    meshio.checked(reader, reader.Update, failure, ValueError, warnings=True)
     data = reader.GetOutputDataObject(0)
     if not isinstance(data, (vtkStructuredGrid, vtkUnstructuredGrid)):
-        raise ValueError("cannot read a lattice from %s: it holds %s" % (
-            path, "a " + type(data).__name__ if data else "nothing"))
+        raise ValueError("%s: it holds %s" % (failure, "a " + type(data).__name__ if data else "nothing"))
     _require_lattice_arrays(data, path)
+    meshio.check_cells(data, failure)
     lattice = type(data)()
     lattice.DeepCopy(data)
     return lattice
@@ -652,7 +702,8 @@ def write_lattice(lattice, path):
     """Writes a lattice to a file, by its extension: .vts (a dense lattice), .vtu (a sparse or tetrahedral one),
     .vtk (either), each by vtkffd.meshio's write_mesh (XML compressed, legacy binary: doubles stay exact), .vdb (a
     sparse lattice of a local basis, vtkFFDVDBWriter), .prm (write_prm), .tfm (write_tfm). ValueError for another
-    extension or a lattice the format cannot hold; OSError when VTK cannot write the file."""
+    extension or a lattice the format cannot hold, or whose points are not finite; OSError when the file cannot be
+    written, which then is as it was (vtkffd.meshio.write_atomically)."""
     extension = lattice_extension(path)
     if extension == ".prm":
         return write_prm(lattice, path)
@@ -662,6 +713,7 @@ def write_lattice(lattice, path):
         raise ValueError("write_lattice takes a lattice (vtkStructuredGrid or vtkUnstructuredGrid), not %s" % (
             type(lattice).__name__))
     _require_lattice_arrays(lattice, "the data set to write to " + path)
+    _require_finite(lattice, path)
     if extension == ".vts" and not isinstance(lattice, vtkStructuredGrid):
         raise ValueError("%s: .vts holds dense lattices (vtkStructuredGrid); write this %s to .vtu" % (
             path, type(lattice).__name__))
@@ -672,6 +724,7 @@ def write_lattice(lattice, path):
         return meshio.write_mesh(lattice, path)
     writer = vtkFFDVDBWriter()
     writer.SetInputData(lattice)
-    writer.SetFileName(path)
-    meshio.checked(writer, writer.Write, "cannot write %s" % path, ValueError)
+    # The lattices it refuses are ValueErrors, as those of the other formats.
+    meshio.write_atomically(path, lambda temporary: meshio.write_vtk(writer, temporary, "cannot write " + path,
+                                                                     ValueError))
     return None
