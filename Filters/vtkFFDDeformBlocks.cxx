@@ -177,7 +177,9 @@ int vtkFFDDeformBlocks::RequestData(
   vtkDataArray* inNormals = input->GetPointData()->GetNormals();
   std::vector<vtkDataArray*> movedNormals(static_cast<std::size_t>(count), nullptr);
   vtkSmartPointer<vtkDataArray> outNormals;
-  if (this->TransformNormals && inNormals && inNormals->GetNumberOfComponents() == 3)
+  // Normals of another size are passed on as they are (each vtkFFDDeform warns that it cannot transform them).
+  if (this->TransformNormals && inNormals && inNormals->GetNumberOfComponents() == 3 &&
+    inNormals->GetNumberOfTuples() == numPoints)
   {
     for (int b = 0; b < count; ++b)
     {

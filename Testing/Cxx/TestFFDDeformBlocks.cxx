@@ -9,10 +9,12 @@
 #include "FFDTestLattices.h"
 #include "FFDTestMeshes.h"
 
+#include "vtkDoubleArray.h"
 #include "vtkFFDBuildTetrahedralLattice.h"
 #include "vtkFFDDeformBlocks.h"
 #include "vtkFFDRefineLattice.h"
 #include "vtkMath.h"
+#include "vtkPointData.h"
 #include "vtkUnstructuredGrid.h"
 
 #include <gtest/gtest.h>
@@ -382,4 +384,42 @@ TEST(vtkFFDDeformBlocks, SaysWhichInputIsMissingOrWrong)
     ffdtest::MovedLattice(cow, vtkFFDBuildLattice::TRILINEAR, n, vtkFFDBuildLattice::DENSE, rng, 0.01));
   ffdtest::ExpectClearInputErrors(blocks, 0, "the mesh", "SetInputConnection() to the mesh to deform");
   ffdtest::ExpectClearInputErrors(blocks, 1, "the lattices", "AddLatticeConnection()");
+}
+
+// Issue 30, siblings of item 6: point normals with fewer tuples than the mesh has points were read past their
+// end for every point (and written out as the point count's worth of transformed normals). They are passed on
+// as they are, untransformed, as vtkFFDDeform passes them; the points are deformed as without normals.
+TEST(vtkFFDDeformBlocks, NormalsOfAnotherSizeArePassedOnUntransformed)
+{
+  vtkSmartPointer<vtkPolyData> cow = ReadTestMesh("cow");
+  std::mt19937 rng(36);
+  const int n[3] = { 2, 2, 2 };
+  vtkSmartPointer<vtkPointSet> lattice =
+    ffdtest::MovedLattice(cow, vtkFFDBuildLattice::TRILINEAR, n, vtkFFDBuildLattice::DENSE, rng, 0.05);
+  vtkNew<vtkFFDDeformBlocks> plain;
+  plain->SetInputData(cow);
+  plain->AddLatticeData(lattice);
+  plain->Update();
+
+  vtkNew<vtkPolyData> shortNormals;
+  shortNormals->ShallowCopy(cow);
+  vtkNew<vtkDoubleArray> normals;
+  normals->SetName("Normals");
+  normals->SetNumberOfComponents(3);
+  normals->SetNumberOfTuples(10);
+  normals->FillValue(0.0);
+  shortNormals->GetPointData()->SetNormals(normals);
+  for (int composition : { vtkFFDDeformBlocks::BLEND, vtkFFDDeformBlocks::ADD })
+  {
+    vtkNew<vtkFFDDeformBlocks> blocks;
+    blocks->SetComposition(composition);
+    blocks->SetInputData(shortNormals);
+    blocks->AddLatticeData(lattice);
+    blocks->Update();
+    vtkPointSet* output = blocks->GetOutput();
+    ASSERT_EQ(output->GetNumberOfPoints(), cow->GetNumberOfPoints());
+    EXPECT_TRUE(ffdtest::SamePoints(output, plain->GetOutput()));
+    ASSERT_NE(output->GetPointData()->GetNormals(), nullptr);
+    EXPECT_EQ(output->GetPointData()->GetNormals()->GetNumberOfTuples(), 10);
+  }
 }
