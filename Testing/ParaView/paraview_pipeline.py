@@ -44,8 +44,8 @@ if processes > 1:
     # Pieces of cells share the points on their borders: GenerateGlobalIds marks every copy but one as a ghost.
     mesh = GenerateGlobalIds(Input=RedistributeDataSet(Input=mesh))
 
-voxels = FFDVoxelize(Input=mesh, Divisions=[5, 6, 4], FrameMode="PrincipalAxes")  # noqa: F821
-lattice = FFDBuildLattice(Input=voxels, Basis="CubicBSpline", LatticeForm="Sparse")  # noqa: F821
+voxels = FFDVoxelize(Input=mesh, Divisions=[5, 6, 4], FrameMode="Principal Axes")  # noqa: F821
+lattice = FFDBuildLattice(Input=voxels, Basis="Cubic B-Spline", LatticeForm="Sparse")  # noqa: F821
 moved = ProgrammableFilter(Input=lattice, Script=MOVE)
 deformed = FFDDeform(Input=mesh, Lattice=moved)  # noqa: F821
 tetrahedra = FFDBuildTetrahedralLattice(Input=mesh, SubdivisionLevels=1)  # noqa: F821
