@@ -24,6 +24,7 @@
 #include "vtkSMPTools.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
+#include "FFDFrame.h"
 #include "FFDLeastSquares.h"
 
 #include <algorithm>
@@ -82,11 +83,13 @@ bool IsFinite(const double x[3])
 }
 
 /// 1 for each point whose rest (`mesh`) and deformed (`target`) positions are both finite, else 0; `first` is
-/// the first point that is not (-1: none).
-std::vector<char> FinitePoints(vtkPointSet* mesh, vtkPointSet* target, vtkIdType& first)
+/// the first point that is not (-1: none), `inside` how many of those that are lie in `frame` at rest.
+std::vector<char> FinitePoints(
+  vtkPointSet* mesh, vtkPointSet* target, const ffd::Frame<double>& frame, vtkIdType& first, vtkIdType& inside)
 {
   std::vector<char> finite(std::size_t(mesh->GetNumberOfPoints()));
   first = -1;
+  inside = 0;
   for (vtkIdType p = 0; p < mesh->GetNumberOfPoints(); ++p)
   {
     double x[3], y[3];
@@ -97,6 +100,8 @@ std::vector<char> FinitePoints(vtkPointSet* mesh, vtkPointSet* target, vtkIdType
     {
       first = p;
     }
+    ffd::Vec3<double> stu;
+    inside += finite[p] && frame.Bind(ffd::Vec3<double>::From(x), stu);
   }
   return finite;
 }
@@ -259,13 +264,15 @@ int vtkFFDCoarsenLattice::RequestData(
     }
   }
   // A point without a finite rest or deformed position has no displacement to fit: it is left out, and said so.
-  vtkIdType firstNotFinite;
-  const std::vector<char> finite = FinitePoints(mesh, target, firstNotFinite);
+  vtkIdType firstNotFinite, inside;
+  const std::vector<char> finite =
+    FinitePoints(mesh, target, ffd::Frame<double>::FromArray(fine.Frame), firstNotFinite, inside);
   const vtkIdType numFinite = std::count(finite.begin(), finite.end(), 1);
-  if (numFinite == 0)
+  if (inside == 0)
   {
-    vtkErrorMacro(<< "None of the mesh's " << mesh->GetNumberOfPoints()
-                  << " points has a finite position, at rest and deformed: there is nothing to fit.");
+    vtkErrorMacro(<< "None of the mesh's " << mesh->GetNumberOfPoints() << " points "
+                  << (numFinite == 0 ? "has a finite position, at rest and deformed" : "lies in the lattice's frame")
+                  << ": there is nothing to fit. SetMeshConnection() to the mesh that the lattice deforms.");
     return 0;
   }
   if (firstNotFinite >= 0)

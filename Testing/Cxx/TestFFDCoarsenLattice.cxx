@@ -473,3 +473,33 @@ TEST(vtkFFDCoarsenLattice, LeavesNonFinitePointsOutAndSaysSo)
   EXPECT_NE(nothingErrors->Errors.find("has a finite position"), std::string::npos) << nothingErrors->Errors;
   EXPECT_EQ(nothing->GetOutput()->GetNumberOfPoints(), 0);
 }
+
+// A sibling of issue 30, item 7: a mesh wholly outside the lattice's frame gave, dense, "Could not build the
+// coarse lattice (see the error above)" with no error above, and, sparse, a lattice fitted to nothing. Both say
+// that no point lies in the frame.
+TEST(vtkFFDCoarsenLattice, RefusesAMeshOutsideTheLatticesFrame)
+{
+  vtkSmartPointer<vtkPolyData> cow = ReadTestMesh("cow");
+  std::mt19937 rng(37);
+  const int n[3] = { 4, 4, 4 };
+  for (int form : { vtkFFDBuildLattice::DENSE, vtkFFDBuildLattice::SPARSE })
+  {
+    vtkSmartPointer<vtkPointSet> fine = MovedLattice(cow, vtkFFDBuildLattice::CUBIC_BSPLINE, n, form, rng, 0.02);
+    const double size = ffdtest::Diagonal(ffdtest::FrameOf(fine));
+    vtkNew<vtkPolyData> far;
+    far->DeepCopy(cow);
+    for (vtkIdType p = 0; p < far->GetNumberOfPoints(); ++p)
+    {
+      double x[3];
+      far->GetPoint(p, x);
+      far->GetPoints()->SetPoint(p, x[0] + 10 * size, x[1], x[2]);
+    }
+    vtkNew<vtkFFDCoarsenLattice> coarsen;
+    vtkNew<FFDTestErrorObserver> errors;
+    errors->WatchWithExecutive(coarsen);
+    Coarsen(fine, far, coarsen);
+    EXPECT_NE(errors->Errors.find("lies in the lattice's frame: there is nothing to fit"), std::string::npos)
+      << errors->Errors;
+    EXPECT_EQ(coarsen->GetOutput()->GetNumberOfPoints(), 0);
+  }
+}
