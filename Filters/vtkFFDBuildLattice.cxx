@@ -9,6 +9,7 @@
 #include "vtkFFDMemory.h"
 #include "vtkFFDPipelineKeys.h"
 #include "vtkFFDSparseLattice.h"
+#include "vtkFFDStatistics.h"
 #include "vtkFFDWholeInput.h"
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
@@ -409,6 +410,7 @@ int vtkFFDBuildLattice::BuildDense(const double frame[12], const int divisions[3
   vtkFFDDataContract::SetDivisions(output, divisions);
   vtkFFDDataContract::SetBasis(output, this->Basis);
   this->NumberOfActiveControlPoints = numActive;
+  vtkFFDRecordCount(output, "NumberOfActiveControlPoints", numActive);
   return 1;
 }
 
@@ -425,6 +427,7 @@ int vtkFFDBuildLattice::BuildSparse(
     return 0;
   }
   this->NumberOfActiveControlPoints = output->GetNumberOfPoints();
+  vtkFFDRecordCount(output, "NumberOfActiveControlPoints", this->NumberOfActiveControlPoints);
   return 1;
 }
 

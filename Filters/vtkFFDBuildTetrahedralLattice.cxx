@@ -4,6 +4,7 @@
 #include "vtkFFDDataContract.h"
 #include "vtkFFDDistributed.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDStatistics.h"
 #include "vtkFFDTetrahedralDeformer.h"
 
 #include "vtkCellArray.h"
@@ -444,6 +445,8 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
     }
     output->GetPointData()->AddArray(ghosts);
   }
+  vtkFFDRecordCount(output, "NumberOfHullFaces", this->NumberOfHullFaces);
+  vtkFFDRecordCount(output, "NumberOfActiveNodes", this->NumberOfActiveNodes);
   this->UpdateProgress(1.0);
   return 1;
 }

@@ -8,6 +8,7 @@
 #include "vtkFFDMemory.h"
 #include "vtkFFDPipelineKeys.h"
 #include "vtkFFDSparseLattice.h"
+#include "vtkFFDStatistics.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
@@ -430,6 +431,7 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
     return 0;
   }
   this->NumberOfActiveVoxels = static_cast<vtkIdType>(voxels.size());
+  vtkFFDRecordCount(output, "NumberOfActiveVoxels", this->NumberOfActiveVoxels);
   this->UpdateProgress(1.0);
   return 1;
 }

@@ -39,6 +39,7 @@
 #include "FFDTestComparisons.h"
 #include "FFDTestErrorObserver.h"
 #include "FFDTestMeshes.h"
+#include "FFDTestStatistics.h"
 
 #include <gtest/gtest.h>
 
@@ -280,6 +281,7 @@ void ExpectActiveFromSupports(int basis, vtkDataSet* voxels, vtkFFDBuildLattice*
         expectedActive += influences;
       }
   EXPECT_EQ(build->GetNumberOfActiveControlPoints(), expectedActive);
+  ExpectRecordedCount(lattice, "NumberOfActiveControlPoints", expectedActive);
   // The ghost array exists exactly when some control point is culled.
   EXPECT_EQ(ghosts != nullptr, expectedActive < lattice->GetNumberOfPoints());
 }

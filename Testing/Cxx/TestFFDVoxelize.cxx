@@ -27,6 +27,7 @@
 #include "FFDTestComparisons.h"
 #include "FFDTestErrorObserver.h"
 #include "FFDTestMeshes.h"
+#include "FFDTestStatistics.h"
 
 #include <gtest/gtest.h>
 
@@ -208,6 +209,7 @@ void ExpectActiveVoxelsMatchBruteForce(vtkPointSet* input, vtkFFDVoxelize* filte
   EXPECT_FALSE(expected.empty());
   EXPECT_EQ(ActiveVoxels(out), expected);
   EXPECT_EQ(filter->GetNumberOfActiveVoxels(), static_cast<vtkIdType>(expected.size()));
+  ExpectRecordedCount(out, "NumberOfActiveVoxels", static_cast<vtkIdType>(expected.size()));
   ExpectCellsOnTheirCorners(out, n);
 }
 
