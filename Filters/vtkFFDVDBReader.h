@@ -17,10 +17,14 @@
  * as the writer leaves it, and at its rest position plus the displacement where another tool changed the
  * displacement.
  *
- * Both outputs cost memory in proportion to the active voxels and control points; the grids' size in memory, as
- * the file states it, is checked against the memory the system can give before they are read, and the outputs'
- * before they are made. Errors (reported with vtkErrorMacro, both outputs then empty): no FileName; a file that is
- * missing, unreadable or not a .vdb file (OpenVDB's exceptions are caught and reported); a missing grid or one of
+ * The file is read whole into memory (its size checked first against the memory the system can give) and
+ * parsed by OpenVDB from there, so that no read goes past its end. OpenVDB trusts the sizes in a file, so the
+ * checksum that vtkFFDVDBWriter appends (README, ".vdb files") is checked before OpenVDB parses a byte: a file it
+ * wrote that was changed or cut since is an error, never a crash or other data. A file without the checksum
+ * (another tool's) is parsed as it is: one cut short is an error; damage inside it is OpenVDB's to find. Both
+ * outputs cost memory in proportion to the active voxels and control points, checked before they are made.
+ * Errors (reported with vtkErrorMacro, both outputs then empty): no FileName; a file that is missing, unreadable,
+ * damaged, cut short or not a .vdb file (OpenVDB's exceptions are caught and reported); a missing grid or one of
  * another type; missing or malformed metadata, or grids that disagree on it; a flat or non-finite frame,
  * divisions below one, an unknown basis or the global BERNSTEIN one; an active voxel outside the divisions; a
  * control point of the voxels' supports without a displacement or position, or one where the lattice has no

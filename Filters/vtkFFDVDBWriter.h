@@ -25,7 +25,13 @@
  * what differs, as are a dense lattice (vtkStructuredGrid: use vtkFFDBuildLattice::SetLatticeFormToSparse()), the
  * global BERNSTEIN basis (no sparse form), missing or malformed contract arrays, two cells of one voxel, no
  * FileName, and a file OpenVDB cannot write (its exception is caught and reported). Write() then returns 0, with
- * GetErrorCode() set, and a file it could not finish is removed.
+ * GetErrorCode() set.
+ *
+ * The file is written whole to a temporary file beside FileName, every write, the flush and the close checked,
+ * and only then renamed over FileName (keeping an existing file's permissions): a write that fails part-way (a
+ * full disk, a quota, a read-only folder) is an error that leaves the file at FileName as it was and no temporary
+ * file behind. After OpenVDB's bytes comes a checksum of them (README, ".vdb files"), which vtkFFDVDBReader checks
+ * before parsing and other tools never read.
  *
  * @sa vtkFFDVDBReader vtkFFDBuildLattice
  */
@@ -34,6 +40,8 @@
 
 #include "vtkFFDFiltersModule.h" // For export macro
 #include "vtkWriter.h"
+
+#include <string> // For WriteFileAtomically
 
 class vtkDataObject;
 
@@ -63,6 +71,9 @@ protected:
 private:
   /// WriteData() without its exceptions: false, with the error reported, when nothing was written.
   bool WriteLattice(vtkDataObject* input);
+  /// Writes `bytes` to FileName through a temporary file renamed over it: false, with the error and its code set,
+  /// where any step fails, the temporary file then removed.
+  bool WriteFileAtomically(const std::string& bytes);
 
   vtkFFDVDBWriter(const vtkFFDVDBWriter&) = delete;
   void operator=(const vtkFFDVDBWriter&) = delete;

@@ -3,7 +3,9 @@
 // points moved at random, written and read back identical bit for bit (every array, the cells, the field data),
 // with the voxel grid vtkFFDVoxelize makes and the same deformation; OpenVDB's own vdb_print reads the file; a
 // displacement that another tool changed is the deformation read back; every bad input and every malformed file
-// (made here with OpenVDB) gives an error and empty outputs, never a crash. File size and times are printed.
+// (made here with OpenVDB) gives an error and empty outputs, never a crash; every byte flipped and every cut of a
+// written file is an error or the file read back identical, in a child process under an address-space limit; a write
+// that fails part-way leaves the old file as it was. File size and times are printed.
 
 #include "FFDTestErrorObserver.h"
 #include "FFDTestLattices.h"
@@ -29,15 +31,22 @@
 
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <random>
 #include <regex>
@@ -216,6 +225,112 @@ typename GridT::Ptr GridNamed(openvdb::GridPtrVec& grids, const std::string& nam
 {
   return openvdb::gridPtrCast<GridT>(openvdb::findGridByName(grids, name));
 }
+
+/// The bytes of the file at `path`.
+std::string FileBytes(const std::string& path)
+{
+  std::ifstream file(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+}
+
+void WriteBytes(const std::string& path, const std::string& bytes)
+{
+  std::ofstream(path, std::ios::binary | std::ios::trunc).write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+/// What reading a damaged file gave (ReadInChild()).
+enum Outcome
+{
+  Identical = 0, ///< both outputs identical to what was written
+  Damaged = 1,   ///< the checksum's error ("is damaged"), outputs empty
+  Refused = 2,   ///< another error, outputs empty
+  Wrong = 3,     ///< read without error, but other data: silently wrong
+  NotEmpty = 4,  ///< an error, but an output is not empty
+  NoMemory = 5,  ///< an allocation failed under the address-space limit
+  Crashed = 6    ///< the child died of a signal (SIGABRT, SIGSEGV; SIGALRM: it hung)
+};
+
+/**
+ * Reads `path` with vtkFFDVDBReader in a forked child, whose address space may grow by 1 GiB at most (RLIMIT_AS,
+ * so that an unbounded allocation fails there rather than meeting the OOM killer) and which has 30 s: the Outcome,
+ * comparing the outputs with `lattice` and `voxels`. The test runner survives whatever the reader does.
+ */
+Outcome ReadInChild(const std::string& path, vtkUnstructuredGrid* lattice, vtkUnstructuredGrid* voxels)
+{
+  std::fflush(nullptr);
+  const pid_t child = fork();
+  if (child == 0)
+  {
+    long pages = 0;
+    std::ifstream("/proc/self/statm") >> pages;
+    const rlim_t limit = rlim_t(pages) * rlim_t(sysconf(_SC_PAGESIZE)) + (rlim_t(1) << 30);
+    const rlimit bound = { limit, limit };
+    setrlimit(RLIMIT_AS, &bound);
+    alarm(30);
+    vtkNew<vtkFFDVDBReader> reader;
+    vtkNew<FFDTestErrorObserver> observer;
+    const int read = Read(reader, path, observer);
+    Outcome outcome = Identical;
+    if (observer->Errors.find("Out of memory") != std::string::npos)
+    {
+      outcome = NoMemory;
+    }
+    else if (read)
+    {
+      outcome = SameGrid(reader->GetOutput(), lattice) && SameGrid(reader->GetVoxelGridOutput(), voxels) &&
+          observer->Errors.empty()
+        ? Identical
+        : Wrong;
+    }
+    else if (reader->GetOutput()->GetNumberOfPoints() > 0 || reader->GetVoxelGridOutput()->GetNumberOfPoints() > 0)
+    {
+      outcome = NotEmpty;
+    }
+    else
+    {
+      outcome = observer->Errors.find(" is damaged: ") != std::string::npos ? Damaged : Refused;
+    }
+    if (outcome >= Wrong)
+    {
+      std::cerr << observer->Errors;
+    }
+    _exit(outcome);
+  }
+  int status = 0;
+  if (child < 0 || waitpid(child, &status, 0) != child)
+  {
+    ADD_FAILURE() << "fork() or waitpid() failed: " << std::strerror(errno);
+    return Crashed;
+  }
+  return WIFEXITED(status) ? Outcome(WEXITSTATUS(status)) : Crashed;
+}
+
+/// A folder of its own, removed with what it holds at the end of the scope.
+struct TempFolder
+{
+  explicit TempFolder(const std::string& name)
+    : Path(TempPath(name))
+  {
+    std::filesystem::create_directories(this->Path);
+  }
+  ~TempFolder()
+  {
+    std::filesystem::permissions(this->Path, std::filesystem::perms::owner_all);
+    std::filesystem::remove_all(this->Path);
+  }
+  /// The names of the files in the folder.
+  std::vector<std::string> Files() const
+  {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(this->Path))
+    {
+      names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+  const std::string Path;
+};
 } // namespace
 
 TEST(vtkFFDVDB, RoundTripOfTheBearIsIdenticalForEveryLocalBasis)
@@ -575,6 +690,149 @@ TEST(vtkFFDVDB, ReaderRefusesMissingAndMalformedFiles)
   {
     std::remove(files[f].second.c_str());
   }
+}
+
+TEST(vtkFFDVDB, EveryFlippedByteOrCutIsAnErrorOrTheSameLattice)
+{
+  // OpenVDB trusts the sizes in a file: one flipped byte aborted the process, a cut to 4,096 bytes allocated until
+  // the OOM killer came. Now every byte of OpenVDB's part flipped is the checksum's error, before OpenVDB parses
+  // it; a flip in the trailer's mark leaves an intact file of another tool; a cut is an error unless it cuts only
+  // the trailer. Never a crash, an unbounded allocation or other data without an error.
+  vtkSmartPointer<vtkPolyData> bear = ReadTestMesh("bear");
+  vtkSmartPointer<vtkFFDVoxelize> voxelize = VoxelizedBear(bear, 6);
+  vtkSmartPointer<vtkUnstructuredGrid> lattice = SparseLattice(voxelize, vtkFFDBuildLattice::CUBIC_BSPLINE);
+  std::mt19937 rng(20251129);
+  ffdtest::Perturb(lattice, rng, 0.01);
+  TempFile good("sweep_good.vdb"), damaged("sweep_damaged.vdb");
+  ASSERT_EQ(Write(lattice, good.Path), 1);
+  const std::string bytes = FileBytes(good.Path);
+  const size_t size = bytes.size(), payload = size - 24; // the trailer: length, checksum, mark (8 bytes each)
+  ASSERT_GT(payload, 4096u + 1024u) << "a file long enough to cut at 4,096 bytes inside its grids";
+  EXPECT_EQ(bytes.substr(payload + 16), "VoxFFDv1");
+
+  std::vector<size_t> flips; // the header, the trailer and fixed-seed random positions
+  for (size_t b = 0; b < 128; ++b)
+  {
+    flips.push_back(b);
+  }
+  for (size_t b = payload; b < size; ++b)
+  {
+    flips.push_back(b);
+  }
+  std::uniform_int_distribution<size_t> anywhere(0, size - 1);
+  for (int n = 0; n < 160; ++n)
+  {
+    flips.push_back(anywhere(rng));
+  }
+  std::uniform_int_distribution<int> mask(1, 255);
+  for (size_t at : flips)
+  {
+    std::string changed = bytes;
+    changed[at] = char(changed[at] ^ mask(rng));
+    WriteBytes(damaged.Path, changed);
+    const Outcome outcome = ReadInChild(damaged.Path, lattice, voxelize->GetOutput());
+    EXPECT_EQ(outcome, at < size - 8 ? Damaged : Identical) << "byte " << at << " of " << size << " flipped";
+  }
+
+  std::vector<size_t> cuts = { 0, 1, 7, 8, 57, 100, 4096, payload - 1, payload, payload + 1, size - 1 };
+  for (int n = 0; n < 40; ++n)
+  {
+    cuts.push_back(anywhere(rng));
+  }
+  for (size_t length : cuts)
+  {
+    WriteBytes(damaged.Path, bytes.substr(0, length));
+    const Outcome outcome = ReadInChild(damaged.Path, lattice, voxelize->GetOutput());
+    EXPECT_EQ(outcome, length < payload ? Refused : Identical) << "cut to " << length << " of " << size << " bytes";
+  }
+}
+
+TEST(vtkFFDVDB, AFailedWriteLeavesTheFileAsItWasAndNoTemporaryFile)
+{
+  // The writer truncated its file in place: a write that failed part-way (a full disk, here a file size limit)
+  // left a 4,096-byte file and Write() returned 1. Now it writes a temporary file and renames it over the target.
+  vtkSmartPointer<vtkPolyData> bear = ReadTestMesh("bear");
+  vtkSmartPointer<vtkFFDVoxelize> voxelize = VoxelizedBear(bear, 8);
+  vtkSmartPointer<vtkUnstructuredGrid> lattice = SparseLattice(voxelize, vtkFFDBuildLattice::CUBIC_BSPLINE);
+  TempFolder folder("atomic");
+  const std::string path = folder.Path + "/lattice.vdb";
+  ASSERT_EQ(Write(lattice, path), 1);
+  const std::string before = FileBytes(path);
+  ASSERT_GT(before.size(), 8192u);
+  std::mt19937 rng(5);
+  ffdtest::Perturb(lattice, rng, 0.01); // another lattice, so that a write that went through would show
+
+  // `hinder(true)` before the write, `hinder(false)` after it, where given.
+  auto writeFailing = [&](const std::string& target, unsigned long code, const std::string& message,
+                        const std::vector<std::string>& files = { "lattice.vdb" },
+                        const std::function<void(bool)>& hinder = nullptr)
+  {
+    vtkNew<vtkFFDVDBWriter> writer;
+    vtkNew<FFDTestErrorObserver> observer;
+    observer->WatchWithExecutive(writer);
+    writer->SetInputData(lattice);
+    writer->SetFileName(target.c_str());
+    if (hinder)
+    {
+      hinder(true);
+    }
+    const int written = writer->Write();
+    if (hinder)
+    {
+      hinder(false);
+    }
+    EXPECT_EQ(written, 0);
+    EXPECT_EQ(writer->GetErrorCode(), code) << vtkErrorCode::GetStringFromErrorCode(writer->GetErrorCode());
+    EXPECT_NE(observer->Errors.find(message), std::string::npos) << observer->Errors;
+    const std::string after = FileBytes(path);
+    EXPECT_TRUE(after == before) << "the file changed: " << after.size() << " bytes, " << before.size() << " before";
+    EXPECT_EQ(folder.Files(), files);
+  };
+  {
+    SCOPED_TRACE("a file size limit of 4,096 bytes: the write fails part-way, as on a full disk");
+    rlimit old;
+    ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old), 0);
+    void (*handler)(int) = nullptr;
+    auto limit = [&](bool on) // the test's own output goes to files too: limited only during the write
+    {
+      const rlimit small = { 4096, old.rlim_max };
+      setrlimit(RLIMIT_FSIZE, on ? &small : &old);
+      handler = std::signal(SIGXFSZ, on ? SIG_IGN : handler); // a failed write, not a killed process
+    };
+    writeFailing(path, vtkErrorCode::OutOfDiskSpaceError, "writing it failed (File too large); the file is left",
+      { "lattice.vdb" }, limit);
+  }
+  {
+    SCOPED_TRACE("the target is a folder: the rename fails");
+    std::filesystem::create_directory(folder.Path + "/sub.vdb");
+    writeFailing(folder.Path + "/sub.vdb", vtkErrorCode::UnknownError,
+      "renaming it over the file failed (Is a directory)", { "lattice.vdb", "sub.vdb" });
+    std::filesystem::remove(folder.Path + "/sub.vdb");
+  }
+  {
+    SCOPED_TRACE("a read-only folder: no temporary file can be made");
+    std::filesystem::permissions(folder.Path, std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec);
+    if (std::ofstream(folder.Path + "/probe"))
+    {
+      std::filesystem::remove(folder.Path + "/probe"); // root writes anyway
+    }
+    else
+    {
+      writeFailing(path, vtkErrorCode::CannotOpenFileError, "check that its folder exists and is writable");
+    }
+    std::filesystem::permissions(folder.Path, std::filesystem::perms::owner_all);
+  }
+  // The same write, unhindered, replaces the file, with the permissions it had.
+  std::filesystem::permissions(path,
+    std::filesystem::perms::owner_read | std::filesystem::perms::owner_write | std::filesystem::perms::group_read);
+  ASSERT_EQ(Write(lattice, path), 1);
+  EXPECT_EQ(folder.Files(), std::vector<std::string>{ "lattice.vdb" });
+  EXPECT_EQ(std::filesystem::status(path).permissions() & std::filesystem::perms::all,
+    std::filesystem::perms::owner_read | std::filesystem::perms::owner_write | std::filesystem::perms::group_read);
+  vtkNew<vtkFFDVDBReader> reader;
+  vtkNew<FFDTestErrorObserver> observer;
+  ASSERT_EQ(Read(reader, path, observer), 1) << observer->Errors;
+  EXPECT_TRUE(SameGrid(reader->GetOutput(), lattice));
 }
 
 TEST(vtkFFDVDB, FileSizeAndTimesOfTheBear)

@@ -3,12 +3,15 @@
 """The .vdb files from Python (README, ".vdb files"): a sparse cubic B-spline lattice over the bear, its points
 moved through numpy, written by vtkFFDVDBWriter and read back by vtkFFDVDBReader bit for bit (points, every point,
 cell and field array, the cells), the voxel grid of output port 1 that of vtkFFDVoxelize, the same deformation;
-a dense lattice and a missing file are errors with empty outputs.
+a dense lattice, a missing file and a damaged one are errors with empty outputs; a write that fails part-way
+leaves the file that was there as it was.
 
 Run with Debian's /usr/bin/python3, PYTHONPATH=<build>/lib/python3/dist-packages and VOXELFFD_MESH_DIR set to the
 folder of the meshes (ctest does both). Exits non-zero when a test fails.
 """
 import os
+import resource
+import signal
 import tempfile
 import unittest
 
@@ -98,6 +101,49 @@ class TestVDB(unittest.TestCase):
         self.assertEqual(written, 0)
         self.assertTrue(any("SetLatticeFormToSparse()" in m for m in errors), errors)
         self.assertFalse(os.path.exists(self.path))
+
+    def read_with_errors(self):
+        reader = vtkffd.vtkFFDVDBReader()
+        reader.SetFileName(self.path)
+        errors = catch_errors(reader, executive=True)
+        return reader, reader.GetExecutive().Update(), errors.messages
+
+    def test_damaged_file_is_an_error(self):
+        # A byte flipped in the grids: the checksum's error, before OpenVDB parses the file (it aborted before).
+        self.assertEqual(self.write(self.lattice), (1, []))
+        with open(self.path, "rb") as f:
+            data = bytearray(f.read())
+        data[len(data) // 2] ^= 0x10
+        with open(self.path, "wb") as f:
+            f.write(data)
+        reader, read, errors = self.read_with_errors()
+        self.assertEqual(read, 0)
+        self.assertTrue(any(" is damaged: " in m for m in errors), errors)
+        for port in (0, 1):
+            self.assertEqual(reader.GetOutput(port).GetNumberOfPoints(), 0)
+
+    def test_failed_write_keeps_the_old_file(self):
+        # A file size limit makes the write fail part-way, as a full disk does: an error, the old file unchanged.
+        self.assertEqual(self.write(self.lattice), (1, []))
+        with open(self.path, "rb") as f:
+            before = f.read()
+        self.assertGreater(len(before), 8192)
+        points = vtk_to_numpy(self.lattice.GetPoints().GetData())
+        points += 0.01
+        self.lattice.GetPoints().Modified()
+        soft, hard = resource.getrlimit(resource.RLIMIT_FSIZE)
+        handler = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a failed write, not a killed process
+        resource.setrlimit(resource.RLIMIT_FSIZE, (4096, hard))
+        try:
+            written, errors = self.write(self.lattice)
+        finally:
+            resource.setrlimit(resource.RLIMIT_FSIZE, (soft, hard))
+            signal.signal(signal.SIGXFSZ, handler)
+        self.assertEqual(written, 0)
+        self.assertTrue(any("File too large" in m and "left as it was" in m for m in errors), errors)
+        with open(self.path, "rb") as f:
+            self.assertTrue(f.read() == before, "the file changed")
+        self.assertEqual(os.listdir(self.folder.name), ["bear.vdb"])
 
     def test_missing_file_is_an_error(self):
         reader = vtkffd.vtkFFDVDBReader()
