@@ -248,8 +248,8 @@ int vtkFFDBuildLattice::RequestData(
   if (sparse && this->Basis == BERNSTEIN)
   {
     vtkErrorMacro(<< "A SPARSE lattice of the global BERNSTEIN basis is not possible: each of its control points "
-                     "influences every voxel. Call SetLatticeFormToDense() or SetLatticeFormToAutomatic(), or "
-                     "choose a local basis.");
+                     "influences every voxel. Set LatticeForm to Dense or Automatic (SetLatticeFormToDense()), or "
+                     "choose a local Basis.");
     return 0;
   }
   int pointsPerAxis[3];

@@ -264,6 +264,12 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   {
     return 1; // an empty input gives an empty output
   }
+  if (!(this->Padding >= 0.0)) // the clamp of SetPadding() lets NaN through
+  {
+    vtkErrorMacro(<< "Padding " << this->Padding << " is not a number: set Padding (SetPadding()) to a fraction "
+                  << "such as 0.05.");
+    return 0;
+  }
 
   // The finite points and their centroid, an exact sum over every process rounded once; a distributed mesh's
   // points shared by pieces (marked as copies in its ghost array) count once.

@@ -354,14 +354,14 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
     {
       vtkErrorMacro(<< "None of the input's " << numPoints
                     << " points is finite, so no automatic frame can enclose them: remove the NaN/Inf "
-                       "points or call SetFrameModeToExplicit() with SetFrame().");
+                       "points or give an explicit frame (FrameMode Explicit, SetFrame()).");
       return 0;
     }
     if (!((box.Max - box.Min).maxCoeff() > 0.0))
     {
       vtkErrorMacro(<< "All " << box.Count
                     << " finite input points are identical, so an automatic frame has no size: "
-                       "call SetFrameModeToExplicit() with SetFrame() to give the frame.");
+                       "give an explicit frame (FrameMode Explicit, SetFrame()).");
       return 0;
     }
     box.ToFrame(this->Padding, frame);
