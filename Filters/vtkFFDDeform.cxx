@@ -3,12 +3,15 @@
 
 #include "vtkFFDCudaBackend.h"
 #include "vtkFFDGridDeformer.h"
+#include "vtkFFDInputChecks.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDPipelineKeys.h"
 #include "vtkFFDTetrahedralDeformer.h"
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
+#include "vtkDemandDrivenPipeline.h"
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -143,8 +146,29 @@ int vtkFFDDeform::FillInputPortInformation(int port, vtkInformation* info)
 vtkTypeBool vtkFFDDeform::ProcessRequest(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return vtkFFDCatchAllocationFailure(
-    this, outputVector, [&] { return this->Superclass::ProcessRequest(request, inputVector, outputVector); });
+  // The inputs first: vtkPointSetAlgorithm makes the output, in the first request, without a word where input 0
+  // is missing or not a vtkPointSet, and the executive's message on input 1 does not say what to connect.
+  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT()) &&
+    !(vtkFFDCheckInput(this, inputVector[0], 0, "vtkPointSet", "the mesh",
+        "SetInputConnection() to the mesh to deform (a vtkPolyData, vtkUnstructuredGrid or other vtkPointSet).") &&
+      vtkFFDCheckInput(this, inputVector[1], 1, "vtkPointSet", "the lattice",
+        "SetLatticeConnection() to the lattice, the output of vtkFFDBuildLattice or "
+        "vtkFFDBuildTetrahedralLattice.")))
+  {
+    return vtkFFDEmptyOutputs(outputVector); // an earlier output would show what the inputs no longer give
+  }
+  return vtkFFDCatchAllocationFailure(this, outputVector,
+    [&]
+    {
+      const vtkTypeBool done = this->Superclass::ProcessRequest(request, inputVector, outputVector);
+      // The executive passes input 0's times only: a lattice that varies in time (vtkFFDSimulateLattice) must
+      // make the mesh re-execute at each time, with the lattice at that time.
+      if (done && request->Has(vtkDemandDrivenPipeline::REQUEST_INFORMATION()))
+      {
+        vtkFFDPipelineKeys::AnnounceTimes(inputVector, 2, outputVector->GetInformationObject(0));
+      }
+      return done;
+    });
 }
 
 //------------------------------------------------------------------------------------------------------------
@@ -153,9 +177,9 @@ int vtkFFDDeform::RequestData(vtkInformation*, vtkInformationVector** inputVecto
   vtkPointSet* input = vtkPointSet::GetData(inputVector[0]);
   vtkPointSet* lattice = vtkPointSet::GetData(inputVector[1]);
   vtkPointSet* output = vtkPointSet::GetData(outputVector);
-  if (!input || !output)
+  if (!input || !output || !lattice)
   {
-    vtkErrorMacro("Input 0 must be a vtkPointSet.");
+    vtkErrorMacro("Input 0 (the mesh) and input 1 (the lattice) must be vtkPointSets.");
     return 0;
   }
   output->Initialize();

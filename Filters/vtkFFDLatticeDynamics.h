@@ -62,39 +62,42 @@ public:
   vtkGetObjectMacro(Mesh, vtkPointSet);
   ///@}
 
+  // Every setting below is checked where it is used (CheckSettings(), at each Initialize() and Step()): a value
+  // out of its range is an error, never silently clamped.
+
   ///@{
-  /// The time step h in seconds (default 1/60).
-  vtkSetClampMacro(TimeStep, double, 1e-12, VTK_DOUBLE_MAX);
+  /// The time step h in seconds, > 0 (default 1/60).
+  vtkSetMacro(TimeStep, double);
   vtkGetMacro(TimeStep, double);
   ///@}
 
   ///@{
-  /// The mass of the whole body (default 1).
-  vtkSetClampMacro(TotalMass, double, 1e-300, VTK_DOUBLE_MAX);
+  /// The mass of the whole body, > 0 (default 1).
+  vtkSetMacro(TotalMass, double);
   vtkGetMacro(TotalMass, double);
   ///@}
 
   ///@{
-  /// The least mass of a particle, as a fraction of the mean (default 0.01).
-  vtkSetClampMacro(MinimumMassFraction, double, 1e-12, 1.0);
+  /// The least mass of a particle, as a fraction of the mean, in (0, 1] (default 0.01).
+  vtkSetMacro(MinimumMassFraction, double);
   vtkGetMacro(MinimumMassFraction, double);
   ///@}
 
   ///@{
-  /// A spring's force per unit of stretch (default 1).
-  vtkSetClampMacro(SpringStiffness, double, 0.0, VTK_DOUBLE_MAX);
+  /// A spring's force per unit of stretch, >= 0 (default 1).
+  vtkSetMacro(SpringStiffness, double);
   vtkGetMacro(SpringStiffness, double);
   ///@}
 
   ///@{
-  /// A spring's force per unit of relative velocity of its ends (default 0.01).
-  vtkSetClampMacro(SpringDamping, double, 0.0, VTK_DOUBLE_MAX);
+  /// A spring's force per unit of relative velocity of its ends, >= 0 (default 0.01).
+  vtkSetMacro(SpringDamping, double);
   vtkGetMacro(SpringDamping, double);
   ///@}
 
   ///@{
-  /// The pull toward the rigid core per unit of mass and of distance, in 1/s^2 (default 10; 0: no core).
-  vtkSetClampMacro(CoreStiffness, double, 0.0, VTK_DOUBLE_MAX);
+  /// The pull toward the rigid core per unit of mass and of distance, in 1/s^2, >= 0 (default 10; 0: no core).
+  vtkSetMacro(CoreStiffness, double);
   vtkGetMacro(CoreStiffness, double);
   ///@}
 
@@ -105,7 +108,7 @@ public:
   ///@}
 
   ///@{
-  /// Gravity, an acceleration (default 0, 0, 0).
+  /// Gravity, an acceleration, finite (default 0, 0, 0).
   vtkSetVector3Macro(Gravity, double);
   vtkGetVector3Macro(Gravity, double);
   ///@}
@@ -159,14 +162,33 @@ public:
   int GetNumberOfPinnedPoints();
   ///@}
 
-  /// Changes a simulated point's momentum by an impulse at the next step (its velocity by impulse / mass).
-  void ApplyImpulse(vtkIdType pointId, double x, double y, double z);
+  /**
+   * Changes a simulated point's momentum by an impulse at the next Step() (its velocity by impulse / mass),
+   * whether or not the simulation has started: impulses are queued until a step applies them. Returns 1 when
+   * queued, or 0 with an error where the impulse is not finite or the id is not a point of the lattice (or, once
+   * the simulation has started, not a simulated one). A queued impulse that the next Step() finds on a point that
+   * is not simulated is an error there and is dropped.
+   */
+  int ApplyImpulse(vtkIdType pointId, double x, double y, double z);
+
+  /**
+   * Reports the first setting that cannot be simulated (not finite, or out of its range: the time step, the
+   * masses, the stiffnesses and damping, gravity, the magnetic spheres' settings and paths, the pins' targets) as
+   * an error naming its setter. Returns 1 where every one can be. Initialize() and Step() call it.
+   */
+  int CheckSettings();
 
   /// Reads the lattice and the mesh and starts at rest from the lattice's points. Returns 1, or 0 after an error.
   int Initialize();
 
-  /// Advances `steps` (>= 0) time steps (ProgressEvents every 5 % of them from 20 steps). Returns 1, or 0 after an
-  /// error.
+  /**
+   * Advances `steps` (>= 0) time steps (ProgressEvents every 5 % of them from 20 steps). Returns 1, or 0 after an
+   * error, which leaves the lattice's points and the simulation's state as they were before the call: a setting
+   * that cannot be simulated, springs too stiff for the time step and the masses (their stiffness, plus damping
+   * over the time step, times the time step squared over the lightest particle's mass above 1e8: the step's
+   * linear solve would lose the body's motion to rounding), or a step whose positions are not finite (a force or
+   * a collider too large or not finite there).
+   */
   int Step(int steps = 1);
 
   ///@{

@@ -33,33 +33,36 @@ public:
   vtkTypeMacro(vtkFFDMagneticSphere, vtkObject);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
+  // The settings are checked where they are used (vtkFFDLatticeDynamics::CheckSettings()): a value out of its
+  // range is an error there, never silently clamped.
+
   ///@{
-  /// The centre without a path (default 0, 0, 0).
+  /// The centre without a path, finite (default 0, 0, 0).
   vtkSetVector3Macro(Center, double);
   vtkGetVector3Macro(Center, double);
   ///@}
 
   ///@{
   /// The sphere's radius, greater than 0 (default 1).
-  vtkSetClampMacro(Radius, double, 1e-300, VTK_DOUBLE_MAX);
+  vtkSetMacro(Radius, double);
   vtkGetMacro(Radius, double);
   ///@}
 
   ///@{
   /// The acceleration at the sphere's surface, at least 0 (default 1).
-  vtkSetClampMacro(Strength, double, 0.0, VTK_DOUBLE_MAX);
+  vtkSetMacro(Strength, double);
   vtkGetMacro(Strength, double);
   ///@}
 
   ///@{
   /// The exponent of the pull's decrease with distance outside the sphere, at least 0 (default 2).
-  vtkSetClampMacro(Falloff, double, 0.0, VTK_DOUBLE_MAX);
+  vtkSetMacro(Falloff, double);
   vtkGetMacro(Falloff, double);
   ///@}
 
   ///@{
   /// The distance from the centre beyond which nothing is pulled; 0 (the default): no limit.
-  vtkSetClampMacro(Range, double, 0.0, VTK_DOUBLE_MAX);
+  vtkSetMacro(Range, double);
   vtkGetMacro(Range, double);
   ///@}
 
@@ -79,12 +82,12 @@ public:
 
   ///@{
   /**
-   * The path: at least 2 points, through which the centre moves along a closed spline, once every Period
+   * The path: at least 2 points, through which the centre moves along a closed spline, once every Period (> 0)
    * seconds. Null (the default): the centre stays at Center.
    */
   void SetPath(vtkPoints* path);
   vtkGetObjectMacro(Path, vtkPoints);
-  vtkSetClampMacro(Period, double, 1e-300, VTK_DOUBLE_MAX);
+  vtkSetMacro(Period, double);
   vtkGetMacro(Period, double);
   ///@}
 

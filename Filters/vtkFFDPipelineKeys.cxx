@@ -5,10 +5,13 @@
 #include "vtkFFDBuildLattice.h"
 #include "vtkInformation.h"
 #include "vtkInformationIntegerVectorKey.h"
+#include "vtkInformationVector.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStructuredGrid.h"
 
+#include <algorithm>
 #include <string>
+#include <vector>
 
 namespace
 {
@@ -80,4 +83,50 @@ bool vtkFFDPipelineKeys::AnnouncedLattice(vtkInformation* inInfo, int& basis, in
   inInfo->Get(DIVISIONS(), divisions);
   basis = inInfo->Get(BASIS(), 0);
   return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkFFDPipelineKeys::AnnounceTimes(vtkInformationVector** inputs, int ports, vtkInformation* outInfo)
+{
+  using SDDP = vtkStreamingDemandDrivenPipeline;
+  std::vector<double> steps;
+  double range[2] = { 0, 0 };
+  bool timed = false, stepped = true;
+  for (int port = 0; port < ports; ++port)
+  {
+    for (int c = 0; inputs[port] && c < inputs[port]->GetNumberOfInformationObjects(); ++c)
+    {
+      vtkInformation* inInfo = inputs[port]->GetInformationObject(c);
+      const double* own = inInfo->Get(SDDP::TIME_STEPS());
+      const int count = own ? inInfo->Length(SDDP::TIME_STEPS()) : 0;
+      double first = count ? own[0] : 0, last = count ? own[count - 1] : 0;
+      if (inInfo->Length(SDDP::TIME_RANGE()) == 2)
+      {
+        first = inInfo->Get(SDDP::TIME_RANGE())[0];
+        last = inInfo->Get(SDDP::TIME_RANGE())[1];
+      }
+      else if (count == 0)
+      {
+        continue; // no time
+      }
+      range[0] = timed ? std::min(range[0], first) : first;
+      range[1] = timed ? std::max(range[1], last) : last;
+      timed = true;
+      stepped = stepped && count > 0;
+      steps.insert(steps.end(), own, own + count);
+    }
+  }
+  outInfo->Remove(SDDP::TIME_STEPS());
+  outInfo->Remove(SDDP::TIME_RANGE());
+  if (!timed)
+  {
+    return;
+  }
+  if (stepped)
+  {
+    std::sort(steps.begin(), steps.end());
+    steps.erase(std::unique(steps.begin(), steps.end()), steps.end());
+    outInfo->Set(SDDP::TIME_STEPS(), steps.data(), static_cast<int>(steps.size()));
+  }
+  outInfo->Set(SDDP::TIME_RANGE(), range, 2);
 }

@@ -10,13 +10,15 @@
  * vtkFFDVoxelize announces its divisions, vtkFFDBuildLattice, vtkFFDRefineLattice and vtkFFDCoarsenLattice the
  * divisions and basis of their output and, when it is dense, its WHOLE_EXTENT. The keys travel downstream through
  * any filter (ParaView puts one after every filter). Where nothing is announced (a voxel grid read from a file),
- * a dense lattice's extent is unknown until it executes, as before.
+ * a dense lattice's extent is unknown until it executes, as before. A filter of two inputs announces the times of
+ * both (AnnounceTimes()).
  */
 #ifndef vtkFFDPipelineKeys_h
 #define vtkFFDPipelineKeys_h
 
 class vtkInformation;
 class vtkInformationIntegerVectorKey;
+class vtkInformationVector;
 
 class vtkFFDPipelineKeys
 {
@@ -33,6 +35,15 @@ public:
   static void Forget(vtkInformation* outInfo);
   /// The divisions and basis that `inInfo` announces, if it announces both.
   static bool AnnouncedLattice(vtkInformation* inInfo, int& basis, int divisions[3]);
+
+  /**
+   * Announces in `outInfo` the times of every connection of the first `ports` inputs (`inputs`, the filter's input
+   * information vectors), as the executive does of input 0's alone: the union of their TIME_RANGEs, and of their
+   * TIME_STEPS where each input that has a range has steps (else the output is continuous in time). A filter whose
+   * other input varies in time (a lattice from vtkFFDSimulateLattice) then re-executes when the time changes; the
+   * executive requests the time asked of the output from every input.
+   */
+  static void AnnounceTimes(vtkInformationVector** inputs, int ports, vtkInformation* outInfo);
 };
 
 #endif

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkFFDSimulateLattice.h"
 
+#include "vtkFFDInputChecks.h"
 #include "vtkFFDLatticeDynamics.h"
 
 #include "vtkInformation.h"
@@ -21,6 +22,7 @@ vtkCxxSetObjectMacro(vtkFFDSimulateLattice, Dynamics, vtkFFDLatticeDynamics);
 vtkFFDSimulateLattice::vtkFFDSimulateLattice()
   : Dynamics(vtkFFDLatticeDynamics::New())
   , EndTime(10.0)
+  , MaximumNumberOfSteps(100000)
   , Working(nullptr)
   , WorkingStep(0)
   , WorkingTime(0)
@@ -62,14 +64,69 @@ int vtkFFDSimulateLattice::FillInputPortInformation(int port, vtkInformation* in
 }
 
 //------------------------------------------------------------------------------------------------------------
+int vtkFFDSimulateLattice::RequestDataObject(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (!(vtkFFDCheckInput(this, inputVector[0], 0, "vtkPointSet", "the lattice",
+          "SetInputConnection() to the lattice to simulate, the output of vtkFFDBuildLattice or "
+          "vtkFFDBuildTetrahedralLattice.") &&
+        vtkFFDCheckInput(this, inputVector[1], 1, "vtkPointSet", "the mesh",
+          "SetMeshConnection() to the mesh that the lattice deforms, whose points give the masses, or to nothing.",
+          true)))
+  {
+    return vtkFFDEmptyOutputs(outputVector); // an earlier output would show what the inputs no longer give
+  }
+  return this->Superclass::RequestDataObject(request, inputVector, outputVector);
+}
+
+//------------------------------------------------------------------------------------------------------------
 int vtkFFDSimulateLattice::ExecuteInformation(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkInformation* info = outputVector->GetInformationObject(0);
   info->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-  const double range[2] = { 0.0, this->EndTime };
-  info->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+  info->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+  if (std::isfinite(this->EndTime) && this->EndTime >= 0) // else RequestData() says what is wrong
+  {
+    const double range[2] = { 0.0, this->EndTime };
+    info->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+  }
   return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDSimulateLattice::RequestedStep(vtkInformation* outInfo, double& time, double& step)
+{
+  if (!this->Dynamics)
+  {
+    vtkErrorMacro("No Dynamics object: SetDynamics() to a vtkFFDLatticeDynamics.");
+    return false;
+  }
+  if (!(std::isfinite(this->EndTime) && this->EndTime >= 0))
+  {
+    vtkErrorMacro(<< "SetEndTime(" << this->EndTime << "): the end time (s) must be a finite number >= 0.");
+    return false;
+  }
+  if (this->MaximumNumberOfSteps < 1)
+  {
+    vtkErrorMacro(<< "SetMaximumNumberOfSteps(" << this->MaximumNumberOfSteps << "): it must be at least 1.");
+    return false;
+  }
+  if (!this->Dynamics->CheckSettings()) // the Dynamics object reports which
+  {
+    return false;
+  }
+  time = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+    : 0.0;
+  if (std::isnan(time))
+  {
+    vtkErrorMacro("The pipeline asks for the lattice at time NaN: ask for a time in [0, EndTime].");
+    return false;
+  }
+  time = std::min(std::max(time, 0.0), this->EndTime);
+  step = std::floor(time / this->Dynamics->GetTimeStep() + 0.5);
+  return true;
 }
 
 //------------------------------------------------------------------------------------------------------------
@@ -82,25 +139,14 @@ int vtkFFDSimulateLattice::RequestData(
   vtkPointSet* output = vtkPointSet::GetData(outInfo);
   if (!input || !output)
   {
-    vtkErrorMacro("Expected a lattice (a vtkPointSet) on input 0.");
+    vtkErrorMacro("Input 0 (the lattice) must be a vtkPointSet.");
     return 0;
   }
-  if (!this->Dynamics)
+  double t = 0, step = 0;
+  if (!this->RequestedStep(outInfo, t, step))
   {
-    vtkErrorMacro("No Dynamics object: SetDynamics() to a vtkFFDLatticeDynamics.");
     return 0;
   }
-  const double t = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
-    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
-    : 0.0;
-  const double steps = std::floor(std::max(t, 0.0) / this->Dynamics->GetTimeStep() + 0.5);
-  if (!(steps < double(VTK_INT_MAX)))
-  {
-    vtkErrorMacro(<< "Time " << t << " is " << steps << " time steps of " << this->Dynamics->GetTimeStep()
-                  << " s away: too many.");
-    return 0;
-  }
-  const vtkIdType target = static_cast<vtkIdType>(steps);
 
   // Continue the last simulation when nothing changed and the time is not earlier; else start again.
   vtkMTimeType sources = std::max(this->GetMTime(), input->GetMTime());
@@ -108,51 +154,25 @@ int vtkFFDSimulateLattice::RequestData(
   {
     sources = std::max(sources, mesh->GetMTime());
   }
-  if (!this->Working || sources > this->WorkingTime || target < this->WorkingStep ||
-    this->Dynamics->GetLattice() != this->Working || this->Dynamics->GetMesh() != mesh)
+  const bool restart = !this->Working || sources > this->WorkingTime || step < double(this->WorkingStep) ||
+    this->Dynamics->GetLattice() != this->Working || this->Dynamics->GetMesh() != mesh;
+  const double from = restart ? 0.0 : double(this->WorkingStep);
+  if (!(step - from <= double(this->MaximumNumberOfSteps)))
   {
-    // The same working lattice when it can be: the Dynamics object then keeps its MTime.
-    if (this->Working && !this->Working->IsA(input->GetClassName()))
-    {
-      this->Working->Delete();
-      this->Working = nullptr;
-    }
-    if (!this->Working)
-    {
-      this->Working = input->NewInstance();
-    }
-    this->Working->DeepCopy(input);
-    this->Dynamics->SetLattice(this->Working);
-    this->Dynamics->SetMesh(mesh);
-    this->WorkingStep = 0;
-    this->WorkingTime = std::max(this->GetMTime(), sources);
-    if (!this->Dynamics->Initialize())
-    {
-      this->Working->Delete();
-      this->Working = nullptr;
-      return 0;
-    }
+    vtkErrorMacro(<< "Time " << t << " s is " << step - from << " time steps of " << this->Dynamics->GetTimeStep()
+                  << " s from the last simulated time (" << from * this->Dynamics->GetTimeStep()
+                  << " s): more than the " << this->MaximumNumberOfSteps
+                  << " an update may run. Raise SetMaximumNumberOfSteps(), lengthen the Dynamics' SetTimeStep(), "
+                     "or ask for earlier times first (a later time continues from the last one).");
+    return 0;
   }
-  // Progress every few steps; the simulation can be aborted between them.
-  const vtkIdType first = this->WorkingStep;
-  const vtkIdType chunk = std::max<vtkIdType>(1, (target - first) / 20);
-  while (this->WorkingStep < target && !this->GetAbortExecute())
+  if ((restart && !this->Restart(input, mesh, sources)) || !this->Simulate(static_cast<vtkIdType>(step)))
   {
-    const int now = static_cast<int>(std::min(chunk, target - this->WorkingStep));
-    if (!this->Dynamics->Step(now))
-    {
-      this->Working->Delete();
-      this->Working = nullptr;
-      return 0;
-    }
-    this->WorkingStep += now;
-    this->UpdateProgress(double(this->WorkingStep - first) / double(target - first));
+    return 0;
   }
-  if (this->WorkingStep < target) // aborted: the next request starts again
+  if (!this->Working)
   {
-    this->Working->Delete();
-    this->Working = nullptr;
-    return 1;
+    return 1; // aborted: the output stays empty
   }
   output->ShallowCopy(input);
   vtkNew<vtkPoints> points;
@@ -164,10 +184,64 @@ int vtkFFDSimulateLattice::RequestData(
 }
 
 //------------------------------------------------------------------------------------------------------------
+bool vtkFFDSimulateLattice::Restart(vtkPointSet* input, vtkPointSet* mesh, vtkMTimeType sources)
+{
+  // The same working lattice when it can be: the Dynamics object then keeps its MTime.
+  if (this->Working && !this->Working->IsA(input->GetClassName()))
+  {
+    this->Working->Delete();
+    this->Working = nullptr;
+  }
+  if (!this->Working)
+  {
+    this->Working = input->NewInstance();
+  }
+  this->Working->DeepCopy(input);
+  this->Dynamics->SetLattice(this->Working);
+  this->Dynamics->SetMesh(mesh);
+  this->WorkingStep = 0;
+  this->WorkingTime = std::max(this->GetMTime(), sources);
+  if (!this->Dynamics->Initialize())
+  {
+    this->Working->Delete();
+    this->Working = nullptr;
+    return false;
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDSimulateLattice::Simulate(vtkIdType target)
+{
+  // Progress every 1 % of the steps; the simulation can be aborted between them.
+  const vtkIdType first = this->WorkingStep;
+  const vtkIdType chunk = std::min<vtkIdType>(VTK_INT_MAX, std::max<vtkIdType>(1, (target - first) / 100));
+  while (this->WorkingStep < target && !this->GetAbortExecute())
+  {
+    const int now = static_cast<int>(std::min(chunk, target - this->WorkingStep));
+    if (!this->Dynamics->Step(now))
+    {
+      this->Working->Delete();
+      this->Working = nullptr;
+      return false;
+    }
+    this->WorkingStep += now;
+    this->UpdateProgress(double(this->WorkingStep - first) / double(target - first));
+  }
+  if (this->WorkingStep < target) // aborted: the next request starts again
+  {
+    this->Working->Delete();
+    this->Working = nullptr;
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------------------------------------
 void vtkFFDSimulateLattice::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "EndTime: " << this->EndTime << "\n";
+  os << indent << "MaximumNumberOfSteps: " << this->MaximumNumberOfSteps << "\n";
   os << indent << "Dynamics: " << this->Dynamics << "\n";
   if (this->Dynamics)
   {

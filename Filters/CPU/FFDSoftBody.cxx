@@ -440,6 +440,10 @@ bool SoftBody::Step(const std::vector<double>& acceleration, const std::vector<d
   {
     constrain(u);
   }
+  if (!std::all_of(u.begin(), u.end(), [](double value) { return std::isfinite(value); }))
+  {
+    return false; // the state stays as it was
+  }
   for (std::size_t j = 0; j < 3 * n; ++j)
   {
     this->V[j] = (u[j] - this->U[j]) / h;

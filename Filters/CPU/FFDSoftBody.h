@@ -80,7 +80,7 @@ public:
    * `targets`: each pinned particle's displacement at the end of the step (3 a particle, read at pinned ones
    * only); `constrain` (may be empty) moves the new displacements out of colliders before the velocities are
    * taken from them. Returns false, leaving the state as it was, where the system could not be factored (a
-   * non-finite setting).
+   * non-finite setting) or the new displacements are not finite.
    */
   bool Step(const std::vector<double>& acceleration, const std::vector<double>& targets,
     const std::function<void(std::vector<double>& displacements)>& constrain);
