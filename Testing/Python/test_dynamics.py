@@ -3,7 +3,9 @@
 """vtkFFDLatticeDynamics, vtkFFDMagneticSphere and vtkFFDSimulateLattice from Python, against references written
 here: under gravity alone the body falls as backward Euler does, u_n = g h^2 n (n + 1) / 2, every simulated
 control point alike (numpy views of the lattice's points, the culled ones unmoved); impulses are the momentum
-that stays; the pipeline's lattice at a time does not depend on the order of the requests; bad input is an error.
+that stays, queued before the first step too; the pipeline's lattice at a time does not depend on the order of the
+requests, and a vtkFFDDeform downstream follows it in time (against a vtkFFDDeform of its own on each time's
+lattice); a time beyond the end is the end; bad input and settings that cannot be simulated are errors.
 
 Run with Debian's /usr/bin/python3, PYTHONPATH=<build>/lib/python3/dist-packages and VOXELFFD_MESH_DIR set to the
 folder of the meshes (ctest does both). Exits non-zero when a test fails.
@@ -14,6 +16,7 @@ import unittest
 import numpy as np
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkDataObject, vtkStructuredGrid
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
 
 import vtkffd
@@ -91,6 +94,90 @@ class DynamicsTest(unittest.TestCase):
         at(0.25)
         np.testing.assert_array_equal(at(0.75), direct)  # continued from 0.25
         np.testing.assert_array_equal(at(0.0), points_of(self.lattice))  # started again: the input
+
+    def test_a_deformed_mesh_follows_the_simulation_in_time(self):
+        # Issue 30, item 2: simulation -> vtkFFDDeform, asked for several times (the last one earlier: the
+        # simulation starts again). Before, vtkFFDDeform announced only the static mesh's time (none), so no time
+        # request re-executed it and the bear never moved. At each time its output must be the bear deformed by
+        # the lattice the simulation outputs then, through a vtkFFDDeform of its own on a copy (the same bits).
+        simulate = vtkffd.vtkFFDSimulateLattice()
+        simulate.SetInputData(self.lattice)
+        simulate.SetMeshData(self.mesh)
+        simulate.SetEndTime(1.0)
+        simulate.GetDynamics().SetGravity(0.0, -9.81, 0.0)
+        deform = vtkffd.vtkFFDDeform()
+        deform.SetInputData(self.mesh)
+        deform.SetLatticeConnection(simulate.GetOutputPort())
+        deform.UpdateInformation()
+        self.assertEqual(deform.GetOutputInformation(0).Get(vtkStreamingDemandDrivenPipeline.TIME_RANGE()),
+                         (0.0, 1.0))
+        lowest = []
+        for t in (0.0, 0.5, 1.0, 0.5):
+            self.assertEqual(deform.UpdateTimeStep(t), 1)
+            copy = vtkStructuredGrid()
+            copy.ShallowCopy(simulate.GetOutput())
+            alone = vtkffd.vtkFFDDeform()
+            alone.SetInputData(self.mesh)
+            alone.SetLatticeData(copy)
+            alone.Update()
+            np.testing.assert_array_equal(points_of(deform.GetOutput()), points_of(alone.GetOutput()), f"t={t}")
+            lowest.append(points_of(deform.GetOutput())[:, 1].min())
+        # Free fall of backward Euler: 30 steps of 1/60 s fall g h^2 30 * 31 / 2 = 1.27 (the bear is ~1 high).
+        self.assertLess(lowest[1], lowest[0] - 0.5)
+        self.assertLess(lowest[2], lowest[1])
+        self.assertEqual(lowest[3], lowest[1])
+
+    def test_a_time_beyond_the_end_is_the_end(self):
+        # Issue 30, item 11: 1e5 s with EndTime 1 s is the lattice at 1 s (before: six million steps, and the
+        # output said 1e5 s).
+        def at(t):
+            simulate = vtkffd.vtkFFDSimulateLattice()
+            simulate.SetInputData(self.lattice)
+            simulate.SetEndTime(1.0)
+            simulate.GetDynamics().SetGravity(0.0, -9.81, 0.0)
+            simulate.UpdateTimeStep(t)
+            return simulate.GetOutput().GetInformation().Get(vtkDataObject.DATA_TIME_STEP()), points_of(
+                simulate.GetOutput())
+
+        far_time, far = at(1e5)
+        self.assertEqual(far_time, 1.0)
+        np.testing.assert_array_equal(far, at(1.0)[1])
+
+    def test_impulses_before_the_first_step_are_applied(self):
+        # Issue 30, item 15: the first step's initialization discarded them; a bad id or value is refused.
+        dynamics = vtkffd.vtkFFDLatticeDynamics()
+        dynamics.SetLattice(self.lattice)
+        errors = catch_errors(dynamics)
+        active = np.flatnonzero(vtk_to_numpy(self.lattice.GetPointData().GetArray("Active")))
+        self.assertEqual(dynamics.ApplyImpulse(-1, 1.0, 0.0, 0.0), 0)
+        self.assertIn("the lattice has no point -1", errors.messages[-1])
+        self.assertEqual(dynamics.ApplyImpulse(int(active[0]), math.inf, 0.0, 0.0), 0)
+        self.assertIn("the impulse must be finite", errors.messages[-1])
+        self.assertEqual(dynamics.ApplyImpulse(int(active[0]), 0.0, 0.5, 0.0), 1)
+        self.assertEqual(dynamics.Step(10), 1)
+        momentum = [0.0, 0.0, 0.0]
+        dynamics.GetMomentum(momentum)
+        # No external force: the impulse's momentum stays (tolerance as above).
+        np.testing.assert_allclose(momentum, [0.0, 0.5, 0.0], rtol=0, atol=1e-10)
+
+    def test_settings_that_cannot_be_simulated_are_errors(self):
+        # Issue 30, item 15: a NaN setting filled every control point with NaN and Step() succeeded.
+        dynamics = vtkffd.vtkFFDLatticeDynamics()
+        dynamics.SetLattice(self.lattice)
+        dynamics.SetMesh(self.mesh)
+        errors = catch_errors(dynamics)
+        before = points_of(self.lattice)
+        for setter, bad, good in (("SetTimeStep", math.nan, 1.0 / 60.0), ("SetTotalMass", -1.0, 1.0),
+                                  ("SetSpringStiffness", math.inf, 1.0), ("SetCoreStiffness", math.nan, 10.0)):
+            getattr(dynamics, setter)(bad)
+            self.assertEqual(dynamics.Step(5), 0, setter)
+            self.assertIn(f"{setter}({bad:g})", errors.messages[-1])
+            np.testing.assert_array_equal(points_of(self.lattice), before, setter)
+            getattr(dynamics, setter)(good)
+        dynamics.SetGravity(0.0, math.nan, 0.0)
+        self.assertEqual(dynamics.Step(5), 0)
+        self.assertIn("SetGravity(0, nan, 0): gravity must be finite", errors.messages[-1])
+        np.testing.assert_array_equal(points_of(self.lattice), before)
 
     def test_bad_input_is_an_error(self):
         dynamics = vtkffd.vtkFFDLatticeDynamics()
