@@ -6,6 +6,7 @@
 #include "vtkFFDDataContract.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDSparseLattice.h"
+#include "vtkFFDStatistics.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
@@ -522,6 +523,13 @@ bool vtkFFDVDBReader::ReadFile(vtkUnstructuredGrid* lattice, vtkUnstructuredGrid
   {
     return built;
   }
+  // The statistics vtkFFDVoxelize and vtkFFDBuildLattice record (vtkFFDStatistics.h), the lattice passing its
+  // voxel grid's as the pipeline does.
+  for (vtkUnstructuredGrid* output : { voxelGrid, lattice })
+  {
+    vtkFFDRecordCount(output, "NumberOfActiveVoxels", voxelIndex->GetNumberOfTuples());
+  }
+  vtkFFDRecordCount(lattice, "NumberOfActiveControlPoints", lattice->GetNumberOfPoints());
   this->UpdateProgress(0.7);
   return PlacePoints(this, found, lattice) && CheckNoOtherValues(this, found, lattice);
 }

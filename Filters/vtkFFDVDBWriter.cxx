@@ -28,6 +28,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <new>
 #include <sstream>
@@ -398,8 +399,17 @@ bool vtkFFDVDBWriter::WriteLattice(vtkDataObject* input)
 //------------------------------------------------------------------------------------------------------------
 bool vtkFFDVDBWriter::WriteFileAtomically(const std::string& bytes)
 {
-  const std::string target = this->FileName;
+  // A symbolic link stays: the file it names is replaced.
+  std::string target = this->FileName;
   struct stat existing;
+  if (lstat(target.c_str(), &existing) == 0 && S_ISLNK(existing.st_mode))
+  {
+    if (char* resolved = realpath(target.c_str(), nullptr))
+    {
+      target = resolved;
+      std::free(resolved);
+    }
+  }
   const bool exists = stat(target.c_str(), &existing) == 0;
   // The temporary file lies beside the target, so that rename() replaces the target in one step: a reader sees
   // the old file or the new one, never part of one.

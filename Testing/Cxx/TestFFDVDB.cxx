@@ -745,6 +745,20 @@ TEST(vtkFFDVDB, EveryFlippedByteOrCutIsAnErrorOrTheSameLattice)
     const Outcome outcome = ReadInChild(damaged.Path, lattice, voxelize->GetOutput());
     EXPECT_EQ(outcome, length < payload ? Refused : Identical) << "cut to " << length << " of " << size << " bytes";
   }
+
+  // The same grids written by OpenVDB itself, without the checksum, as another tool writes them: every read stays
+  // within the file, so each cut is an error too.
+  TempFile foreign("sweep_foreign.vdb");
+  Rewrite(good.Path, foreign.Path, [](openvdb::GridPtrVec&) {});
+  const std::string theirs = FileBytes(foreign.Path);
+  for (size_t length : cuts)
+  {
+    length = std::min(length, theirs.size());
+    WriteBytes(damaged.Path, theirs.substr(0, length));
+    const Outcome outcome = ReadInChild(damaged.Path, lattice, voxelize->GetOutput());
+    EXPECT_EQ(outcome, length < theirs.size() ? Refused : Identical)
+      << "OpenVDB's file cut to " << length << " of " << theirs.size() << " bytes";
+  }
 }
 
 TEST(vtkFFDVDB, AFailedWriteLeavesTheFileAsItWasAndNoTemporaryFile)
@@ -833,6 +847,17 @@ TEST(vtkFFDVDB, AFailedWriteLeavesTheFileAsItWasAndNoTemporaryFile)
   vtkNew<FFDTestErrorObserver> observer;
   ASSERT_EQ(Read(reader, path, observer), 1) << observer->Errors;
   EXPECT_TRUE(SameGrid(reader->GetOutput(), lattice));
+
+  // Through a symbolic link: the file it names is replaced, the link stays.
+  const std::string link = folder.Path + "/link.vdb";
+  std::filesystem::create_symlink("lattice.vdb", link);
+  ffdtest::Perturb(lattice, rng, 0.01);
+  ASSERT_EQ(Write(lattice, link), 1);
+  EXPECT_TRUE(std::filesystem::is_symlink(link));
+  EXPECT_EQ(folder.Files(), (std::vector<std::string>{ "lattice.vdb", "link.vdb" }));
+  vtkNew<vtkFFDVDBReader> again;
+  ASSERT_EQ(Read(again, path, observer), 1) << observer->Errors;
+  EXPECT_TRUE(SameGrid(again->GetOutput(), lattice));
 }
 
 TEST(vtkFFDVDB, FileSizeAndTimesOfTheBear)
