@@ -31,6 +31,14 @@ ArrayT* FindFieldArray(vtkDataObject* data, const char* name, vtkIdType count)
 template <typename ArrayT, typename ValueT>
 void SetFieldArray(vtkDataObject* data, const char* name, const ValueT* values, int count)
 {
+  // Static methods have no object to report through: VTK's output window shows the error (Python: None passed).
+  if (!data || !values)
+  {
+    vtkErrorWithObjectMacro(nullptr,
+      "vtkFFDDataContract cannot set " << name << ": " << (!data ? "the data object" : "the values")
+                                       << " is null. Pass a data object and " << count << " values.");
+    return;
+  }
   vtkNew<ArrayT> array;
   array->SetName(name);
   array->SetNumberOfValues(count);
@@ -47,6 +55,11 @@ bool vtkFFDDataContract::GetFrame(vtkDataObject* data, double frame[12])
   vtkDoubleArray* array = FindFieldArray<vtkDoubleArray>(data, FrameArrayName(), 12);
   if (!array)
   {
+    return false;
+  }
+  if (!frame)
+  {
+    vtkErrorWithObjectMacro(nullptr, "vtkFFDDataContract::GetFrame(): the output array is null; pass 12 doubles.");
     return false;
   }
   double values[12];
@@ -72,6 +85,11 @@ bool vtkFFDDataContract::GetDivisions(vtkDataObject* data, int divisions[3])
   vtkIntArray* array = FindFieldArray<vtkIntArray>(data, DivisionsArrayName(), 3);
   if (!array || array->GetValue(0) < 1 || array->GetValue(1) < 1 || array->GetValue(2) < 1)
   {
+    return false;
+  }
+  if (!divisions)
+  {
+    vtkErrorWithObjectMacro(nullptr, "vtkFFDDataContract::GetDivisions(): the output array is null; pass 3 ints.");
     return false;
   }
   for (int c = 0; c < 3; ++c)

@@ -448,5 +448,40 @@ class TestLocalBases(unittest.TestCase):
                                  RELATIVE_TOLERANCE * diagonal, basis)
 
 
+
+class TestDataContract(unittest.TestCase):
+    """vtkFFDDataContract's static setters given None: an error on VTK's output window, nothing set, no crash. Each
+    call runs in its own interpreter, so that a crash (as it was: a segfault) fails the test, not the runner."""
+
+    def run_script(self, body):
+        import subprocess
+        import sys
+        script = "import vtkffd\nfrom vtkmodules.vtkCommonDataModel import vtkStructuredGrid\n" + body
+        return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+
+    def test_setters_given_none_are_errors_not_crashes(self):
+        contract = "vtkffd.vtkFFDDataContract"
+        for call, expected in (
+                ("SetFrame(None, [0.0] * 12)", "cannot set FFDFrame: the data object is null"),
+                ("SetDivisions(None, [1, 2, 3])", "cannot set FFDDivisions: the data object is null"),
+                ("SetBasis(None, 1)", "cannot set FFDBasis: the data object is null")):
+            with self.subTest(call=call):
+                result = self.run_script("%s.%s\nprint('returned')\n" % (contract, call))
+                self.assertEqual(result.returncode, 0, result.stderr[-2000:])
+                self.assertEqual(result.stdout.split(), ["returned"])
+                self.assertIn(expected, result.stderr)
+
+    def test_a_grid_keeps_its_arrays_when_a_setter_fails(self):
+        # The values None: refused by the wrapping or by the setter; either way the grid gains no array.
+        for call in ("SetFrame(grid, None)", "SetDivisions(grid, None)"):
+            with self.subTest(call=call):
+                result = self.run_script(
+                    "grid = vtkStructuredGrid()\n"
+                    "try:\n    vtkffd.vtkFFDDataContract.%s\nexcept (TypeError, ValueError):\n    pass\n"
+                    "print(grid.GetFieldData().GetNumberOfArrays())\n" % call)
+                self.assertEqual(result.returncode, 0, result.stderr[-2000:])
+                self.assertEqual(result.stdout.split(), ["0"])
+
+
 if __name__ == "__main__":
     unittest.main()
