@@ -20,6 +20,7 @@
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
+#include <array>
 #include <utility>
 #include <vector>
 
@@ -28,37 +29,32 @@ vtkStandardNewMacro(vtkFFDCellEdges);
 namespace
 {
 /// The control net of a sparse lattice: addEdge(a, b) for each two points whose LatticeIndex differ by one along
-/// one axis, found by binary search among the points' indices (linear over the largest index plus one).
+/// one axis, found by binary search among the points' indices sorted as (k, j, i): whatever their values, which a
+/// flat key i + nI (j + nJ k) could overflow or alias where they are negative.
 template <typename AddEdge>
 void AddControlNet(vtkIntArray* latticeIndex, AddEdge&& addEdge)
 {
+  using Key = std::array<int, 3>; // (k, j, i)
   const vtkIdType n = latticeIndex->GetNumberOfTuples();
   const int* index = latticeIndex->GetPointer(0);
-  vtkTypeInt64 extent[3] = { 1, 1, 1 };
+  std::vector<std::pair<Key, vtkIdType>> sorted(static_cast<size_t>(n));
   for (vtkIdType p = 0; p < n; ++p)
   {
-    for (int a = 0; a < 3; ++a)
-    {
-      extent[a] = std::max<vtkTypeInt64>(extent[a], vtkTypeInt64(index[3 * p + a]) + 2);
-    }
-  }
-  auto key = [&](const int* ijk)
-  { return ijk[0] + extent[0] * (vtkTypeInt64(ijk[1]) + extent[1] * vtkTypeInt64(ijk[2])); };
-  std::vector<std::pair<vtkTypeInt64, vtkIdType>> sorted(static_cast<size_t>(n));
-  for (vtkIdType p = 0; p < n; ++p)
-  {
-    sorted[p] = { key(index + 3 * p), p };
+    sorted[p] = { { index[3 * p + 2], index[3 * p + 1], index[3 * p] }, p };
   }
   std::sort(sorted.begin(), sorted.end());
   for (vtkIdType p = 0; p < n; ++p)
   {
     for (int a = 0; a < 3; ++a)
     {
-      int next[3] = { index[3 * p], index[3 * p + 1], index[3 * p + 2] };
-      ++next[a];
-      const vtkTypeInt64 k = key(next);
-      const auto at = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(k, vtkIdType(0)));
-      if (at != sorted.end() && at->first == k)
+      Key next = { index[3 * p + 2], index[3 * p + 1], index[3 * p] };
+      if (next[2 - a] == VTK_INT_MAX)
+      {
+        continue;
+      }
+      ++next[2 - a];
+      const auto at = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(next, vtkIdType(0)));
+      if (at != sorted.end() && at->first == next)
       {
         addEdge(p, at->second);
       }

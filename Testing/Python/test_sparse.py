@@ -127,5 +127,29 @@ class TestSparse(unittest.TestCase):
                         errors.messages)
 
 
+    def test_control_net_joins_only_index_neighbours(self):
+        # vtkFFDCellEdges joins two points of a sparse lattice where their LatticeIndex differ by one along one
+        # axis. A flat key i + nI (j + nJ k) over the indices' range aliased (-1, 1, 0) with (2, 0, 0), the
+        # neighbour of (1, 0, 0): an edge between points that are not neighbours. Only (0, 0, 0)-(1, 0, 0) is one.
+        from vtkmodules.util.numpy_support import numpy_to_vtk
+        from vtkmodules.vtkCommonCore import vtkPoints
+        from vtkmodules.vtkCommonDataModel import vtkUnstructuredGrid
+        from vtkmodules.util.vtkConstants import VTK_INT
+        indices = np.array([[0, 0, 0], [1, 0, 0], [-1, 1, 0]], dtype=np.int32)
+        points = vtkPoints()
+        points.SetData(numpy_to_vtk(indices.astype(np.float64), deep=True))
+        net = vtkUnstructuredGrid()
+        net.SetPoints(points)
+        index = numpy_to_vtk(indices, deep=True, array_type=VTK_INT)
+        index.SetName("LatticeIndex")
+        net.GetPointData().AddArray(index)
+        edges = vtkffd.vtkFFDCellEdges()
+        edges.SetInputData(net)
+        edges.Update()
+        lines = edges.GetOutput().GetLines()
+        pairs = vtk_to_numpy(lines.GetConnectivityArray()).reshape(-1, 2).tolist()
+        self.assertEqual(pairs, [[0, 1]])
+
+
 if __name__ == "__main__":
     unittest.main()
