@@ -7,11 +7,13 @@
 #include "vtkFFDDeformPoints.h"
 #include "vtkFFDForInChunks.h"
 #include "vtkFFDLatticeDisplacements.h"
+#include "vtkFFDSparseLattice.h"
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkArrayDispatch.h"
 #include "vtkDataArray.h"
 #include "vtkDataArrayRange.h"
+#include "vtkIntArray.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
@@ -23,6 +25,8 @@
 #include "FFDGridLanes.h"
 
 #include <algorithm>
+#include <atomic>
+#include <cmath>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -32,20 +36,163 @@ namespace
 {
 using PointArrays = vtkArrayDispatch::Reals;
 
+/// What to do about a lattice that breaks the data contract.
+const std::string ContractFix = " Build the lattice with vtkFFDBuildLattice, or keep its data contract "
+                                "(see vtkFFDDataContract).";
+
+//------------------------------------------------------------------------------------------------------------
+// The first point of `lattice` (of `view`) whose RestPosition lies farther than `tolerance` (per coordinate) from
+// the rest position its frame gives it (vtkFFDRestPoint), or -1; `expected` is then that rest position.
+vtkIdType FirstMovedRestPosition(vtkPointSet* lattice, vtkDataArray* rest, const vtkFFDGridLattice& view,
+  double tolerance, ffd::Vec3<double>& expected)
+{
+  const vtkIdType count = lattice->GetNumberOfPoints();
+  const ffd::Frame<double> frame = ffd::Frame<double>::FromArray(view.Frame);
+  const int* dims = view.ControlPointsPerAxis;
+  vtkIntArray* index = view.Sparse
+    ? vtkIntArray::SafeDownCast(lattice->GetPointData()->GetAbstractArray(vtkFFDDataContract::LatticeIndexArrayName()))
+    : nullptr; // checked by vtkFFDSparseCells::Read()
+  auto restPointOf = [&](vtkIdType p)
+  {
+    int ijk[3] = { int(p % dims[0]), int(p / dims[0] % dims[1]), int(p / dims[0] / dims[1]) };
+    if (index)
+    {
+      index->GetTypedTuple(p, ijk);
+    }
+    return vtkFFDRestPoint(frame, view.Basis, view.Divisions, ijk[0], ijk[1], ijk[2]);
+  };
+  std::atomic<vtkIdType> first(count);
+  auto check = [&](auto* restPositions)
+  {
+    const auto x0 = vtk::DataArrayTupleRange<3>(restPositions);
+    vtkSMPTools::For(0, count, 4096,
+      [&](vtkIdType begin, vtkIdType end)
+      {
+        for (vtkIdType p = begin; p < end && p < first; ++p)
+        {
+          const ffd::Vec3<double> x = restPointOf(p);
+          if (!(std::fabs(x0[p][0] - x.x) <= tolerance && std::fabs(x0[p][1] - x.y) <= tolerance &&
+                std::fabs(x0[p][2] - x.z) <= tolerance))
+          {
+            vtkIdType seen = first.load();
+            while (p < seen && !first.compare_exchange_weak(seen, p))
+            {
+            }
+          }
+        }
+      });
+  };
+  if (!vtkArrayDispatch::DispatchByValueType<vtkArrayDispatch::Reals>::Execute(rest, check))
+  {
+    check(rest);
+  }
+  if (first == count)
+  {
+    return -1;
+  }
+  expected = restPointOf(first);
+  return first;
+}
+
+//------------------------------------------------------------------------------------------------------------
+// A grid lattice's rest positions are fixed by its frame (README, "Data contract"). They leave it where a transform
+// moved RestPosition as a vector together with the points (vtkTransformFilter's TransformAllInputVectors, on by
+// default in ParaView's Transform): the lattice would then deform nothing however it was rotated or scaled. The
+// check runs again only when the arrays or the frame change (`checked`).
+std::string CheckRestPositions(
+  vtkPointSet* lattice, vtkDataArray* rest, const vtkFFDGridLattice& view, vtkFFDRestCheck& checked)
+{
+  vtkAbstractArray* index =
+    view.Sparse ? lattice->GetPointData()->GetAbstractArray(vtkFFDDataContract::LatticeIndexArrayName()) : nullptr;
+  vtkFFDRestCheck key;
+  key.Arrays[0] = rest;
+  key.Times[0] = rest->GetMTime();
+  key.Arrays[1] = index;
+  key.Times[1] = index ? index->GetMTime() : 0;
+  key.Count = lattice->GetNumberOfPoints();
+  std::copy(view.Frame, view.Frame + 12, key.Frame);
+  std::copy(view.Divisions, view.Divisions + 3, key.Divisions);
+  key.Basis = int(view.Basis);
+  if (key == checked)
+  {
+    return std::string();
+  }
+  checked = vtkFFDRestCheck();
+  // 1e-9 of the frame's extent: far above the rounding of any evaluation of the formula (a few 1e-16), far below
+  // what a rotation or scaling that matters moves.
+  double extent = 0.0;
+  for (int c = 0; c < 3; ++c)
+  {
+    extent = std::max(extent,
+      std::fabs(view.Frame[c]) + std::fabs(view.Frame[3 + c]) + std::fabs(view.Frame[6 + c]) +
+        std::fabs(view.Frame[9 + c]));
+  }
+  const double tolerance = 1e-9 * extent;
+  ffd::Vec3<double> expected;
+  const vtkIdType moved = FirstMovedRestPosition(lattice, rest, view, tolerance, expected);
+  if (moved >= 0)
+  {
+    double x0[3];
+    rest->GetTuple(moved, x0);
+    std::ostringstream msg;
+    msg << "The RestPosition of lattice point " << moved << ", (" << x0[0] << ", " << x0[1] << ", " << x0[2]
+        << "), is not the rest position (" << expected.x << ", " << expected.y << ", " << expected.z
+        << ") that the lattice's FFDFrame gives it (tolerance " << tolerance
+        << ", 1e-9 of the frame's extent): the lattice's RestPosition/VoxelIndex no longer match its FFDFrame. A "
+           "transform moved them as vectors (VTK's vtkTransformFilter / ParaView's Transform with "
+           "TransformAllInputVectors on); transform the lattice with that option off, so that only its points move. "
+           "Without a transform, rebuild the lattice with vtkFFDBuildLattice, or keep its RestPosition where the "
+           "frame puts it (README, \"Data contract\").";
+    return msg.str();
+  }
+  checked = key;
+  return std::string();
+}
+
+//------------------------------------------------------------------------------------------------------------
+// The point arrays of a lattice whose cells `view` holds: RestPosition (doubles, where the frame puts them), Active
+// (where present) and the displacements, into `view`.
+std::string ReadPointArrays(vtkPointSet* lattice, vtkFFDGridLattice& view, vtkFFDRestCheck& restChecked)
+{
+  const vtkIdType count = lattice->GetNumberOfPoints();
+  vtkDataArray* rest = lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
+  if (!rest || rest->GetNumberOfComponents() != 3 || rest->GetNumberOfTuples() != count)
+  {
+    return "The lattice has no RestPosition point array of 3 components per point." + ContractFix;
+  }
+  vtkDataArray* active = lattice->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName());
+  if (active && (active->GetNumberOfComponents() != 1 || active->GetNumberOfTuples() != count))
+  {
+    return "The lattice's Active point array does not have one value per point: it has " +
+      std::to_string(active->GetNumberOfTuples()) + " tuples of " + std::to_string(active->GetNumberOfComponents()) +
+      " components for " + std::to_string(count) + " points." + ContractFix;
+  }
+  std::string why = vtkFFDCheckLatticePrecision(lattice, rest, "The lattice");
+  if (!why.empty())
+  {
+    return why;
+  }
+  const vtkIdType bad = vtkFFDReadLatticeDisplacements(lattice, rest, view.Displacements, nullptr);
+  if (bad >= 0)
+  {
+    return vtkFFDLatticePointProblem(lattice, rest, bad, "Lattice point");
+  }
+  return CheckRestPositions(lattice, rest, view, restChecked);
+}
+
 //------------------------------------------------------------------------------------------------------------
 // Reads a lattice per the data contract; returns an empty string or what is wrong with it. Its FFDBasis holds
 // vtkFFDBuildLattice's values, which vtkFFDBuildLattice.cxx asserts are ffd::GridBasis's.
-std::string ReadLattice(vtkPointSet* lattice, vtkFFDGridLattice& view, vtkFFDSparseCells& sparseCells)
+std::string ReadLattice(
+  vtkPointSet* lattice, vtkFFDGridLattice& view, vtkFFDSparseCells& sparseCells, vtkFFDRestCheck& restChecked)
 {
-  const std::string fix = " Build the lattice with vtkFFDBuildLattice, or keep its data contract "
-                          "(see vtkFFDDataContract).";
   if (!lattice)
   {
-    return "The lattice on input port 1 is not a vtkPointSet." + fix;
+    return "The lattice on input port 1 is not a vtkPointSet." + ContractFix;
   }
   if (!vtkFFDDataContract::GetFrame(lattice, view.Frame))
   {
-    return "The lattice has no valid FFDFrame field array (12 finite doubles)." + fix;
+    return "The lattice has no valid FFDFrame field array (12 finite doubles)." + ContractFix;
   }
   if (ffd::CheckFrame(view.Frame) != ffd::FrameStatus::Valid)
   {
@@ -53,16 +200,16 @@ std::string ReadLattice(vtkPointSet* lattice, vtkFFDGridLattice& view, vtkFFDSpa
   }
   if (!vtkFFDDataContract::GetDivisions(lattice, view.Divisions))
   {
-    return "The lattice has no valid FFDDivisions field array (3 ints >= 1)." + fix;
+    return "The lattice has no valid FFDDivisions field array (3 ints >= 1)." + ContractFix;
   }
   int basis;
   if (!vtkFFDDataContract::GetBasis(lattice, basis))
   {
-    return "The lattice has no FFDBasis field array (1 int)." + fix;
+    return "The lattice has no FFDBasis field array (1 int)." + ContractFix;
   }
   if (!ffd::IsGridBasis(basis))
   {
-    return "The lattice's FFDBasis " + std::to_string(basis) + " is not a known basis." + fix;
+    return "The lattice's FFDBasis " + std::to_string(basis) + " is not a known basis." + ContractFix;
   }
   view.Basis = static_cast<ffd::GridBasis>(basis);
   // A sparse lattice holds the control points of its cells: its own count, not the whole lattice's.
@@ -72,7 +219,7 @@ std::string ReadLattice(vtkPointSet* lattice, vtkFFDGridLattice& view, vtkFFDSpa
   {
     return "The lattice has a LatticeIndex point array, so it is sparse, but it is not a vtkUnstructuredGrid of a "
            "local basis: a global Bernstein lattice is dense." +
-      fix;
+      ContractFix;
   }
   std::string why;
   if (!vtkFFDBuildLattice::GetControlPointsPerAxis(basis, view.Divisions, view.ControlPointsPerAxis, why,
@@ -99,17 +246,7 @@ std::string ReadLattice(vtkPointSet* lattice, vtkFFDGridLattice& view, vtkFFDSpa
         << expected << ".";
     return msg.str();
   }
-  vtkDataArray* rest = lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
-  if (!rest || rest->GetNumberOfComponents() != 3 || rest->GetNumberOfTuples() != count)
-  {
-    return "The lattice has no RestPosition point array of 3 components per point." + fix;
-  }
-  const vtkIdType notFinite = vtkFFDReadLatticeDisplacements(lattice, rest, view.Displacements, nullptr);
-  if (notFinite >= 0)
-  {
-    return "Lattice point " + std::to_string(notFinite) + " or its RestPosition is not finite.";
-  }
-  return std::string();
+  return ReadPointArrays(lattice, view, restChecked);
 }
 
 //------------------------------------------------------------------------------------------------------------
@@ -400,6 +537,15 @@ struct EvaluateWorker
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
+bool vtkFFDRestCheck::operator==(const vtkFFDRestCheck& other) const
+{
+  return std::equal(this->Arrays, this->Arrays + 2, other.Arrays) &&
+    std::equal(this->Times, this->Times + 2, other.Times) && this->Count == other.Count &&
+    std::equal(this->Frame, this->Frame + 12, other.Frame) &&
+    std::equal(this->Divisions, this->Divisions + 3, other.Divisions) && this->Basis == other.Basis;
+}
+
+//------------------------------------------------------------------------------------------------------------
 vtkFFDGridDeformer::vtkFFDGridDeformer()
   : Binding(new vtkFFDGridBinding)
 {
@@ -410,7 +556,7 @@ vtkFFDGridDeformer::~vtkFFDGridDeformer() = default;
 //------------------------------------------------------------------------------------------------------------
 std::string vtkFFDGridDeformer::SetLattice(vtkPointSet* lattice)
 {
-  return ReadLattice(lattice, this->Lattice, this->SparseCells);
+  return ReadLattice(lattice, this->Lattice, this->SparseCells, this->RestChecked);
 }
 
 //------------------------------------------------------------------------------------------------------------

@@ -41,6 +41,20 @@ struct vtkFFDGridLattice
   bool Sparse = false;               // the control points and cells of vtkFFDGridDeformer::GetSparseCells() only
 };
 
+/// What the last check of a lattice's RestPosition against its frame passed: the arrays (RestPosition, and a sparse
+/// lattice's LatticeIndex) by identity and time, and the frame, divisions and basis they were checked against.
+struct vtkFFDRestCheck
+{
+  const void* Arrays[2] = { nullptr, nullptr };
+  vtkMTimeType Times[2] = { 0, 0 };
+  vtkIdType Count = -1;
+  double Frame[12] = {};
+  int Divisions[3] = {};
+  int Basis = -1;
+
+  bool operator==(const vtkFFDRestCheck& other) const;
+};
+
 class vtkFFDGridDeformer
 {
 public:
@@ -50,8 +64,10 @@ public:
   vtkFFDGridDeformer& operator=(const vtkFFDGridDeformer&) = delete;
 
   /**
-   * Reads and checks a grid lattice per the data contract and keeps it for Bind() and Evaluate(). Returns an
-   * empty string, or what is wrong with it.
+   * Reads and checks a grid lattice per the data contract and keeps it for Bind() and Evaluate(): among others,
+   * every cell's point ids (vtkFFDSparseCells), double points and RestPosition within +-vtkFFDMaxLatticeCoordinate,
+   * and RestPosition where the frame puts it (checked again only when it or the frame changes). Returns an empty
+   * string, or what is wrong with it.
    */
   std::string SetLattice(vtkPointSet* lattice);
 
@@ -89,6 +105,7 @@ public:
 private:
   vtkFFDGridLattice Lattice;
   vtkFFDSparseCells SparseCells;
+  vtkFFDRestCheck RestChecked; // the rest positions are checked again only when they or the frame change
   std::unique_ptr<vtkFFDGridBinding> Binding;
   vtkFFDBindingKey Bound; // what Binding is for
 };

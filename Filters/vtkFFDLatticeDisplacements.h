@@ -15,12 +15,47 @@
 
 #include <atomic>
 #include <cmath>
+#include <sstream>
+#include <string>
 #include <vector>
+
+/**
+ * The largest magnitude of a lattice's coordinates (its points' and rest positions'): beyond it, the products an
+ * evaluation forms (a tetrahedron's volume, the cube of its edges; a basis's derivatives times displacements)
+ * could overflow to infinity and turn the whole mesh into NaN.
+ */
+constexpr double vtkFFDMaxLatticeCoordinate = 1e100;
+
+/**
+ * Why `lattice`'s points or its `rest` (RestPosition) break the data contract's precision, or an empty string:
+ * both must be double arrays, since an integer or float RestPosition displaces the mesh by its rounding, and a float
+ * lattice cannot give double-precision results. `what` names the lattice ("The lattice").
+ */
+inline std::string vtkFFDCheckLatticePrecision(vtkPointSet* lattice, vtkDataArray* rest, const std::string& what)
+{
+  if (rest->GetDataType() != VTK_DOUBLE)
+  {
+    return what + "'s RestPosition array holds " + rest->GetDataTypeAsString() +
+      " values; the data contract asks for doubles (an integer or float RestPosition moves the mesh by its "
+      "rounding). Store the rest positions as a vtkDoubleArray, as vtkFFDBuildLattice and "
+      "vtkFFDBuildTetrahedralLattice do.";
+  }
+  vtkDataArray* points = lattice->GetPoints() ? lattice->GetPoints()->GetData() : nullptr;
+  if (points && points->GetDataType() != VTK_DOUBLE)
+  {
+    return what + "'s points are " + points->GetDataTypeAsString() +
+      "; the data contract asks for doubles (a float lattice cannot give double-precision results). Give it "
+      "double points: vtkPoints::SetDataTypeToDouble(), or OutputPointsPrecision DOUBLE_PRECISION (or default) on "
+      "the filter that made them.";
+  }
+  return std::string();
+}
 
 /**
  * The deformation of `lattice`, its points minus `rest` (3 components, a tuple per point), 3 doubles per point
  * into `displacements`, and the rest positions into `restValues` when not null. Returns the first point whose
- * position or rest position is not finite (the outputs then hold non-finite values), or -1.
+ * position or rest position is not finite or beyond vtkFFDMaxLatticeCoordinate (the outputs then hold such
+ * values), or -1; vtkFFDLatticePointProblem() says what is wrong with it.
  */
 inline vtkIdType vtkFFDReadLatticeDisplacements(
   vtkPointSet* lattice, vtkDataArray* rest, std::vector<double>& displacements, std::vector<double>* restValues)
@@ -35,7 +70,7 @@ inline vtkIdType vtkFFDReadLatticeDisplacements(
   {
     return -1;
   }
-  std::atomic<vtkIdType> firstNotFinite(count);
+  std::atomic<vtkIdType> firstBad(count);
   // Read through the arrays' own types where they are float or double (vtkArrayDispatch): vtkDataArray's
   // virtual tuple access is a noticeable part of an update's fixed cost.
   auto read = [&](auto* points, auto* restPositions)
@@ -53,10 +88,12 @@ inline vtkIdType vtkFFDReadLatticeDisplacements(
           {
             const double rest0 = double(x0[p][c]);
             const double d = double(x[p][c]) - rest0;
-            if (!std::isfinite(d))
+            // Not finite or too large: NaN fails both comparisons.
+            if (!(std::fabs(rest0) <= vtkFFDMaxLatticeCoordinate &&
+                  std::fabs(double(x[p][c])) <= vtkFFDMaxLatticeCoordinate))
             {
-              vtkIdType first = firstNotFinite.load();
-              while (p < first && !firstNotFinite.compare_exchange_weak(first, p))
+              vtkIdType first = firstBad.load();
+              while (p < first && !firstBad.compare_exchange_weak(first, p))
               {
               }
             }
@@ -75,7 +112,23 @@ inline vtkIdType vtkFFDReadLatticeDisplacements(
   {
     read(points, rest);
   }
-  return firstNotFinite == count ? -1 : firstNotFinite.load();
+  return firstBad == count ? -1 : firstBad.load();
+}
+
+/// What is wrong with point `p` of `lattice`, found by vtkFFDReadLatticeDisplacements(); `what` names the point
+/// ("Lattice point").
+inline std::string vtkFFDLatticePointProblem(
+  vtkPointSet* lattice, vtkDataArray* rest, vtkIdType p, const std::string& what)
+{
+  double x[3], x0[3];
+  lattice->GetPoint(p, x);
+  rest->GetTuple(p, x0);
+  std::ostringstream msg;
+  msg << what << " " << p << " or its RestPosition is not finite or lies beyond +-" << vtkFFDMaxLatticeCoordinate
+      << ": the point is at (" << x[0] << ", " << x[1] << ", " << x[2] << "), its RestPosition at (" << x0[0] << ", "
+      << x0[1] << ", " << x0[2] << "). Give every lattice point and RestPosition finite coordinates within +-"
+      << vtkFFDMaxLatticeCoordinate << " (beyond, the deformation's products overflow).";
+  return msg.str();
 }
 
 #endif

@@ -25,12 +25,20 @@ vtkIntArray* IndexArray(vtkFieldData* data, const char* name, vtkIdType count)
   return array && array->GetNumberOfComponents() == 3 && array->GetNumberOfTuples() == count ? array : nullptr;
 }
 
+/// What index arrays that no longer fit their lattice most often mean: vtkTransformFilter (and ParaView's
+/// Transform, where it is the default) transforms every 3-component array as a vector, the indices included.
+const std::string Transformed = " If a transform moved the lattice, the lattice's LatticeIndex/VoxelIndex no longer "
+                                "match its FFDFrame: it moved them as vectors (VTK's vtkTransformFilter / ParaView's "
+                                "Transform with TransformAllInputVectors on); transform the lattice with that option "
+                                "off, so that only its points move.";
+
 /// What Read() needs to check and place one cell's points.
 struct CellReader
 {
   vtkCellArray* Cells;
   const int* VoxelIndices;   // 3 per cell
   const int* LatticeIndices; // 3 per point
+  vtkIdType NumberOfPoints;  // the ids cells may name: [0, NumberOfPoints)
   ffd::GridBasis Basis;
   const int* Divisions;
   int N; // control points per axis of a support
@@ -66,6 +74,12 @@ struct CellReader
     }
     for (vtkIdType p = 0; p < size; ++p)
     {
+      if (points[p] < 0 || points[p] >= this->NumberOfPoints)
+      {
+        return fail("names point " + std::to_string(points[p]) + ", but the lattice has " +
+          std::to_string(this->NumberOfPoints) + " points (ids 0 to " + std::to_string(this->NumberOfPoints - 1) +
+          "): a cell may only name the lattice's own points.");
+      }
       const int* index = this->LatticeIndices + 3 * points[p];
       int slot = 0;
       for (int a = 2; a >= 0; --a)
@@ -73,14 +87,14 @@ struct CellReader
         const int local = index[a] - first[a];
         if (local < 0 || local >= this->N)
         {
-          return fail(
-            "lists point " + std::to_string(points[p]) + ", whose LatticeIndex is outside the voxel's support.");
+          return fail("lists point " + std::to_string(points[p]) +
+            ", whose LatticeIndex is outside the voxel's support." + Transformed);
         }
         slot = slot * this->N + local;
       }
       if (support[slot] >= 0)
       {
-        return fail("lists two points of the same LatticeIndex.");
+        return fail("lists two points of the same LatticeIndex." + Transformed);
       }
       support[slot] = static_cast<int>(points[p]);
     }
@@ -100,13 +114,21 @@ std::string vtkFFDSparseCells::Read(vtkUnstructuredGrid* lattice, ffd::GridBasis
   vtkIntArray* voxelIndex = IndexArray(lattice->GetCellData(), vtkFFDDataContract::VoxelIndexArrayName(), numCells);
   const std::string fix = " Build the lattice with vtkFFDBuildLattice, or keep its data contract (README, \"Data "
                           "contract\").";
+  // An index array of 3 components but not of ints is what a transform of double precision leaves.
+  auto notInts = [](vtkFieldData* data, const char* name)
+  {
+    vtkDataArray* array = data->GetArray(name);
+    return array && array->GetNumberOfComponents() == 3 && !vtkIntArray::SafeDownCast(array) ? Transformed : "";
+  };
   if (!latticeIndex)
   {
-    return "The sparse lattice has no LatticeIndex point array (3 ints per point)." + fix;
+    return "The sparse lattice has no LatticeIndex point array (3 ints per point)." +
+      notInts(lattice->GetPointData(), vtkFFDDataContract::LatticeIndexArrayName()) + fix;
   }
   if (!voxelIndex)
   {
-    return "The sparse lattice has no VoxelIndex cell array (3 ints per cell)." + fix;
+    return "The sparse lattice has no VoxelIndex cell array (3 ints per cell)." +
+      notInts(lattice->GetCellData(), vtkFFDDataContract::VoxelIndexArrayName()) + fix;
   }
   if (numCells == 0 || numCells > VTK_INT_MAX || numPoints > VTK_INT_MAX)
   {
@@ -114,7 +136,10 @@ std::string vtkFFDSparseCells::Read(vtkUnstructuredGrid* lattice, ffd::GridBasis
       " points: it needs at least one cell, and at most 2^31 - 1 of each." + fix;
   }
   const void* source[3] = { cells, latticeIndex, voxelIndex };
-  const vtkMTimeType sourceTime[3] = { cells->GetMTime(), latticeIndex->GetMTime(), voxelIndex->GetMTime() };
+  // The cell array's own time does not follow its arrays' when they are edited in place.
+  const vtkMTimeType cellsTime =
+    std::max({ cells->GetMTime(), cells->GetConnectivityArray()->GetMTime(), cells->GetOffsetsArray()->GetMTime() });
+  const vtkMTimeType sourceTime[3] = { cellsTime, latticeIndex->GetMTime(), voxelIndex->GetMTime() };
   if (std::equal(source, source + 3, this->Source) && std::equal(sourceTime, sourceTime + 3, this->SourceTime) &&
     numPoints == this->SourcePoints && basis == this->SourceBasis &&
     std::equal(divisions, divisions + 3, this->SourceDivisions))
@@ -155,12 +180,13 @@ std::string vtkFFDSparseCells::Read(vtkUnstructuredGrid* lattice, ffd::GridBasis
   const int* indices = latticeIndex->GetPointer(0);
   if (const vtkIdType bad = outside(voxels, divisions, numCells); bad >= 0)
   {
-    return "The VoxelIndex of cell " + std::to_string(bad) + " is outside the lattice's FFDDivisions." + fix;
+    return "The VoxelIndex of cell " + std::to_string(bad) + " is outside the lattice's FFDDivisions." + Transformed +
+      fix;
   }
   if (const vtkIdType bad = outside(indices, pointsPerAxis, numPoints); bad >= 0)
   {
     return "The LatticeIndex of point " + std::to_string(bad) + " is outside the lattice's control points per axis." +
-      fix;
+      Transformed + fix;
   }
 
   // The cells in the order of their voxels' flat indices, each voxel once.
@@ -180,11 +206,11 @@ std::string vtkFFDSparseCells::Read(vtkUnstructuredGrid* lattice, ffd::GridBasis
   if (twice != order.end())
   {
     return "Cells " + std::to_string(twice->second) + " and " + std::to_string((twice + 1)->second) +
-      " have the same VoxelIndex: a sparse lattice has one cell per voxel." + fix;
+      " have the same VoxelIndex: a sparse lattice has one cell per voxel." + Transformed + fix;
   }
 
   // Each cell's support, its points placed by their LatticeIndex.
-  const CellReader reader{ cells, voxels, indices, basis, divisions, ffd::SupportSize(basis, divisions[0]) };
+  const CellReader reader{ cells, voxels, indices, numPoints, basis, divisions, ffd::SupportSize(basis, divisions[0]) };
   const int n3 = reader.N * reader.N * reader.N;
   this->Keys.resize(order.size());
   this->Voxels.resize(3 * order.size());

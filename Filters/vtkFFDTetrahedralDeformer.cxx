@@ -92,11 +92,16 @@ std::string vtkFFDTetrahedralDeformer::SetLattice(vtkUnstructuredGrid* lattice)
   {
     return "The tetrahedral lattice has no RestPosition point array of 3 components per point." + fix;
   }
-  this->RestPositions = rest;
-  const vtkIdType notFinite = vtkFFDReadLatticeDisplacements(lattice, rest, this->Displacements, &this->RestValues);
-  if (notFinite >= 0)
+  std::string why = vtkFFDCheckLatticePrecision(lattice, rest, "The tetrahedral lattice");
+  if (!why.empty())
   {
-    return "Tetrahedral lattice point " + std::to_string(notFinite) + " or its RestPosition is not finite.";
+    return why;
+  }
+  this->RestPositions = rest;
+  const vtkIdType bad = vtkFFDReadLatticeDisplacements(lattice, rest, this->Displacements, &this->RestValues);
+  if (bad >= 0)
+  {
+    return vtkFFDLatticePointProblem(lattice, rest, bad, "Tetrahedral lattice point");
   }
   if (numberOfCells > MaxTetrahedra)
   {

@@ -357,6 +357,39 @@ inline double MaxRelativeErrorOfMovedLattice(Pipeline& pipeline, vtkPointSet* me
   return worst / pipeline.Diagonal();
 }
 
+/// `x` rotated by `degrees` about the axis through `centre` along `axis`, in float64 by Rodrigues' formula
+/// x' = c + v cos a + (k x v) sin a + k (k . v)(1 - cos a), v = x - c, k the unit axis (independent of VTK's).
+inline Vec RotatedAbout(const Vec& x, const Vec& centre, const Vec& axis, double degrees)
+{
+  const double a = degrees * 3.14159265358979323846 / 180.0;
+  const double length = Length(axis);
+  const Vec k = { axis[0] / length, axis[1] / length, axis[2] / length };
+  const Vec v = ffdref::Sub(x, centre);
+  const Vec kv = ffdref::Cross(k, v);
+  const double kDotV = ffdref::Dot(k, v);
+  Vec y;
+  for (int c = 0; c < 3; ++c)
+  {
+    y[c] = centre[c] + v[c] * std::cos(a) + kv[c] * std::sin(a) + k[c] * kDotV * (1.0 - std::cos(a));
+  }
+  return y;
+}
+
+/// `lattice` moved by vtkTransformFilter with `transform`, every 3-component array transformed as a vector too
+/// where `allInputVectors` is on (ParaView's Transform's default), and a copy of the output.
+inline vtkSmartPointer<vtkPointSet> TransformedLattice(
+  vtkPointSet* lattice, vtkAbstractTransform* transform, bool allInputVectors)
+{
+  vtkNew<vtkTransformFilter> move;
+  move->SetInputData(lattice);
+  move->SetTransform(transform);
+  move->SetTransformAllInputVectors(allInputVectors);
+  move->Update();
+  auto moved = vtkSmartPointer<vtkPointSet>::Take(lattice->NewInstance());
+  moved->DeepCopy(move->GetOutput());
+  return moved;
+}
+
 } // namespace ffdtest
 
 #endif

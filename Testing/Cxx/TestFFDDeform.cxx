@@ -16,11 +16,13 @@
 #include "vtkExecutive.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
+#include "vtkIntArray.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkStructuredGrid.h"
 #include "vtkTransform.h"
+#include "vtkUnsignedCharArray.h"
 
 #include <gtest/gtest.h>
 
@@ -522,6 +524,55 @@ TEST(vtkFFDDeform, BadLatticesAreRefusedWithAClearError)
       "RestPosition" },
     { "non-finite control point", [](vtkStructuredGrid* l) { l->GetPoints()->SetPoint(5, 0.0, std::nan(""), 0.0); },
       "not finite" },
+    // Beyond +-1e100 the products of an evaluation overflow: before, the mesh came out as inf and NaN.
+    { "control point at 1e308", [](vtkStructuredGrid* l) { l->GetPoints()->SetPoint(5, 1e308, 0.0, 0.0); },
+      "Lattice point 5 or its RestPosition is not finite or lies beyond +-1e+100" },
+    { "rest position at -1e101",
+      [](vtkStructuredGrid* l) { l->GetPointData()->GetArray("RestPosition")->SetComponent(5, 2, -1e101); },
+      "Lattice point 5 or its RestPosition is not finite or lies beyond" },
+    // The contract's types: an integer RestPosition moved the mesh by its truncation, silently.
+    { "integer rest position",
+      [](vtkStructuredGrid* l)
+      {
+        vtkNew<vtkIntArray> rest;
+        rest->DeepCopy(l->GetPointData()->GetArray("RestPosition"));
+        rest->SetName("RestPosition");
+        l->GetPointData()->AddArray(rest);
+      },
+      "RestPosition array holds int values; the data contract asks for doubles" },
+    { "float rest position",
+      [](vtkStructuredGrid* l)
+      {
+        vtkNew<vtkFloatArray> rest;
+        rest->DeepCopy(l->GetPointData()->GetArray("RestPosition"));
+        rest->SetName("RestPosition");
+        l->GetPointData()->AddArray(rest);
+      },
+      "RestPosition array holds float values" },
+    { "float points",
+      [](vtkStructuredGrid* l)
+      {
+        vtkNew<vtkPoints> points;
+        points->SetDataTypeToFloat();
+        points->DeepCopy(l->GetPoints());
+        l->SetPoints(points);
+      },
+      "The lattice's points are float; the data contract asks for doubles" },
+    // Read by the filters that take a lattice's covered voxels (refine, coarsen, detail) at every control point.
+    { "Active of fewer values",
+      [](vtkStructuredGrid* l)
+      {
+        vtkNew<vtkUnsignedCharArray> active;
+        active->SetName("Active");
+        active->SetNumberOfTuples(3);
+        active->Fill(1);
+        l->GetPointData()->AddArray(active);
+      },
+      "Active point array does not have one value per point: it has 3 tuples of 1 components" },
+    // A rest position the frame does not give (a transform of RestPosition as a vector, or an edit).
+    { "rest position off the frame",
+      [](vtkStructuredGrid* l) { l->GetPointData()->GetArray("RestPosition")->SetComponent(7, 0, 0.51); },
+      "The RestPosition of lattice point 7, (0.51, 1, 0), is not the rest position (0.5, 1, 0)" },
     // Divisions whose counts wrap in 32 or 64 bits (a product that wrapped to 0 once passed the point count).
     { "divisions beyond an int",
       [](vtkStructuredGrid* l)

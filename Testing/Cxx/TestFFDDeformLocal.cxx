@@ -228,6 +228,46 @@ TEST(vtkFFDDeformLocal, AffineLatticeMotionIsReproducedForEveryBasis)
   }
 }
 
+// vtkTransformFilter with TransformAllInputVectors on (ParaView's Transform's default) rotates or scales RestPosition
+// with the points: the lattice would deform nothing. Vtkffd says so, for every basis, rotation and scaling alike.
+// With the option off only the points move: a rigid rotation of the lattice about a point rotates the mesh, by
+// partition of unity and linear precision, within 1e-12 of the diagonal of the float64 rotation of each input
+// point (Rodrigues' formula, written in the test: rounding of sums of at most 216 terms of the diagonal's size).
+TEST(vtkFFDDeformLocal, LatticesTransformedWithTheirVectorsAreRefusedForEveryBasis)
+{
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
+  const Vec centre = { 0.2, -0.1, 0.3 }, axis = { 1.0, 2.0, 3.0 };
+  vtkNew<vtkTransform> rotation;
+  rotation->Translate(centre.data());
+  rotation->RotateWXYZ(35, axis.data());
+  rotation->Translate(-centre[0], -centre[1], -centre[2]);
+  vtkNew<vtkTransform> scaling;
+  scaling->Scale(1.2, 0.8, 1.1);
+  for (int basis : AllBases)
+  {
+    Pipeline pipeline(mesh, basis, 3, 2, 4);
+    for (vtkAbstractTransform* transform :
+      { static_cast<vtkAbstractTransform*>(rotation.Get()), static_cast<vtkAbstractTransform*>(scaling.Get()) })
+    {
+      pipeline.Deform->SetLatticeData(TransformedLattice(pipeline.Lattice, transform, true));
+      vtkNew<FFDTestErrorObserver> observer;
+      observer->WatchWithExecutive(pipeline.Deform);
+      pipeline.Deform->Update();
+      EXPECT_NE(observer->Errors.find("RestPosition/VoxelIndex no longer match its FFDFrame"), std::string::npos)
+        << BasisName(basis) << ": " << observer->Errors;
+      EXPECT_NE(observer->Errors.find("with TransformAllInputVectors on); transform the lattice with that option off"),
+        std::string::npos)
+        << BasisName(basis);
+      EXPECT_EQ(pipeline.Output()->GetNumberOfPoints(), 0) << BasisName(basis);
+    }
+    pipeline.Deform->SetLatticeData(TransformedLattice(pipeline.Lattice, rotation, false));
+    pipeline.Deform->Update();
+    const double error = MaxScaledDistance(
+      mesh, pipeline.Output(), [&](const Vec& x) { return RotatedAbout(x, centre, axis, 35); }, pipeline.Diagonal());
+    EXPECT_LE(error, 1e-12) << BasisName(basis);
+  }
+}
+
 //------------------------------------------------------------------------------------------------------------
 // Peer check: CUBIC_BSPLINE equals VTK's own vtkBSplineTransform (border mode Edge) on real meshes, to 1e-12 of
 // the diagonal in double for points inside the domain, and so does det(J) against its analytic derivative

@@ -9,9 +9,19 @@
 #include "FFDTestLattices.h"
 #include "FFDTestMeshes.h"
 
+#include "vtkCellArray.h"
 #include "vtkCellData.h"
+#include "vtkFFDBuildDetailLattice.h"
 #include "vtkFFDDeform.h"
+#include "vtkFFDDeformBlocks.h"
+#include "vtkFFDDirectManipulation.h"
+#include "vtkFFDInverseDeform.h"
+#include "vtkFFDLatticeDynamics.h"
+#include "vtkIdList.h"
+#include "vtkIdTypeArray.h"
 #include "vtkIntArray.h"
+#include "vtkStringOutputWindow.h"
+#include "vtkTransform.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
 
@@ -20,6 +30,7 @@
 #include <array>
 #include <chrono>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <set>
@@ -180,6 +191,121 @@ std::vector<char> DeformedBytes(vtkPointSet* mesh, vtkPointSet* lattice, int pol
   append(out->GetPointData()->GetArray(vtkFFDDeform::JacobianDeterminantArrayName()));
   ran = deform->GetLastBackendUsed();
   return bytes;
+}
+
+/// The errors of VTK objects without an observer (a filter's inner vtkFFDDeform) while it lives.
+class OutputWindowCapture
+{
+public:
+  OutputWindowCapture()
+    : Previous(vtkOutputWindow::GetInstance())
+  {
+    vtkOutputWindow::SetInstance(this->Window);
+  }
+  ~OutputWindowCapture() { vtkOutputWindow::SetInstance(this->Previous); }
+  std::string Text() { return this->Window->GetOutput(); }
+
+private:
+  vtkSmartPointer<vtkOutputWindow> Previous;
+  vtkNew<vtkStringOutputWindow> Window;
+};
+
+/// The lattice with the first point id of cell 0 replaced by `id`.
+void SetFirstId(vtkUnstructuredGrid* lattice, vtkIdType id)
+{
+  vtkNew<vtkIdList> ids;
+  lattice->GetCells()->GetCellAtId(0, ids);
+  ids->SetId(0, id);
+  lattice->GetCells()->ReplaceCellAtId(0, ids);
+}
+
+/// The lattice without its last `removed` points (and their point data), its cells unchanged.
+void RemoveLastPoints(vtkUnstructuredGrid* lattice, vtkIdType removed)
+{
+  const vtkIdType kept = lattice->GetNumberOfPoints() - removed;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(kept);
+  for (vtkIdType p = 0; p < kept; ++p)
+  {
+    points->SetPoint(p, lattice->GetPoint(p));
+  }
+  lattice->SetPoints(points);
+  for (int a = 0; a < lattice->GetPointData()->GetNumberOfArrays(); ++a)
+  {
+    lattice->GetPointData()->GetAbstractArray(a)->SetNumberOfTuples(kept);
+  }
+}
+
+/// What a run of a filter on a malformed lattice gave: every error (its own, its executive's, its inner filters')
+/// and the number of output points.
+struct Refusal
+{
+  std::string Errors;
+  vtkIdType OutputPoints = 0;
+};
+
+Refusal RunRefusing(vtkAlgorithm* filter)
+{
+  OutputWindowCapture window;
+  vtkNew<FFDTestErrorObserver> observer;
+  observer->WatchWithExecutive(filter);
+  filter->Update();
+  vtkPointSet* out = vtkPointSet::SafeDownCast(filter->GetOutputDataObject(0));
+  return { observer->Errors + window.Text(), out ? out->GetNumberOfPoints() : -1 };
+}
+
+/// Every filter that reads a lattice's cells, run on `lattice` and `mesh` (with point normals).
+std::vector<std::pair<std::string, Refusal>> RunEveryFilter(vtkUnstructuredGrid* lattice, vtkPolyData* mesh)
+{
+  std::vector<std::pair<std::string, Refusal>> runs;
+  for (int options = 0; options < 3; ++options)
+  {
+    vtkNew<vtkFFDDeform> deform;
+    deform->SetInputData(mesh);
+    deform->SetLatticeData(lattice);
+    deform->SetTransformNormals(options == 1);
+    deform->SetComputeJacobianDeterminant(options == 2);
+    runs.push_back(
+      { options == 0 ? "Deform" : (options == 1 ? "Deform, normals" : "Deform, det J"), RunRefusing(deform) });
+  }
+  vtkNew<vtkFFDInverseDeform> inverse;
+  inverse->SetInputData(mesh);
+  inverse->SetLatticeData(lattice);
+  runs.push_back({ "InverseDeform", RunRefusing(inverse) });
+  vtkNew<vtkFFDDeformBlocks> blocks;
+  blocks->SetInputData(mesh);
+  blocks->AddLatticeData(lattice);
+  runs.push_back({ "DeformBlocks", RunRefusing(blocks) });
+  vtkNew<vtkIntArray> selected;
+  selected->SetNumberOfComponents(3);
+  selected->InsertNextTypedTuple(
+    vtkIntArray::SafeDownCast(lattice->GetCellData()->GetArray(vtkFFDDataContract::VoxelIndexArrayName()))
+      ->GetPointer(0));
+  vtkNew<vtkFFDBuildDetailLattice> detail;
+  detail->SetInputData(lattice);
+  detail->SetSelectedVoxels(selected);
+  runs.push_back({ "BuildDetailLattice", RunRefusing(detail) });
+  vtkNew<vtkIdTypeArray> targetIds;
+  targetIds->InsertNextValue(0);
+  vtkNew<vtkPoints> targets;
+  targets->SetDataTypeToDouble();
+  const double* x = mesh->GetPoint(0);
+  targets->InsertNextPoint(x[0] + 0.01, x[1], x[2]);
+  vtkNew<vtkFFDDirectManipulation> manipulate;
+  manipulate->SetInputData(lattice);
+  manipulate->SetMeshData(mesh);
+  manipulate->SetTargetPointIds(targetIds);
+  manipulate->SetTargetPositions(targets);
+  runs.push_back({ "DirectManipulation", RunRefusing(manipulate) });
+  vtkNew<vtkFFDLatticeDynamics> dynamics;
+  dynamics->SetLattice(lattice);
+  dynamics->SetMesh(mesh);
+  vtkNew<FFDTestErrorObserver> observer;
+  observer->Watch(dynamics);
+  const int initialized = dynamics->Initialize();
+  runs.push_back({ "LatticeDynamics", { observer->Errors, initialized ? 1 : 0 } });
+  return runs;
 }
 } // namespace
 
@@ -493,4 +619,92 @@ TEST(vtkFFDDeformSparse, WholePipelineAt1024CubedMatchesReference)
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ::testing::Test::RecordProperty("seconds", std::to_string(seconds)); // about 2 s on 2 cores: not asserted
+}
+
+TEST(vtkFFDDeformSparse, CellsNamingPointsTheLatticeLacksAreRefusedByEveryFilter)
+{
+  // A cell naming a point id the lattice does not have (the first id past its points, a negative id, the largest
+  // int), and a lattice whose last points were taken away while its cells still name them: vtkFFDSparseCells,
+  // which every reader of a grid lattice goes through, refuses the ids before it reads anything through them.
+  // Every filter gives the error and an empty output (the dynamics fail to initialize), for a local basis of two
+  // and of four points per axis. Before, the first ones crashed Deform and the others, and the removed points
+  // were read past the arrays' ends: silently wrong output, and a crash of the dynamics.
+  std::mt19937 rng(1722);
+  const vtkSmartPointer<vtkPolyData> mesh = ffdtest::WithPointNormals(ReadTestMesh("bear"));
+  const int n[3] = { 5, 5, 5 };
+  for (int basis : { vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::CUBIC_BSPLINE })
+  {
+    const vtkSmartPointer<vtkPointSet> built =
+      ffdtest::MovedLattice(mesh, basis, n, vtkFFDBuildLattice::SPARSE, rng, 0.02);
+    const vtkIdType count = built->GetNumberOfPoints();
+    const std::string has = "but the lattice has ";
+    const std::vector<std::pair<std::string, std::function<void(vtkUnstructuredGrid*)>>> defects = {
+      { "names point " + std::to_string(count) + ", " + has + std::to_string(count) + " points",
+        [count](vtkUnstructuredGrid* l) { SetFirstId(l, count); } },
+      { "names point -1, " + has, [](vtkUnstructuredGrid* l) { SetFirstId(l, -1); } },
+      { "names point 2147483647, " + has, [](vtkUnstructuredGrid* l) { SetFirstId(l, VTK_INT_MAX); } },
+      { has + std::to_string(count - 10) + " points", [](vtkUnstructuredGrid* l) { RemoveLastPoints(l, 10); } },
+    };
+    for (const auto& defect : defects)
+    {
+      auto lattice = vtkSmartPointer<vtkUnstructuredGrid>::New();
+      lattice->DeepCopy(built);
+      defect.second(lattice);
+      for (const auto& run : RunEveryFilter(lattice, mesh))
+      {
+        const std::string what = run.first + ", " + vtkFFDBuildLattice::GetBasisAsString(basis) + ": " + defect.first;
+        EXPECT_NE(run.second.Errors.find(defect.first), std::string::npos) << what << "\n" << run.second.Errors;
+        EXPECT_EQ(run.second.OutputPoints, 0) << what;
+      }
+    }
+  }
+}
+
+TEST(vtkFFDDeformSparse, TransformedLatticesFollowOrSayWhatTheTransformDid)
+{
+  // vtkTransformFilter with TransformAllInputVectors on (ParaView's Transform's default) transforms a sparse
+  // lattice's LatticeIndex, VoxelIndex and RestPosition as vectors: the error says so and what to do, for a
+  // rotation and a scaling and every local basis (before, it said only that the lattice was not built by
+  // vtkFFDBuildLattice). With the option off, a rigid rotation of the lattice about a point rotates the mesh:
+  // within 1e-12 of the diagonal of the float64 rotation of each input point (Rodrigues' formula, FFDTestLattices.h;
+  // partition of unity and linear precision, rounding of sums of at most 64 terms of the diagonal's size).
+  std::mt19937 rng(1723);
+  const vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("bear");
+  const int n[3] = { 6, 5, 4 };
+  const Vec centre = { 0.1, 0.2, -0.3 }, axis = { -1.0, 0.5, 2.0 };
+  vtkNew<vtkTransform> rotation;
+  rotation->Translate(centre.data());
+  rotation->RotateWXYZ(40, axis.data());
+  rotation->Translate(-centre[0], -centre[1], -centre[2]);
+  vtkNew<vtkTransform> scaling;
+  scaling->Scale(2.0, 1.5, 0.5);
+  for (int basis : LocalBases)
+  {
+    const std::string name = vtkFFDBuildLattice::GetBasisAsString(basis);
+    const vtkSmartPointer<vtkPointSet> lattice =
+      ffdtest::MovedLattice(mesh, basis, n, vtkFFDBuildLattice::SPARSE, rng, 0.0);
+    for (vtkAbstractTransform* transform :
+      { static_cast<vtkAbstractTransform*>(rotation.Get()), static_cast<vtkAbstractTransform*>(scaling.Get()) })
+    {
+      vtkNew<vtkFFDDeform> deform;
+      deform->SetInputData(mesh);
+      deform->SetLatticeData(ffdtest::TransformedLattice(lattice, transform, true));
+      const Refusal refusal = RunRefusing(deform);
+      EXPECT_NE(refusal.Errors.find("VoxelIndex no longer match its FFDFrame"), std::string::npos)
+        << name << ": " << refusal.Errors;
+      EXPECT_NE(refusal.Errors.find("with TransformAllInputVectors on); transform the lattice with that option off"),
+        std::string::npos)
+        << name;
+      EXPECT_EQ(refusal.OutputPoints, 0) << name;
+    }
+    vtkNew<vtkFFDDeform> deform;
+    deform->SetInputData(mesh);
+    deform->SetLatticeData(ffdtest::TransformedLattice(lattice, rotation, false));
+    deform->Update();
+    const double error = ffdtest::MaxScaledDistance(
+      mesh, vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0)),
+      [&](const Vec& x) { return ffdtest::RotatedAbout(x, centre, axis, 40); },
+      ffdtest::Diagonal(ffdtest::FrameOf(lattice)));
+    EXPECT_LE(error, 1e-12) << name;
+  }
 }

@@ -20,6 +20,7 @@
 #include "vtkFloatArray.h"
 #include "vtkHexahedron.h"
 #include "vtkIdList.h"
+#include "vtkIntArray.h"
 #include "vtkMath.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
@@ -745,6 +746,37 @@ TEST(vtkFFDDeformTetrahedral, InconsistentLatticesAreErrors)
       } },
     { "a NaN node", "point 5 or its RestPosition is not finite",
       [](vtkUnstructuredGrid* g) { g->GetPoints()->SetPoint(5, std::nan(""), 0.0, 0.0); } },
+    // Beyond +-1e100, a tetrahedron's volume (the cube of its edges) and maps overflow: before, every point came
+    // out as NaN or inf without a word.
+    { "a node at 1e308", "Tetrahedral lattice point 5 or its RestPosition is not finite or lies beyond +-1e+100",
+      [](vtkUnstructuredGrid* g) { g->GetPoints()->SetPoint(5, 1e308, 0.0, 0.0); } },
+    { "a rest position at -1e101", "Tetrahedral lattice point 4 or its RestPosition is not finite or lies beyond",
+      [](vtkUnstructuredGrid* g) { g->GetPointData()->GetArray("RestPosition")->SetComponent(4, 1, -1e101); } },
+    // The contract's types: an integer RestPosition moved the mesh by its truncation, silently.
+    { "an integer RestPosition", "RestPosition array holds int values; the data contract asks for doubles",
+      [](vtkUnstructuredGrid* g)
+      {
+        vtkNew<vtkIntArray> rest;
+        rest->DeepCopy(g->GetPointData()->GetArray("RestPosition"));
+        rest->SetName("RestPosition");
+        g->GetPointData()->AddArray(rest);
+      } },
+    { "a float RestPosition", "RestPosition array holds float values",
+      [](vtkUnstructuredGrid* g)
+      {
+        vtkNew<vtkFloatArray> rest;
+        rest->DeepCopy(g->GetPointData()->GetArray("RestPosition"));
+        rest->SetName("RestPosition");
+        g->GetPointData()->AddArray(rest);
+      } },
+    { "float nodes", "The tetrahedral lattice's points are float; the data contract asks for doubles",
+      [](vtkUnstructuredGrid* g)
+      {
+        vtkNew<vtkPoints> points;
+        points->SetDataTypeToFloat();
+        points->DeepCopy(g->GetPoints());
+        g->SetPoints(points);
+      } },
     { "no cells", "has no cells",
       [](vtkUnstructuredGrid* g)
       {
@@ -781,6 +813,61 @@ TEST(vtkFFDDeformTetrahedral, InconsistentLatticesAreErrors)
     EXPECT_NE(observer->Errors.find(c.Expected), std::string::npos) << c.Name << ": " << observer->Errors;
     EXPECT_EQ(deform->GetOutput()->GetNumberOfPoints(), 0) << c.Name;
   }
+}
+
+// The case: a node of the lattice built around a real mesh moved to 1e308 turned the whole mesh into NaN
+// and inf; it is an error naming the node, with an empty output. Up to the bound, a lattice and mesh of 1e99
+// deform as one of size 1: a translation of every node moves every point by it, within 1e-12 of the size.
+TEST(vtkFFDDeformTetrahedral, NodesBeyondTheBoundAreErrorsAndLatticesUpToItDeform)
+{
+  vtkSmartPointer<vtkPolyData> mesh = ReadTestMesh("elephant");
+  vtkNew<vtkFFDBuildTetrahedralLattice> build;
+  build->SetInputData(mesh);
+  build->Update();
+  auto lattice = vtkSmartPointer<vtkUnstructuredGrid>::New();
+  lattice->DeepCopy(build->GetOutput());
+  const vtkIdType node = lattice->GetNumberOfPoints() - 1;
+  lattice->GetPoints()->SetPoint(node, 1e308, 0.0, 0.0);
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(mesh);
+  deform->SetLatticeData(lattice);
+  vtkNew<FFDTestErrorObserver> observer;
+  observer->WatchWithExecutive(deform);
+  deform->Update();
+  EXPECT_NE(observer->Errors.find("Tetrahedral lattice point " + std::to_string(node) +
+              " or its RestPosition is not finite or lies beyond +-1e+100: the point is at (1e+308, 0, 0)"),
+    std::string::npos)
+    << observer->Errors;
+  EXPECT_EQ(deform->GetOutput()->GetNumberOfPoints(), 0);
+
+  const double scale = 1e99;
+  auto big = BoxLattice(3, 0.0, scale, 0.0, false, 2);
+  auto points = RandomPoints(200, 0.1 * scale, 0.9 * scale, VTK_DOUBLE, 62);
+  const double shift[3] = { 0.25 * scale, -0.5 * scale, 0.125 * scale };
+  for (vtkIdType p = 0; p < big->GetNumberOfPoints(); ++p)
+  {
+    double x[3];
+    big->GetPoint(p, x);
+    big->GetPoints()->SetPoint(p, x[0] + shift[0], x[1] + shift[1], x[2] + shift[2]);
+  }
+  vtkNew<vtkFFDDeform> large;
+  large->SetInputData(points);
+  large->SetLatticeData(big);
+  large->Update();
+  vtkPointSet* out = large->GetOutput();
+  ASSERT_EQ(out->GetNumberOfPoints(), points->GetNumberOfPoints());
+  double worst = 0.0;
+  for (vtkIdType p = 0; p < points->GetNumberOfPoints(); ++p)
+  {
+    double x[3], y[3];
+    points->GetPoint(p, x);
+    out->GetPoint(p, y);
+    for (int c = 0; c < 3; ++c)
+    {
+      worst = std::max(worst, std::fabs(y[c] - (x[c] + shift[c])) / scale);
+    }
+  }
+  EXPECT_LE(worst, 1e-12);
 }
 
 // Ids edited in place after a first update (vtkCellArray's time does not follow its arrays'), and nodes taken
