@@ -297,6 +297,7 @@ int vtkFFDLatticeDynamics::CheckSettings()
     OutOfRange("SetSpringStiffness", this->SpringStiffness, "the springs' stiffness", 0, false),
     OutOfRange("SetSpringDamping", this->SpringDamping, "the springs' damping", 0, false),
     OutOfRange("SetCoreStiffness", this->CoreStiffness, "the core's stiffness", 0, false),
+    OutOfRange("SetIterations", this->Iterations, "the iterations of a step", 1, false, 1000),
     NotFinite("SetGravity", "", this->Gravity, "gravity"),
   };
   for (std::size_t i = 0; i < this->Internal->Spheres.size(); ++i)

@@ -102,8 +102,8 @@ public:
   ///@}
 
   ///@{
-  /// Local/global iterations of a step (default 10): more follow backward Euler more closely.
-  vtkSetClampMacro(Iterations, int, 1, 1000);
+  /// Local/global iterations of a step, from 1 to 1000 (default 10): more follow backward Euler more closely.
+  vtkSetMacro(Iterations, int);
   vtkGetMacro(Iterations, int);
   ///@}
 

@@ -996,8 +996,9 @@ TEST(FFDDeform, InputErrorsSayWhatToConnect)
 //------------------------------------------------------------------------------------------------------------
 // Issue 30, item 15: a setting that cannot be simulated (NaN, infinite, out of range) is an error naming its
 // setter when Step() uses it, Step() returns false, and the lattice and the simulation's time are unchanged (before:
-// NaN filled every control point and Step() succeeded; TotalMass <= 0 and infinite stiffnesses were clamped
-// silently, the latter freezing a falling body). Restoring the setting lets the simulation go on.
+// NaN filled every control point and Step() succeeded; TotalMass <= 0, infinite stiffnesses and Iterations out of
+// [1, 1000] were clamped silently, infinite stiffness freezing a falling body). Restoring the setting lets the
+// simulation go on.
 TEST(FFDLatticeDynamics, SettingsThatCannotBeSimulatedAreErrors)
 {
   Scene scene = BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::SPARSE);
@@ -1028,6 +1029,7 @@ TEST(FFDLatticeDynamics, SettingsThatCannotBeSimulatedAreErrors)
     { [&](double v) { dynamics->SetSpringStiffness(v); }, 1, { nan, inf, -1 }, "SetSpringStiffness(" },
     { [&](double v) { dynamics->SetSpringDamping(v); }, 0.01, { nan, inf, -1 }, "SetSpringDamping(" },
     { [&](double v) { dynamics->SetCoreStiffness(v); }, 10, { nan, inf, -1 }, "SetCoreStiffness(" },
+    { [&](double v) { dynamics->SetIterations(int(v)); }, 10, { 0, 1001 }, "SetIterations(" },
     { [&](double v) { dynamics->SetGravity(0, v, -9.81); }, 0, { nan, inf }, "SetGravity(0, " },
     { [&](double v) { sphere->SetCenter(v, 0, 0); }, 0, { nan, -inf }, "Magnetic sphere 0: SetCenter(" },
     { [&](double v) { sphere->SetRadius(v); }, 1, { nan, 0, -1 }, "Magnetic sphere 0: SetRadius(" },
