@@ -10,11 +10,14 @@
   share marked by GenerateGlobalIds; the voxel grid and the lattices that the first process holds, and the
   deformed pieces of every process (each point found by its id), equal pvbatch's single-process outputs bit for
   bit. The ParaView demo on 2 processes reads and deforms the bear once.
+- pvbatch plays simulation_pipeline.py: FFDDeform under FFD Simulate Lattice follows the simulated lattice at each
+  time, asked by UpdatePipeline(time) and by the animation scene; every output equals vtkffd's, bit for bit.
 - pvpython loads the plugin and runs a filter; the GUI (paraview --plugins) loads it and builds the pipeline
   from a script, in an X display.
 
 ctest passes the programs and paths in the environment (Testing/ParaView/CMakeLists.txt); run one part with -k.
 """
+import json
 import os
 import subprocess
 import sys
@@ -24,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 from vtkmodules.util.numpy_support import vtk_to_numpy
-from vtkmodules.vtkCommonDataModel import vtkUnstructuredGrid
+from vtkmodules.vtkCommonDataModel import vtkPlane, vtkUnstructuredGrid
 from vtkmodules.vtkIOXML import vtkXMLGenericDataObjectReader
 
 import vtkffd
@@ -234,6 +237,61 @@ class Mpi(ParaViewTestCase):
             self.assertTrue((Path(folder) / "bear_after.png").is_file())
         (mesh,) = self.serial["mesh"]
         self.assertIn(f"bear: {mesh.GetNumberOfPoints()} vertices, 60 control points (3x4x5)", output)
+
+
+class Dynamics(ParaViewTestCase):
+    """pvbatch plays simulation_pipeline.py: FFDDeform under FFD Simulate Lattice follows the simulation in time."""
+
+    def test_deformed_mesh_follows_the_simulation(self):
+        # Issue 30, item 2: the deformed bear's bounds were the same at every time (FFDDeform announced no time
+        # range, so no time request re-executed it). Each time's output must be the bear deformed by that time's
+        # simulated lattice (vtkffd's vtkFFDDeform on the lattice pvbatch wrote: the same bits, as in Pipeline),
+        # and the lattice vtkffd's own simulation at that time (the same sources: the same bits).
+        with tempfile.TemporaryDirectory() as folder:
+            run([PVBATCH, "--dr", HERE / "simulation_pipeline.py", PLUGIN, MESH, folder])
+            report = json.loads((Path(folder) / "report.json").read_text())
+            times = report["times"]
+            # vtkXMLDataSetWriter names every file .vtk; the reader reads what it holds.
+            lattices = [read(Path(folder) / f"lattice_{i}.vtk") for i in range(len(times))]
+            deformed = [read(Path(folder) / f"deformed_{i}.vtk") for i in range(len(times))]
+        self.assertEqual(report["time_range"], [0.0, 1.0])
+        mesh = read(MESH)
+        size = np.ptp(points(mesh), axis=0).max()
+        lowest = [bounds[4] for bounds in report["updated"]]
+        self.assertEqual(lowest[0], mesh.GetBounds()[4])
+        self.assertLess(lowest[1], lowest[0] - 0.1 * size)  # the bear fell
+        self.assertEqual(report["animated"], report["updated"])  # the animation asks for the same times
+        reference = self.simulation(mesh)
+        for i, time in enumerate(times):
+            reference.UpdateTimeStep(time)
+            np.testing.assert_array_equal(points(lattices[i]), points(reference.GetOutput()), err_msg=f"t={time}")
+            deform = vtkffd.vtkFFDDeform()
+            deform.SetInputData(mesh)
+            deform.SetLatticeData(lattices[i])
+            deform.Update()
+            np.testing.assert_array_equal(points(deformed[i]), points(deform.GetOutput()), err_msg=f"t={time}")
+
+    @staticmethod
+    def simulation(mesh):
+        """simulation_pipeline.py's simulation, built here with vtkffd."""
+        voxelize = vtkffd.vtkFFDVoxelize()
+        voxelize.SetInputData(mesh)
+        voxelize.SetDivisions(5, 5, 5)
+        build = vtkffd.vtkFFDBuildLattice()
+        build.SetInputConnection(voxelize.GetOutputPort())
+        build.SetBasisToTrilinear()
+        build.Update()
+        simulate = vtkffd.vtkFFDSimulateLattice()
+        simulate.SetInputConnection(build.GetOutputPort())
+        simulate.SetMeshData(mesh)
+        simulate.SetEndTime(1.0)
+        simulate.GetDynamics().SetGravity(0.0, 0.0, -9.81)
+        plane = vtkPlane()
+        plane.SetOrigin(0.0, 0.0, build.GetOutput().GetBounds()[4] - 0.25)
+        plane.SetNormal(0.0, 0.0, 1.0)
+        simulate.GetDynamics().AddCollider(plane)
+        simulate.plane = plane  # kept with the filter
+        return simulate
 
 
 class Clients(ParaViewTestCase):
