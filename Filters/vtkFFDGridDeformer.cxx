@@ -19,6 +19,7 @@
 #include "vtkPoints.h"
 #include "vtkSMPThreadLocal.h"
 #include "vtkSMPTools.h"
+#include "vtkStructuredGrid.h"
 #include "vtkUnstructuredGrid.h"
 
 #include "FFDCellTable.h"
@@ -181,6 +182,37 @@ std::string ReadPointArrays(vtkPointSet* lattice, vtkFFDGridLattice& view, vtkFF
 }
 
 //------------------------------------------------------------------------------------------------------------
+// Why a dense lattice's points are not its control points in VTK structured order, or an empty string: their count,
+// and a vtkStructuredGrid's dimensions, which consumers of the grid (rendering, widgets) index it by.
+std::string DenseShapeProblem(vtkPointSet* lattice, const vtkFFDGridLattice& view)
+{
+  const int* n = view.ControlPointsPerAxis;
+  const vtkIdType expected = vtkIdType(n[0]) * n[1] * n[2];
+  const vtkIdType count = lattice->GetNumberOfPoints();
+  std::ostringstream msg;
+  if (count != expected)
+  {
+    msg << "The lattice has " << count << " points but its divisions " << view.Divisions[0] << "x" << view.Divisions[1]
+        << "x" << view.Divisions[2] << " and basis " << vtkFFDBuildLattice::GetBasisAsString(int(view.Basis))
+        << " need " << expected << ".";
+    return msg.str();
+  }
+  int dims[3] = { n[0], n[1], n[2] };
+  if (vtkStructuredGrid* grid = vtkStructuredGrid::SafeDownCast(lattice))
+  {
+    grid->GetDimensions(dims);
+  }
+  if (!std::equal(dims, dims + 3, n))
+  {
+    msg << "The lattice's dimensions " << dims[0] << "x" << dims[1] << "x" << dims[2] << " are not the " << n[0] << "x"
+        << n[1] << "x" << n[2] << " control points that its FFDDivisions and FFDBasis give (control point (i, j, k) "
+        << "is point i + nI (j + nJ k))." << ContractFix;
+    return msg.str();
+  }
+  return std::string();
+}
+
+//------------------------------------------------------------------------------------------------------------
 // Reads a lattice per the data contract; returns an empty string or what is wrong with it. Its FFDBasis holds
 // vtkFFDBuildLattice's values, which vtkFFDBuildLattice.cxx asserts are ffd::GridBasis's.
 std::string ReadLattice(
@@ -227,24 +259,10 @@ std::string ReadLattice(
   {
     return "The lattice's FFDDivisions do not fit its FFDBasis: " + why;
   }
-  const vtkIdType expected =
-    vtkIdType(view.ControlPointsPerAxis[0]) * view.ControlPointsPerAxis[1] * view.ControlPointsPerAxis[2];
-  const vtkIdType count = lattice->GetNumberOfPoints();
-  if (view.Sparse)
+  why = view.Sparse ? sparseCells.Read(sparse, view.Basis, view.Divisions) : DenseShapeProblem(lattice, view);
+  if (!why.empty())
   {
-    why = sparseCells.Read(sparse, view.Basis, view.Divisions);
-    if (!why.empty())
-    {
-      return why;
-    }
-  }
-  else if (count != expected)
-  {
-    std::ostringstream msg;
-    msg << "The lattice has " << count << " points but its divisions " << view.Divisions[0] << "x" << view.Divisions[1]
-        << "x" << view.Divisions[2] << " and basis " << vtkFFDBuildLattice::GetBasisAsString(basis) << " need "
-        << expected << ".";
-    return msg.str();
+    return why;
   }
   return ReadPointArrays(lattice, view, restChecked);
 }

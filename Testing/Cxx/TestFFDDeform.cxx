@@ -509,6 +509,9 @@ TEST(vtkFFDDeform, BadLatticesAreRefusedWithAClearError)
         vtkFFDDataContract::SetDivisions(l, more);
       },
       "need 36" },
+    // The same count of points in another shape: the grid's consumers would index it otherwise than the deformation.
+    { "dimensions of another shape", [](vtkStructuredGrid* l) { l->SetDimensions(9, 3, 1); },
+      "The lattice's dimensions 9x3x1 are not the 3x3x3 control points" },
     { "no rest position", [](vtkStructuredGrid* l) { l->GetPointData()->RemoveArray("RestPosition"); },
       "RestPosition" },
     { "rest position of 2 components",
