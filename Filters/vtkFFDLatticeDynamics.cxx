@@ -538,7 +538,7 @@ std::string vtkFFDLatticeDynamics::Internals::ApplyImpulses()
     const int particle = this->ParticleOfPoint(impulse->first);
     if (particle < 0)
     {
-      why += "An impulse was applied to point " + std::to_string(impulse->first) +
+      why += std::string(why.empty() ? "" : " ") + "An impulse was applied to point " + std::to_string(impulse->first) +
         ", which is not a simulated control point of the lattice: it is dropped.";
       impulse = this->Impulses.erase(impulse);
       continue;
