@@ -118,5 +118,38 @@ class TetrahedralPipelineTest(unittest.TestCase):
         self.assertTrue(any("is not a tetrahedron" in m for m in catcher.messages), catcher.messages)
 
 
+    def test_overflowing_nodes_and_integer_rest_positions_are_errors(self):
+        # A node at 1e308 made every deformed point NaN or inf, and an integer RestPosition (the contract says
+        # doubles) moved the mesh by its truncation, both without a word: now each is an error, the output empty.
+        def deformed_with(change):
+            lattice = vtkUnstructuredGrid()
+            lattice.DeepCopy(self.build.GetOutput())
+            change(lattice)
+            deform = vtkffd.vtkFFDDeform()
+            catcher = catch_errors(deform, executive=True)
+            deform.SetInputData(self.mesh)
+            deform.SetLatticeData(lattice)
+            deform.Update()
+            return deform.GetOutput().GetNumberOfPoints(), catcher.messages
+
+        def far_node(lattice):
+            vtk_to_numpy(lattice.GetPoints().GetData())[7] = (1e308, 0.0, 0.0)
+            lattice.GetPoints().Modified()
+
+        def integer_rest(lattice):
+            rest = vtk_to_numpy(lattice.GetPointData().GetArray("RestPosition"))
+            integers = numpy_to_vtk(rest.astype(np.int32), deep=True)
+            integers.SetName("RestPosition")
+            lattice.GetPointData().AddArray(integers)
+
+        for change, expected in (
+                (far_node, "Tetrahedral lattice point 7 or its RestPosition is not finite or lies beyond +-1e+100"),
+                (integer_rest, "RestPosition array holds int values; the data contract asks for doubles")):
+            with self.subTest(change=change.__name__):
+                count, messages = deformed_with(change)
+                self.assertEqual(count, 0)
+                self.assertTrue(any(expected in m for m in messages), messages)
+
+
 if __name__ == "__main__":
     unittest.main()
