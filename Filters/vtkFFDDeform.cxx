@@ -161,11 +161,10 @@ vtkTypeBool vtkFFDDeform::ProcessRequest(
     [&]
     {
       const vtkTypeBool done = this->Superclass::ProcessRequest(request, inputVector, outputVector);
-      // The executive passes input 0's times only: a lattice that varies in time (vtkFFDSimulateLattice) must
-      // make the mesh re-execute at each time, with the lattice at that time.
-      if (done && request->Has(vtkDemandDrivenPipeline::REQUEST_INFORMATION()))
+      // A lattice that varies in time (vtkFFDSimulateLattice) must make the mesh re-execute at each time.
+      if (done)
       {
-        vtkFFDPipelineKeys::AnnounceTimes(inputVector, 2, outputVector->GetInformationObject(0));
+        vtkFFDPipelineKeys::AnnounceTimes(request, inputVector, 2, outputVector);
       }
       return done;
     });

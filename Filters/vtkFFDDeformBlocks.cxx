@@ -7,6 +7,7 @@
 #include "vtkFFDDeform.h"
 #include "vtkFFDInputChecks.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDPipelineKeys.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
@@ -78,8 +79,17 @@ int vtkFFDDeformBlocks::FillInputPortInformation(int port, vtkInformation* info)
 vtkTypeBool vtkFFDDeformBlocks::ProcessRequest(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return vtkFFDCatchAllocationFailure(
-    this, outputVector, [&] { return this->Superclass::ProcessRequest(request, inputVector, outputVector); });
+  return vtkFFDCatchAllocationFailure(this, outputVector,
+    [&]
+    {
+      const vtkTypeBool done = this->Superclass::ProcessRequest(request, inputVector, outputVector);
+      // A lattice that varies in time (vtkFFDSimulateLattice) must make the mesh re-execute at each time.
+      if (done)
+      {
+        vtkFFDPipelineKeys::AnnounceTimes(request, inputVector, 2, outputVector);
+      }
+      return done;
+    });
 }
 
 //------------------------------------------------------------------------------------------------------------

@@ -10,6 +10,7 @@
 #include "vtkFFDInputChecks.h"
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDPipelineKeys.h"
 #include "vtkFFDSparseLattice.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkIdList.h"
@@ -263,8 +264,17 @@ int vtkFFDInverseDeform::FillInputPortInformation(int port, vtkInformation* info
 vtkTypeBool vtkFFDInverseDeform::ProcessRequest(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return vtkFFDCatchAllocationFailure(
-    this, outputVector, [&] { return this->Superclass::ProcessRequest(request, inputVector, outputVector); });
+  return vtkFFDCatchAllocationFailure(this, outputVector,
+    [&]
+    {
+      const vtkTypeBool done = this->Superclass::ProcessRequest(request, inputVector, outputVector);
+      // A lattice that varies in time (vtkFFDSimulateLattice) must make the mesh re-execute at each time.
+      if (done)
+      {
+        vtkFFDPipelineKeys::AnnounceTimes(request, inputVector, 2, outputVector);
+      }
+      return done;
+    });
 }
 
 //------------------------------------------------------------------------------------------------------------

@@ -86,8 +86,14 @@ bool vtkFFDPipelineKeys::AnnouncedLattice(vtkInformation* inInfo, int& basis, in
 }
 
 //------------------------------------------------------------------------------
-void vtkFFDPipelineKeys::AnnounceTimes(vtkInformationVector** inputs, int ports, vtkInformation* outInfo)
+void vtkFFDPipelineKeys::AnnounceTimes(
+  vtkInformation* request, vtkInformationVector** inputs, int ports, vtkInformationVector* outputs)
 {
+  if (!request->Has(vtkDemandDrivenPipeline::REQUEST_INFORMATION()))
+  {
+    return;
+  }
+  vtkInformation* outInfo = outputs->GetInformationObject(0);
   using SDDP = vtkStreamingDemandDrivenPipeline;
   std::vector<double> steps;
   double range[2] = { 0, 0 };

@@ -14,6 +14,8 @@
 #include "vtkDataArray.h"
 #include "vtkFFDBuildTetrahedralLattice.h"
 #include "vtkFFDDeform.h"
+#include "vtkFFDDeformBlocks.h"
+#include "vtkFFDInverseDeform.h"
 #include "vtkFFDLatticeDynamics.h"
 #include "vtkFFDMagneticSphere.h"
 #include "vtkFFDSimulateLattice.h"
@@ -879,6 +881,33 @@ TEST(FFDDeform, AnnouncesTheTimesOfTheMeshAndTheLattice)
   ASSERT_TRUE(deform->UpdateTimeStep(2.0));
   EXPECT_EQ(mesh->Asked, 2.0);
   EXPECT_EQ(lattice->Asked, 2.0);
+}
+
+//------------------------------------------------------------------------------------------------------------
+// The other filters with a lattice on input 1 announce its times too (before: input 0's alone, so a simulated
+// lattice never re-executed them), and ask it for the time asked of them.
+TEST(FFDDeform, BlocksAndInverseAnnounceTheTimesOfTheirLattices)
+{
+  Scene scene = BearScene(vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::DENSE);
+  vtkNew<TimedInput> lattice;
+  lattice->SetInputData(scene.Lattice);
+  lattice->Steps = { 0.25, 0.5, 4.0 };
+  vtkNew<vtkFFDDeformBlocks> blocks;
+  blocks->SetInputData(scene.Mesh);
+  blocks->AddLatticeConnection(lattice->GetOutputPort());
+  vtkNew<vtkFFDInverseDeform> inverse;
+  inverse->SetInputData(scene.Mesh);
+  inverse->SetLatticeConnection(lattice->GetOutputPort());
+  using Times = std::pair<std::vector<double>, std::array<double, 2>>;
+  double time = 2.0; // a new time for each filter, so that the lattice executes again
+  for (vtkAlgorithm* filter : { static_cast<vtkAlgorithm*>(blocks), static_cast<vtkAlgorithm*>(inverse) })
+  {
+    SCOPED_TRACE(filter->GetClassName());
+    EXPECT_EQ(TimesOf(filter), (Times{ { 0.25, 0.5, 4.0 }, { 0.25, 4.0 } }));
+    ASSERT_TRUE(filter->UpdateTimeStep(time));
+    EXPECT_EQ(lattice->Asked, time);
+    time += 1.0;
+  }
 }
 
 //------------------------------------------------------------------------------------------------------------
