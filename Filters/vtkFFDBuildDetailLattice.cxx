@@ -8,6 +8,7 @@
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDSparseLattice.h"
+#include "vtkFFDStatistics.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -165,6 +166,8 @@ int vtkFFDBuildDetailLattice::RequestData(
   vtkPointSet* input = vtkPointSet::GetData(inputVector[0]);
   vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector);
   this->NumberOfRefinedVoxels = 0;
+  const vtkFFDStatisticsOnReturn statistics(output,
+    [this](vtkDataObject* out) { vtkFFDRecordCount(out, "NumberOfRefinedVoxels", this->NumberOfRefinedVoxels); });
   if (!input || input->GetNumberOfPoints() == 0)
   {
     return 1;

@@ -218,6 +218,9 @@ int vtkFFDBuildLattice::RequestData(
   vtkDataSet* input = vtkDataSet::GetData(inputVector[0]);
   vtkDataObject* output = vtkDataObject::GetData(outputVector);
   this->NumberOfActiveControlPoints = 0;
+  const vtkFFDStatisticsOnReturn statistics(output,
+    [this](vtkDataObject* out)
+    { vtkFFDRecordCount(out, "NumberOfActiveControlPoints", this->NumberOfActiveControlPoints); });
   if (!input ||
     (input->GetNumberOfCells() == 0 && !input->GetFieldData()->GetAbstractArray(vtkFFDDataContract::FrameArrayName())))
   {
@@ -410,7 +413,6 @@ int vtkFFDBuildLattice::BuildDense(const double frame[12], const int divisions[3
   vtkFFDDataContract::SetDivisions(output, divisions);
   vtkFFDDataContract::SetBasis(output, this->Basis);
   this->NumberOfActiveControlPoints = numActive;
-  vtkFFDRecordCount(output, "NumberOfActiveControlPoints", numActive);
   return 1;
 }
 
@@ -427,7 +429,6 @@ int vtkFFDBuildLattice::BuildSparse(
     return 0;
   }
   this->NumberOfActiveControlPoints = output->GetNumberOfPoints();
-  vtkFFDRecordCount(output, "NumberOfActiveControlPoints", this->NumberOfActiveControlPoints);
   return 1;
 }
 

@@ -258,6 +258,12 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
   vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector);
   this->NumberOfHullFaces = 0;
   this->NumberOfActiveNodes = 0;
+  const vtkFFDStatisticsOnReturn statistics(output,
+    [this](vtkDataObject* out)
+    {
+      vtkFFDRecordCount(out, "NumberOfHullFaces", this->NumberOfHullFaces);
+      vtkFFDRecordCount(out, "NumberOfActiveNodes", this->NumberOfActiveNodes);
+    });
   // With several processes, every one takes part in the reductions, an empty piece too.
   vtkMultiProcessController* controller = vtkFFDIsDistributed(this->Controller) ? this->Controller : nullptr;
   if (!input || (input->GetNumberOfPoints() == 0 && !controller))
@@ -451,8 +457,6 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
     }
     output->GetPointData()->AddArray(ghosts);
   }
-  vtkFFDRecordCount(output, "NumberOfHullFaces", this->NumberOfHullFaces);
-  vtkFFDRecordCount(output, "NumberOfActiveNodes", this->NumberOfActiveNodes);
   this->UpdateProgress(1.0);
   return 1;
 }

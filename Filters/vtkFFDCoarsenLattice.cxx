@@ -11,6 +11,7 @@
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDPipelineKeys.h"
+#include "vtkFFDStatistics.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkFFDVoxelize.h"
 #include "vtkFFDWholeInput.h"
@@ -196,6 +197,12 @@ int vtkFFDCoarsenLattice::RequestData(
   vtkPointSet* mesh = vtkPointSet::GetData(inputVector[1]);
   vtkPointSet* output = vtkPointSet::GetData(outputVector);
   this->ResidualRMS = this->MaximumResidual = 0;
+  const vtkFFDStatisticsOnReturn statistics(output,
+    [this](vtkDataObject* out)
+    {
+      vtkFFDRecordValue(out, "ResidualRMS", this->ResidualRMS);
+      vtkFFDRecordValue(out, "MaximumResidual", this->MaximumResidual);
+    });
   if (!input || input->GetNumberOfPoints() == 0)
   {
     return 1;

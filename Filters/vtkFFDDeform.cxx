@@ -6,6 +6,7 @@
 #include "vtkFFDInputChecks.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDPipelineKeys.h"
+#include "vtkFFDStatistics.h"
 #include "vtkFFDTetrahedralDeformer.h"
 
 #include "vtkAOSDataArrayTemplate.h"
@@ -182,6 +183,8 @@ int vtkFFDDeform::RequestData(vtkInformation*, vtkInformationVector** inputVecto
     return 0;
   }
   output->Initialize();
+  const vtkFFDStatisticsOnReturn statistics(
+    output, [this](vtkDataObject* out) { vtkFFDRecordText(out, "LastBackendUsed", this->LastBackendUsed); });
   vtkPoints* points = input->GetPoints();
   if (!points || points->GetNumberOfPoints() == 0)
   {

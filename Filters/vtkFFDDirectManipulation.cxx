@@ -7,6 +7,7 @@
 #include "vtkFFDInputChecks.h"
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDStatistics.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkIdTypeArray.h"
 #include "vtkInformation.h"
@@ -186,6 +187,12 @@ int vtkFFDDirectManipulation::RequestData(
   vtkPointSet* output = vtkPointSet::GetData(outputVector);
   this->NumberOfMovedControlPoints = 0;
   this->MaximumTargetDistance = 0;
+  const vtkFFDStatisticsOnReturn statistics(output,
+    [this](vtkDataObject* out)
+    {
+      vtkFFDRecordCount(out, "NumberOfMovedControlPoints", this->NumberOfMovedControlPoints);
+      vtkFFDRecordValue(out, "MaximumTargetDistance", this->MaximumTargetDistance);
+    });
   if (!lattice || lattice->GetNumberOfPoints() == 0)
   {
     return 1;

@@ -8,10 +8,12 @@
 #include "vtkFFDForInChunks.h"
 #include "vtkFFDGridDeformer.h"
 #include "vtkFFDInputChecks.h"
+#include "vtkFFDLatticeDisplacements.h"
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDPipelineKeys.h"
 #include "vtkFFDSparseLattice.h"
+#include "vtkFFDStatistics.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #include "vtkIdList.h"
 #include "vtkInformation.h"
@@ -189,6 +191,12 @@ bool InvertByTetrahedra(vtkAlgorithm* self, vtkUnstructuredGrid* lattice, vtkPoi
     problem = "The tetrahedral lattice has no RestPosition point array of 3 components per point.";
     return false;
   }
+  // Checked before the exchange below turns both into doubles.
+  problem = vtkFFDCheckLatticePrecision(lattice, rest, "The tetrahedral lattice");
+  if (!problem.empty())
+  {
+    return false;
+  }
   vtkNew<vtkUnstructuredGrid> exchanged;
   exchanged->ShallowCopy(lattice);
   vtkNew<vtkPoints> restPoints;
@@ -300,6 +308,12 @@ int vtkFFDInverseDeform::RequestData(
   vtkPointSet* lattice = vtkPointSet::GetData(inputVector[1]);
   vtkPointSet* output = vtkPointSet::GetData(outputVector);
   this->NumberOfFoldedPoints = this->NumberOfUnconvergedPoints = 0;
+  const vtkFFDStatisticsOnReturn statistics(output,
+    [this](vtkDataObject* out)
+    {
+      vtkFFDRecordCount(out, "NumberOfFoldedPoints", this->NumberOfFoldedPoints);
+      vtkFFDRecordCount(out, "NumberOfUnconvergedPoints", this->NumberOfUnconvergedPoints);
+    });
   if (!input || !output)
   {
     vtkErrorMacro("Input 0 must be a vtkPointSet.");

@@ -3,6 +3,7 @@
 
 #include "vtkFFDInputChecks.h"
 #include "vtkFFDLatticeDynamics.h"
+#include "vtkFFDStatistics.h"
 
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -142,6 +143,20 @@ int vtkFFDSimulateLattice::RequestData(
     vtkErrorMacro("Input 0 (the lattice) must be a vtkPointSet.");
     return 0;
   }
+  const vtkFFDStatisticsOnReturn statistics(output,
+    [this](vtkDataObject* out)
+    {
+      vtkFFDLatticeDynamics* dynamics = this->GetDynamics();
+      if (!dynamics)
+      {
+        return; // SetDynamics(nullptr): an error, and no statistics
+      }
+      vtkFFDRecordValue(out, "Time", dynamics->GetTime());
+      vtkFFDRecordCount(out, "NumberOfSimulatedPoints", dynamics->GetNumberOfSimulatedPoints());
+      vtkFFDRecordCount(out, "NumberOfSprings", dynamics->GetNumberOfSprings());
+      vtkFFDRecordValue(out, "KineticEnergy", dynamics->GetKineticEnergy());
+      vtkFFDRecordValue(out, "PotentialEnergy", dynamics->GetPotentialEnergy());
+    });
   double t = 0, step = 0;
   if (!this->RequestedStep(outInfo, t, step))
   {

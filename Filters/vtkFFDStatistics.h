@@ -14,7 +14,9 @@
 
 #include "vtkType.h"
 
+#include <new>
 #include <string>
+#include <utility>
 
 class vtkDataObject;
 
@@ -22,5 +24,41 @@ class vtkDataObject;
 void vtkFFDRecordCount(vtkDataObject* output, const char* name, vtkIdType value);
 void vtkFFDRecordValue(vtkDataObject* output, const char* name, double value);
 void vtkFFDRecordText(vtkDataObject* output, const char* name, const std::string& value);
+
+/**
+ * Records a filter's statistics in its output when RequestData returns, whichever way it returns (an empty input,
+ * an error, the end): made at the top of RequestData with a function that records them,
+ *   const vtkFFDStatisticsOnReturn statistics(output, [this](vtkDataObject* out) { vtkFFDRecordCount(...); });
+ */
+template <typename Record>
+class vtkFFDStatisticsOnReturn
+{
+public:
+  vtkFFDStatisticsOnReturn(vtkDataObject* output, Record record)
+    : Output(output)
+    , RecordStatistics(std::move(record))
+  {
+  }
+  ~vtkFFDStatisticsOnReturn()
+  {
+    try
+    {
+      if (this->Output)
+      {
+        this->RecordStatistics(this->Output);
+      }
+    }
+    catch (const std::bad_alloc&)
+    {
+      // Out of memory already (RequestData is unwinding from it): the statistics are lost, not the process.
+    }
+  }
+  vtkFFDStatisticsOnReturn(const vtkFFDStatisticsOnReturn&) = delete;
+  void operator=(const vtkFFDStatisticsOnReturn&) = delete;
+
+private:
+  vtkDataObject* Output;
+  Record RecordStatistics;
+};
 
 #endif

@@ -5,6 +5,7 @@
 #include "vtkDataArrayRange.h"
 #include "vtkDoubleArray.h"
 #include "vtkFFDDistributed.h"
+#include "vtkFFDInputChecks.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDPipelineKeys.h"
 #include "vtkFFDSparseLattice.h"
@@ -287,7 +288,7 @@ int vtkFFDVoxelize::RequestInformation(vtkInformation*, vtkInformationVector**, 
 {
   if (!CheckDivisions(this, this->Divisions))
   {
-    return 0;
+    return vtkFFDEmptyOutputs(outputVector); // RequestData does not run: an earlier output would stay
   }
   outputVector->GetInformationObject(0)->Set(vtkFFDPipelineKeys::DIVISIONS(), this->Divisions, 3);
   return 1;
@@ -315,6 +316,8 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
   vtkPointSet* input = vtkPointSet::GetData(inputVector[0]);
   vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector);
   this->NumberOfActiveVoxels = 0;
+  const vtkFFDStatisticsOnReturn statistics(
+    output, [this](vtkDataObject* out) { vtkFFDRecordCount(out, "NumberOfActiveVoxels", this->NumberOfActiveVoxels); });
   const vtkIdType numPoints = input ? input->GetNumberOfPoints() : 0;
   // With several processes, every one takes part in the reductions, an empty piece too.
   vtkMultiProcessController* controller = vtkFFDIsDistributed(this->Controller) ? this->Controller : nullptr;
@@ -431,7 +434,6 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
     return 0;
   }
   this->NumberOfActiveVoxels = static_cast<vtkIdType>(voxels.size());
-  vtkFFDRecordCount(output, "NumberOfActiveVoxels", this->NumberOfActiveVoxels);
   this->UpdateProgress(1.0);
   return 1;
 }

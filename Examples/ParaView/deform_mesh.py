@@ -135,6 +135,12 @@ def frame_camera(view, bounds):
     _DisableFirstRenderCameraReset()  # else the first Render() frames the visible data itself
 
 
+def statistic(proxy, name):
+    """A statistic of a VoxelFFD filter's last update, a field array of its output: a number or a word."""
+    array = proxy.FieldData[name]
+    return array.GetStringValue(0) if array.GetNumberOfStringValues() else array.GetRange()[0]
+
+
 def union_bounds(*proxies):
     # numpy's min and max: in pvbatch's single process a Programmable Filter's script runs in the namespace of
     # __main__, this module, and imports ParaView's array algorithms of those names into it.
@@ -159,8 +165,6 @@ def main(argv):
     load_plugin(arguments.plugin)
     pipeline = build_pipeline(path)
     pipeline["deformed"].UpdatePipeline()
-    for name in ("voxels", "lattice", "deformed"):
-        pipeline[name].UpdatePropertyInformation()
 
     arguments.output_dir.mkdir(parents=True, exist_ok=True)
     before_png = arguments.output_dir / f"{path.stem}_before.png"
@@ -184,9 +188,9 @@ def main(argv):
     n_i, n_j, n_k = dimensions
     mesh_points = pipeline["mesh"].GetDataInformation().GetNumberOfPoints()
     print(f"{path.stem}: {mesh_points} vertices, {lattice.GetNumberOfPoints()} control points "
-          f"({n_i}x{n_j}x{n_k}), {pipeline['voxels'].NumberOfActiveVoxels} active voxels, "
-          f"{pipeline['lattice'].NumberOfActiveControlPoints} active control points "
-          f"(deformed on the {pipeline['deformed'].LastBackendUsed})")
+          f"({n_i}x{n_j}x{n_k}), {statistic(pipeline['voxels'], 'NumberOfActiveVoxels'):.0f} active voxels, "
+          f"{statistic(pipeline['lattice'], 'NumberOfActiveControlPoints'):.0f} active control points "
+          f"(deformed on the {statistic(pipeline['deformed'], 'LastBackendUsed')})")
     print(f"wrote {before_png} and {after_png}")
 
 

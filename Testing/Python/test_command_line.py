@@ -43,9 +43,17 @@ def contents(data):
                       "connectivity": vtk_to_numpy(data.GetCells().GetConnectivityArray())})
     for where, attributes in (("point", data.GetPointData()), ("cell", data.GetCellData()),
                               ("field", data.GetFieldData())):
-        parts.update({f"{where} {attributes.GetArrayName(a)}": vtk_to_numpy(attributes.GetArray(a))
+        parts.update({f"{where} {attributes.GetArrayName(a)}": as_numpy(attributes.GetAbstractArray(a))
                       for a in range(attributes.GetNumberOfArrays())})
     return parts
+
+
+def as_numpy(array):
+    """A VTK array's values as a numpy array: numbers as they are stored, strings (a statistic such as
+    LastBackendUsed) as numpy strings."""
+    if array.IsA("vtkDataArray"):
+        return vtk_to_numpy(array)
+    return np.array([array.GetValue(i) for i in range(array.GetNumberOfValues())])
 
 
 def build_in_process(mesh, basis, divisions, form=vtkffd.vtkFFDBuildLattice.AUTOMATIC):

@@ -13,7 +13,7 @@ import os
 import unittest
 
 import numpy as np
-from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray, vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkCommonExecutionModel import vtkAlgorithm
@@ -447,6 +447,68 @@ class TestLocalBases(unittest.TestCase):
             self.assertLessEqual(np.abs(output - self.reference(basis, lattice, rest)).max(),
                                  RELATIVE_TOLERANCE * diagonal, basis)
 
+
+
+class TestStatistics(unittest.TestCase):
+    """Every statistic that a filter's getter returns is also a one-value field array of its output, of the
+    getter's name without Get (ParaView reads the output's field data: its information properties read 0 before
+    an update computes them). Each is compared with its getter after a real update."""
+
+    def expect_recorded(self, algorithm, names):
+        algorithm.Update()
+        field_data = algorithm.GetOutputDataObject(0).GetFieldData()
+        for name in names:
+            array = field_data.GetAbstractArray(name)
+            self.assertIsNotNone(array, f"{algorithm.GetClassName()}: {name}")
+            self.assertEqual(array.GetNumberOfValues(), 1, name)
+            self.assertEqual(array.GetValue(0), getattr(algorithm, "Get" + name)(), name)
+
+    def test_every_filter_records_its_statistics(self):
+        bear = read_mesh("bear")
+        voxelize, build, lattice = build_lattice(bear, (3, 3, 3), vtkffd.vtkFFDBuildLattice.CUBIC_BSPLINE)
+        self.expect_recorded(voxelize, ["NumberOfActiveVoxels"])
+        self.expect_recorded(build, ["NumberOfActiveControlPoints"])
+        tetrahedra = vtkffd.vtkFFDBuildTetrahedralLattice()
+        tetrahedra.SetInputData(bear)
+        self.expect_recorded(tetrahedra, ["NumberOfHullFaces", "NumberOfActiveNodes"])
+        rng = np.random.default_rng(20261129)
+        points = vtk_to_numpy(lattice.GetPoints().GetData())
+        points += rng.uniform(-0.02, 0.02, points.shape)
+        lattice.GetPoints().Modified()
+        deform = vtkffd.vtkFFDDeform()
+        deform.SetInputData(bear)
+        deform.SetLatticeData(lattice)
+        deform.SetBackendToCPU()
+        self.expect_recorded(deform, ["LastBackendUsed"])
+        inverse = vtkffd.vtkFFDInverseDeform()
+        inverse.SetInputConnection(deform.GetOutputPort())
+        inverse.SetLatticeData(lattice)
+        self.expect_recorded(inverse, ["NumberOfFoldedPoints", "NumberOfUnconvergedPoints"])
+        coarsen = vtkffd.vtkFFDCoarsenLattice()
+        coarsen.SetInputData(lattice)
+        coarsen.SetMeshData(bear)
+        self.expect_recorded(coarsen, ["ResidualRMS", "MaximumResidual"])
+        detail = vtkffd.vtkFFDBuildDetailLattice()
+        detail.SetInputData(lattice)
+        detail.SetSecondDerivativeThreshold(1e-6)
+        self.expect_recorded(detail, ["NumberOfRefinedVoxels"])
+        manipulate = vtkffd.vtkFFDDirectManipulation()
+        manipulate.SetInputData(build.GetOutput())
+        manipulate.SetMeshData(bear)
+        manipulate.SetTargetPointIds(numpy_to_vtkIdTypeArray(np.array([0, 100], dtype=np.int64), deep=True))
+        targets = vtkPoints()
+        targets.SetData(numpy_to_vtk(points_of(bear)[[0, 100]] + 0.01, deep=True))
+        manipulate.SetTargetPositions(targets)
+        self.expect_recorded(manipulate, ["NumberOfMovedControlPoints", "MaximumTargetDistance"])
+        simulate = vtkffd.vtkFFDSimulateLattice()
+        simulate.SetInputData(build.GetOutput())
+        dynamics = simulate.GetDynamics()
+        dynamics.SetGravity(0.0, -9.81, 0.0)
+        simulate.UpdateTimeStep(0.1)
+        field_data = simulate.GetOutputDataObject(0).GetFieldData()
+        for name in ("Time", "NumberOfSimulatedPoints", "NumberOfSprings", "KineticEnergy", "PotentialEnergy"):
+            self.assertEqual(field_data.GetAbstractArray(name).GetValue(0), getattr(dynamics, "Get" + name)(), name)
+        self.assertGreater(field_data.GetAbstractArray("KineticEnergy").GetValue(0), 0.0)  # falling
 
 
 class TestDataContract(unittest.TestCase):
