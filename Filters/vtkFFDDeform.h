@@ -37,6 +37,9 @@
  * GetLastBackendUsed() tells which ran. On the device the points, normals and binding stay resident across
  * updates; an update uploads only the lattice and downloads the deformed points into the output array.
  * Progress is reported between chunks of points on the CPU, and the filter stops early when aborted.
+ * The output announces the times of both inputs (the union of their ranges; of their time steps where both have
+ * steps), so that a lattice that varies in time, such as vtkFFDSimulateLattice's, re-executes the deformation at
+ * each time.
  *
  * Tetrahedral lattices (paper section III.E): input 1 may instead be a vtkUnstructuredGrid of tetrahedra with a
  * `RestPosition` point array and no `FFDFrame` (from vtkFFDBuildTetrahedralLattice, or built by the user). Each

@@ -226,9 +226,9 @@ std::string ReadLattice(
   {
     return "The lattice has no valid FFDFrame field array (12 finite doubles)." + ContractFix;
   }
-  if (ffd::CheckFrame(view.Frame) != ffd::FrameStatus::Valid)
+  if (const ffd::FrameStatus status = ffd::CheckFrame(view.Frame); status != ffd::FrameStatus::Valid)
   {
-    return "The lattice's FFDFrame has no volume: its edge vectors S, T, U are (nearly) linearly dependent.";
+    return std::string("The lattice's FFDFrame ") + ffd::DescribeFrameStatus(status) + ".";
   }
   if (!vtkFFDDataContract::GetDivisions(lattice, view.Divisions))
   {

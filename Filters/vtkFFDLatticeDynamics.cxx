@@ -125,6 +125,12 @@ void CheckSphere(vtkFFDMagneticSphere* sphere, std::size_t index, std::vector<st
   problems.push_back(OutOfRange(of + "SetRange", sphere->GetRange(), "its range", 0, false));
   problems.push_back(OutOfRange(of + "SetPeriod", sphere->GetPeriod(), "its period", 0, true));
   vtkPoints* path = sphere->GetPath();
+  if (path && path->GetNumberOfPoints() < 2)
+  {
+    problems.push_back(of + "its path (SetPath()) has " + std::to_string(path->GetNumberOfPoints()) +
+      " point(s): a path needs at least 2, or none (SetPath(nullptr)) for a sphere that stays at its centre.");
+    return;
+  }
   for (vtkIdType p = 0; path && p < path->GetNumberOfPoints(); ++p)
   {
     const double* x = path->GetPoint(p);

@@ -494,7 +494,7 @@ TEST(vtkFFDDeform, BadLatticesAreRefusedWithAClearError)
   const int zero[3] = { 0, 2, 2 };
   const std::vector<Case> cases = {
     { "no frame", [](vtkStructuredGrid* l) { l->GetFieldData()->RemoveArray("FFDFrame"); }, "FFDFrame" },
-    { "flat frame", [&](vtkStructuredGrid* l) { vtkFFDDataContract::SetFrame(l, flat); }, "no volume" },
+    { "flat frame", [&](vtkStructuredGrid* l) { vtkFFDDataContract::SetFrame(l, flat); }, "(nearly) zero volume" },
     { "non-finite frame", [&](vtkStructuredGrid* l) { vtkFFDDataContract::SetFrame(l, nonFinite); }, "FFDFrame" },
     { "no divisions", [](vtkStructuredGrid* l) { l->GetFieldData()->RemoveArray("FFDDivisions"); }, "FFDDivisions" },
     { "zero divisions", [&](vtkStructuredGrid* l) { vtkFFDDataContract::SetDivisions(l, zero); }, "FFDDivisions" },
