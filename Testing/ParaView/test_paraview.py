@@ -242,6 +242,52 @@ class Mpi(ParaViewTestCase):
         self.assertIn(f"bear: {mesh.GetNumberOfPoints()} vertices, 60 control points (3x4x5)", output)
 
 
+class Transform(ParaViewTestCase):
+    """ParaView's Transform on a lattice (issue 30, item 3). With TransformAllInputVectors on (the GUI's default)
+    it rotated a sparse lattice's VoxelIndex as a vector, and a dense lattice's RestPosition, which then deformed
+    nothing: FFDDeform now says what the transform did. With it off, the lattice's points alone turn, and the bear
+    turns with them: rotating every control point about the origin rotates every point inside, since the weights
+    sum to 1. The bear is float32: its points agree to float32 rounding, 1e-6 of its size."""
+
+    SCRIPT = """
+import json
+from paraview import servermanager
+from paraview.simple import *
+LoadPlugin({plugin!r}, ns=globals())
+mesh = XMLPolyDataReader(FileName=[{mesh!r}])
+report = dict()
+for form in ("Dense", "Sparse"):
+    lattice = FFDBuildLattice(Input=FFDVoxelize(Input=mesh, Divisions=[4, 4, 4]), LatticeForm=form,
+                              Basis="Cubic B-Spline")
+    for vectors in (1, 0):
+        moved = Transform(Input=lattice, TransformAllInputVectors=vectors)
+        moved.Transform.Rotate = [0, 0, 30]
+        deformed = FFDDeform(Input=mesh, Lattice=moved)
+        deformed.UpdatePipeline()
+        output = servermanager.Fetch(deformed)
+        report[form + str(vectors)] = [list(output.GetPoint(i)) for i in range(output.GetNumberOfPoints())]
+open({report!r}, "w").write(json.dumps(report))
+"""
+
+    def test_transformed_lattices_turn_the_mesh_or_say_why_not(self):
+        with tempfile.TemporaryDirectory() as folder:
+            report = Path(folder) / "report.json"
+            script = Path(folder) / "script.py"
+            script.write_text(self.SCRIPT.format(plugin=PLUGIN, mesh=str(MESH), report=str(report)))
+            output = run([PVBATCH, "--dr", script], expected_errors=("no longer match its FFDFrame",))
+            result = json.loads(report.read_text())
+        self.assertEqual(output.count("no longer match its FFDFrame"), 2, output)  # dense and sparse, vectors on
+        bear = points(read(MESH))
+        angle = np.radians(30.0)
+        rotation = np.array([[np.cos(angle), -np.sin(angle), 0], [np.sin(angle), np.cos(angle), 0], [0, 0, 1]])
+        expected = bear @ rotation.T
+        size = np.ptp(bear, axis=0).max()
+        for form in ("Dense", "Sparse"):
+            with self.subTest(form=form):
+                self.assertEqual(result[form + "1"], [])  # an error and an empty output
+                self.assertLess(np.abs(np.array(result[form + "0"]) - expected).max(), 1e-6 * size)
+
+
 class Dynamics(ParaViewTestCase):
     """pvbatch plays simulation_pipeline.py: FFDDeform under FFD Simulate Lattice follows the simulation in time."""
 
