@@ -16,7 +16,11 @@
  * program checks that it was not recomputed). That is the evaluation as a user sees it: reading the lattice,
  * allocating the output points and X + sum B_i B_j B_k D_ijk at every point. Normals and the Jacobian are off.
  *
- * Usage: BenchmarkFFDDeform [--quick] [--section global|bases|all] [--mesh path.vtp]
+ * A third section, inverse, times the inverse map: vtkFFDInverseDeform against VTK's
+ * vtkBSplineTransform::GetInverse() in a vtkTransformFilter, on the ~0.5 M-point mesh deformed by a moved
+ * CUBIC_BSPLINE lattice of 7^3 voxels, with each one's largest error.
+ *
+ * Usage: BenchmarkFFDDeform [--quick] [--section global|bases|inverse|all] [--mesh path.vtp]
  *   --quick    small meshes and short runs, a smoke check of the program (seconds)
  *   --section  run one section only (default: all)
  *   --mesh     the mesh to subdivide (VTK XML PolyData); default: the armadillo of the test data
@@ -25,6 +29,7 @@
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDDeform.h"
+#include "vtkFFDInverseDeform.h"
 #include "vtkFFDVoxelize.h"
 
 #include "vtkBSplineTransform.h"
@@ -40,6 +45,7 @@
 #include "vtkStructuredGrid.h"
 #include "vtkTransformFilter.h"
 #include "vtkTriangleFilter.h"
+#include "vtkWarpTransform.h"
 #include "vtkXMLPolyDataReader.h"
 
 #include <immintrin.h>
@@ -635,6 +641,9 @@ double MaxDistance(vtkPointSet* a, vtkPointSet* b)
   return largest;
 }
 
+/// The divisions of the CUBIC_BSPLINE lattice compared with VTK's vtkBSplineTransform (bases and inverse sections).
+constexpr int VtkDivisions = 7;
+
 /// One lattice set-up of the bases table.
 struct BasisCase
 {
@@ -658,7 +667,7 @@ struct VtkRow
  * section, its points per second turned into bytes per second (BytesPerPoint) and compared with the copy
  * bandwidth of the same thread count, the two measured side by side (MeasureSideBySide(): the load of a shared
  * machine drifts within a run, and a copy measured once at the start swung from 39 to 64 GB/s between runs
- * minutes apart). For CUBIC_BSPLINE over `vtkDivisions`, VTK's vtkBSplineTransform + vtkTransformFilter on the
+ * minutes apart). For CUBIC_BSPLINE over `VtkDivisions`, VTK's vtkBSplineTransform + vtkTransformFilter on the
  * same mesh and lattice, timed as in the global section. Returns false when a pipeline failed.
  */
 bool RunBasesSection(
@@ -669,11 +678,10 @@ bool RunBasesSection(
 
   // Every basis over 4 x 4 x 4 voxels (the global one's cost grows with its degree, so it stays at 4), and the
   // local ones again over lattices of about 10^3 control points: their cost per point should not change.
-  const int vtkDivisions = 7;
   const std::vector<BasisCase> cases = { { vtkFFDBuildLattice::BERNSTEIN, 4 }, { vtkFFDBuildLattice::TRILINEAR, 4 },
     { vtkFFDBuildLattice::TRILINEAR, 9 }, { vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, 4 },
     { vtkFFDBuildLattice::TRICUBIC_BEZIER, 4 }, { vtkFFDBuildLattice::TRICUBIC_BEZIER, 3 },
-    { vtkFFDBuildLattice::CUBIC_BSPLINE, 4 }, { vtkFFDBuildLattice::CUBIC_BSPLINE, vtkDivisions } };
+    { vtkFFDBuildLattice::CUBIC_BSPLINE, 4 }, { vtkFFDBuildLattice::CUBIC_BSPLINE, VtkDivisions } };
   const int minRepeats = quick ? 2 : 3;
   const double minSeconds = quick ? 0.0 : 0.5;
   const int rounds = quick ? 1 : 5; // of MeasureSideBySide()
@@ -709,7 +717,7 @@ bool RunBasesSection(
           continue;
         }
         VtkBSpline vtk;
-        const bool compare = c.Basis == vtkFFDBuildLattice::CUBIC_BSPLINE && c.Divisions == vtkDivisions;
+        const bool compare = c.Basis == vtkFFDBuildLattice::CUBIC_BSPLINE && c.Divisions == VtkDivisions;
         if (compare && !vtk.SetUp(input, lattice, c.Divisions))
         {
           std::fprintf(stderr, "The frame is not axis-aligned: VTK's B-spline grid cannot follow it\n");
@@ -758,7 +766,7 @@ bool RunBasesSection(
               "(%d^3 control points), the same mesh and lattice\n(coefficients = the lattice's displacements, "
               "origin = rest position of control point (0, 0, 0), spacing = frame edge / %d, border mode Edge).\n"
               "difference: largest distance between the two outputs / the mesh's bounding-box diagonal.\n\n",
-    vtkDivisions, vtkDivisions + 3, vtkDivisions);
+    VtkDivisions, VtkDivisions + 3, VtkDivisions);
   std::printf("| points    | type    | th | VTK best (s) | VTK median | VTK Mpoints/s | ours best (s) | "
               "ours Mpoints/s | speed-up | difference |\n");
   std::printf("|----------:|---------|---:|-------------:|-----------:|--------------:|--------------:|"
@@ -770,6 +778,115 @@ bool RunBasesSection(
       r.Ours.Best, r.Points / r.Ours.Best * 1e-6, r.Vtk.Best / r.Ours.Best, r.RelativeDifference);
   }
   return ok && vtkRows.size() == 2 * 2 * threadCounts.size();
+}
+//------------------------------------------------------------------------------------------------------------
+// The inverse section.
+
+/// The diagonal |S + T + U| of a lattice's frame: what vtkFFDInverseDeform's Tolerance is relative to.
+double FrameDiagonal(vtkDataObject* lattice)
+{
+  double f[12];
+  if (!vtkFFDDataContract::GetFrame(lattice, f))
+  {
+    return 0.0;
+  }
+  return std::sqrt((f[3] + f[6] + f[9]) * (f[3] + f[6] + f[9]) + (f[4] + f[7] + f[10]) * (f[4] + f[7] + f[10]) +
+    (f[5] + f[8] + f[11]) * (f[5] + f[8] + f[11]));
+}
+
+/// One row of the inverse table: how a rest position was found from the deformed mesh, its time and errors.
+struct InverseRow
+{
+  const char* Name;
+  Timing Time;
+  double RestError;     // largest |x - x*| / d: x found, x* the mesh's own rest point, d the frame's diagonal
+  double ResidualError; // largest |F(x) - y| / d: F evaluated by vtkFFDDeform, y the deformed point
+};
+
+/// Times Update() of `filter`, whose output are rest positions, `repeats` times (Modified() before each); its
+/// errors from the last output, against the rest mesh and, mapped by `forward` again, against the deformed mesh.
+InverseRow TimeInverse(const char* name, vtkAlgorithm* filter, int repeats, vtkPolyData* rest, vtkPolyData* deformed,
+  vtkFFDDeform* forward, double diagonal)
+{
+  const auto update = [filter]()
+  {
+    filter->Modified();
+    const Clock::time_point begin = Clock::now();
+    filter->Update();
+    return Seconds(begin);
+  };
+  InverseRow row{ name, Repeat(update, repeats, 0.0), 0.0, 0.0 };
+  vtkPointSet* found = vtkPointSet::SafeDownCast(filter->GetOutputDataObject(0));
+  row.RestError = MaxDistance(found, rest) / diagonal;
+  vtkNew<vtkPolyData> copy;
+  copy->ShallowCopy(found);
+  forward->SetInputData(copy);
+  forward->Update();
+  row.ResidualError = MaxDistance(forward->GetOutput(), deformed) / diagonal;
+  return row;
+}
+
+/**
+ * vtkFFDInverseDeform against VTK's vtkBSplineTransform::GetInverse() in a vtkTransformFilter (the same
+ * coefficients as in the bases section), at VTK's default InverseTolerance (0.001, in world units) and at
+ * 1e-12 of the frame's diagonal (as vtkFFDInverseDeform's default Tolerance), in one run: the mesh (float64)
+ * is deformed once by CUBIC_BSPLINE over VtkDivisions^3 voxels, its control points moved as in the other sections;
+ * each inverse maps it back. Median and best of `repeats` updates on all threads. Returns false on failure.
+ */
+bool RunInverseSection(vtkPolyData* mesh, bool quick)
+{
+  vtkSmartPointer<vtkPolyData> rest = WithPrecision(mesh, true);
+  BenchmarkLattice lattice;
+  BuildLattice(rest, vtkFFDBuildLattice::CUBIC_BSPLINE, VtkDivisions, lattice);
+  std::mt19937 rng(8);
+  MoveLattice(lattice.Grid, lattice.Rest, rng);
+  const double diagonal = FrameDiagonal(lattice.Grid);
+  vtkNew<vtkFFDDeform> forward;
+  forward->SetInputData(rest);
+  forward->SetLatticeData(lattice.Grid);
+  forward->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
+  forward->Update();
+  vtkNew<vtkPolyData> deformed;
+  deformed->DeepCopy(forward->GetOutput());
+  VtkBSpline vtk;
+  if (deformed->GetNumberOfPoints() != rest->GetNumberOfPoints() || !vtk.SetUp(deformed, lattice, VtkDivisions))
+  {
+    std::fprintf(stderr, "The inverse section could not deform the mesh, or its frame is not axis-aligned\n");
+    return false;
+  }
+  vtk.Filter->SetTransform(vtk.Transform->GetInverse());
+  vtk.Filter->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
+  vtkNew<vtkFFDInverseDeform> ours;
+  ours->SetInputData(deformed);
+  ours->SetLatticeData(lattice.Grid);
+  const int repeats = quick ? 1 : 5;
+  std::vector<InverseRow> rows;
+  rows.push_back(TimeInverse("vtkFFDInverseDeform, Tolerance 1e-12", ours, repeats, rest, deformed, forward, diagonal));
+  const vtkIdType unreliable = ours->GetNumberOfFoldedPoints() + ours->GetNumberOfUnconvergedPoints();
+  rows.push_back(
+    TimeInverse("VTK GetInverse(), InverseTolerance 0.001", vtk.Filter, repeats, rest, deformed, forward, diagonal));
+  vtkWarpTransform::SafeDownCast(vtk.Transform->GetInverse())->SetInverseTolerance(1e-12 * diagonal);
+  rows.push_back(
+    TimeInverse("VTK GetInverse(), InverseTolerance 1e-12 d", vtk.Filter, repeats, rest, deformed, forward, diagonal));
+
+  std::printf("\nInverse: the mesh (%lld points, float64) deformed by CUBIC_BSPLINE over %d^3 voxels (%d^3 control "
+              "points, moved as above), mapped back to its rest positions; %d threads;\nmedian and best of %d "
+              "updates; d: the frame's diagonal (%.4g); x - x*: to the mesh's own points; F(x) - y: x mapped "
+              "forward again by vtkFFDDeform; vs ours: the median's ratio to vtkFFDInverseDeform's.\n"
+              "vtkFFDInverseDeform: %lld points folded or not converged.\n\n",
+    static_cast<long long>(rest->GetNumberOfPoints()), VtkDivisions, VtkDivisions + 3,
+    vtkSMPTools::GetEstimatedNumberOfThreads(), repeats, diagonal, static_cast<long long>(unreliable));
+  std::printf("| inverse                                   | median (s) | best (s) | max |x - x*| / d | "
+              "max |F(x) - y| / d | vs ours |\n");
+  std::printf("|-------------------------------------------|-----------:|---------:|----------------:|"
+              "------------------:|--------:|\n");
+  for (const InverseRow& r : rows)
+  {
+    std::printf("| %-41s | %10.4f | %8.4f | %15.1e | %18.1e | %6.1fx |\n", r.Name, r.Time.Median, r.Time.Best,
+      r.RestError, r.ResidualError, r.Time.Median / rows[0].Time.Median);
+  }
+  std::fflush(stdout);
+  return unreliable == 0;
 }
 } // namespace
 
@@ -791,13 +908,13 @@ int main(int argc, char* argv[])
     }
     else if (arg == "--section" && a + 1 < argc &&
       (std::string(argv[a + 1]) == "global" || std::string(argv[a + 1]) == "bases" ||
-        std::string(argv[a + 1]) == "all"))
+        std::string(argv[a + 1]) == "inverse" || std::string(argv[a + 1]) == "all"))
     {
       section = argv[++a];
     }
     else
     {
-      std::fprintf(stderr, "usage: %s [--quick] [--section global|bases|all] [--mesh path.vtp]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--quick] [--section global|bases|inverse|all] [--mesh path.vtp]\n", argv[0]);
       return arg == "--help" || arg == "-h" ? 0 : 1;
     }
   }
@@ -834,20 +951,25 @@ int main(int argc, char* argv[])
   std::vector<vtkSmartPointer<vtkPolyData>> meshes;
   const Clock::time_point subdivideBegin = Clock::now();
   meshes.push_back(Subdivide(base, levels[0]));
-  meshes.push_back(Subdivide(meshes[0], levels[1] - levels[0]));
+  // The inverse section alone needs the smaller only.
+  meshes.push_back(section == "inverse" ? meshes[0] : Subdivide(meshes[0], levels[1] - levels[0]));
   std::printf("\nMesh %s: %lld points; subdivided %d and %d times: %lld and %lld points (%.1f s)\n", meshPath.c_str(),
     static_cast<long long>(base->GetNumberOfPoints()), levels[0], levels[1],
     static_cast<long long>(meshes[0]->GetNumberOfPoints()), static_cast<long long>(meshes[1]->GetNumberOfPoints()),
     Seconds(subdivideBegin));
 
   bool ok = true;
-  if (section != "bases")
+  if (section == "global" || section == "all")
   {
     ok = RunGlobalSection(meshes, threadCounts, quick) && ok;
   }
-  if (section != "global")
+  if (section == "bases" || section == "all")
   {
     ok = RunBasesSection(meshes, threadCounts, quick) && ok;
+  }
+  if (section == "inverse" || section == "all")
+  {
+    ok = RunInverseSection(meshes[0], quick) && ok;
   }
   vtkSMPTools::Initialize(0);
   return ok ? 0 : 1;
