@@ -271,17 +271,20 @@ std::string ReadLattice(
 // Binding: the cell of every point (ffd::BindToGrid), -1 for points that keep their position.
 struct BindSettings
 {
-  ffd::Frame<double> Frame;
+  const ffd::Frame<double>& Frame;
   ffd::GridBasis Basis;
   int Voxels[3];
   bool ClampOutside;
   const vtkFFDSparseCells* SparseCells; // null for a dense lattice
 };
 
-BindSettings SettingsOf(const vtkFFDGridLattice& lattice, const vtkFFDSparseCells* sparse, bool clampOutside)
+// `frame` is the lattice's with its dual basis (ffd::Frame::FromArray()), made once per lattice: building it is most
+// of the cost of binding one point.
+BindSettings SettingsOf(
+  const ffd::Frame<double>& frame, const vtkFFDGridLattice& lattice, const vtkFFDSparseCells* sparse, bool clampOutside)
 {
-  return { ffd::Frame<double>::FromArray(lattice.Frame), lattice.Basis,
-    { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] }, clampOutside, sparse };
+  return { frame, lattice.Basis, { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] }, clampOutside,
+    sparse };
 }
 
 int BindOne(const BindSettings& s, const ffd::Vec3<double>& p)
@@ -574,7 +577,12 @@ vtkFFDGridDeformer::~vtkFFDGridDeformer() = default;
 //------------------------------------------------------------------------------------------------------------
 std::string vtkFFDGridDeformer::SetLattice(vtkPointSet* lattice)
 {
-  return ReadLattice(lattice, this->Lattice, this->SparseCells, this->RestChecked);
+  std::string problem = ReadLattice(lattice, this->Lattice, this->SparseCells, this->RestChecked);
+  if (problem.empty())
+  {
+    this->BindFrame = ffd::Frame<double>::FromArray(this->Lattice.Frame);
+  }
+  return problem;
 }
 
 //------------------------------------------------------------------------------------------------------------
@@ -588,7 +596,8 @@ vtkFFDBindingKey vtkFFDGridDeformer::KeyOf(vtkPoints* points, int outsidePolicy)
 //------------------------------------------------------------------------------------------------------------
 int vtkFFDGridDeformer::BindPoint(const double x[3], int outsidePolicy) const
 {
-  return BindOne(SettingsOf(this->Lattice, this->GetSparseCells(), outsidePolicy == vtkFFDDeform::CLAMP_TO_EDGE),
+  return BindOne(
+    SettingsOf(this->BindFrame, this->Lattice, this->GetSparseCells(), outsidePolicy == vtkFFDDeform::CLAMP_TO_EDGE),
     ffd::Vec3<double>::From(x));
 }
 
@@ -608,7 +617,7 @@ bool vtkFFDGridDeformer::Bind(
   const vtkIdType n = points->GetNumberOfPoints();
   binding.CellOfPoint.resize(n);
   const vtkFFDSparseCells* sparse = this->GetSparseCells();
-  const BindSettings settings = SettingsOf(lattice, sparse, key.ClampsOutside());
+  const BindSettings settings = SettingsOf(this->BindFrame, lattice, sparse, key.ClampsOutside());
   bool completed = false;
   BindWorker bind;
   if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(

@@ -105,7 +105,8 @@ public:
 private:
   vtkFFDGridLattice Lattice;
   vtkFFDSparseCells SparseCells;
-  vtkFFDRestCheck RestChecked; // the rest positions are checked again only when they or the frame change
+  vtkFFDRestCheck RestChecked;    // the rest positions are checked again only when they or the frame change
+  ffd::Frame<double> BindFrame{}; // the frame with its dual basis, made by SetLattice() for every BindPoint()
   std::unique_ptr<vtkFFDGridBinding> Binding;
   vtkFFDBindingKey Bound; // what Binding is for
 };

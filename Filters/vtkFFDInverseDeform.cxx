@@ -23,13 +23,17 @@
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
+#include "vtkSMPTools.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
 
+#include "FFDGridLanes.h"
 #include "FFDInverse.h"
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <vector>
 
 vtkStandardNewMacro(vtkFFDInverseDeform);
 
@@ -94,66 +98,435 @@ int SearchCell(const vtkFFDGridDeformer& deformer, const ffd::Frame<double>& fra
   return found;
 }
 
-// Grid lattices: ffd::InvertPoint on the lattice's float64 evaluation. A normal m at y goes back by the inverse's
-// cofactor, det(J^-1) J^T: as J^T m, renormalised.
+// What the steps of a grid lattice's inversion share. A normal m at y goes back by the inverse's cofactor,
+// det(J^-1) J^T: as J^T m, renormalised.
+struct GridInversion
+{
+  const vtkFFDGridDeformer& Deformer;
+  ffd::Frame<double> Frame;
+  double Tolerance; // the largest |F(x) - y| accepted, in world units
+  // A residual from which one Newton step reaches Tolerance: the residual squares at each step, times about
+  // |J^-1| |F''| d ~ 1 (d the frame's diagonal): sqrt(Tolerance d).
+  double ChordResidual;
+  int MaxIterations;
+  vtkPoints* Points;
+  const double* Coordinates; // the points' doubles where they are stored so, else null
+  vtkDataArray* Normals;
+  const InverseOutput& Out;
+
+  void PointOf(vtkIdType p, double y[3]) const
+  {
+    if (this->Coordinates)
+    {
+      std::copy_n(this->Coordinates + 3 * p, 3, y);
+      return;
+    }
+    this->Points->GetPoint(p, y);
+  }
+
+  // The cell of x, as BindPoint() gives it under `clamp` (CLAMP_TO_EDGE, else KEEP_POSITION); a dense lattice's
+  // inline (ffd::BindToGrid(), as BindPoint() binds), which saves a fifth of the inversion's time.
+  int BindTo(const ffd::Vec3<double>& x, bool clamp) const
+  {
+    if (this->Deformer.GetSparseCells())
+    {
+      const double p[3] = { x.x, x.y, x.z };
+      return this->Deformer.BindPoint(p, clamp ? vtkFFDDeform::CLAMP_TO_EDGE : vtkFFDDeform::KEEP_POSITION);
+    }
+    const vtkFFDGridLattice& lattice = this->Deformer.GetLattice();
+    return ffd::BindToGrid(this->Frame, lattice.Basis, lattice.Divisions, x, clamp);
+  }
+
+  // The cell that extends F to x for the search (SearchCell()).
+  int Bind(const ffd::Vec3<double>& x) const
+  {
+    return this->Deformer.GetSparseCells() ? SearchCell(this->Deformer, this->Frame, x) : this->BindTo(x, true);
+  }
+
+  // Writes point p's rest position x, found for y = F(x), with J there. Outside the lattice's cells F is the
+  // identity: y is its own rest position there (so are non-finite points, which no cell binds), and has none
+  // inside.
+  void Finish(
+    vtkIdType p, const double y[3], ffd::Vec3<double> x, ffd::Mat3<double> jacobian, InverseStatus status) const
+  {
+    if (this->BindTo(x, false) < 0)
+    {
+      const bool outside = this->BindTo(ffd::Vec3<double>::From(y), false) < 0;
+      x = ffd::Vec3<double>::From(y);
+      jacobian = ffd::Mat3<double>::Identity();
+      status = outside ? InverseStatus::Converged : InverseStatus::NotConverged;
+    }
+    std::copy_n(&x.x, 3, this->Out.Points + 3 * p);
+    this->Out.Status[p] = static_cast<unsigned char>(status);
+    if (!this->Out.Normals)
+    {
+      return;
+    }
+    double m[3];
+    this->Normals->GetTuple(p, m);
+    double n[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      n[a] = jacobian.M[0][a] * m[0] + jacobian.M[1][a] * m[1] + jacobian.M[2][a] * m[2];
+    }
+    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (int a = 0; a < 3; ++a)
+    {
+      this->Out.Normals[3 * p + a] = length > 0 ? n[a] / length : m[a];
+    }
+  }
+
+  // Point p alone: ffd::InvertPoint, with its line search and its report of folds.
+  template <typename Deformation>
+  void InvertOne(const Deformation& deformation, vtkIdType p) const
+  {
+    double y[3];
+    this->PointOf(p, y);
+    ffd::Vec3<double> x = ffd::Vec3<double>::From(y);
+    ffd::Mat3<double> jacobian = ffd::Mat3<double>::Identity();
+    InverseStatus status = InverseStatus::Converged;
+    if (std::isfinite(y[0]) && std::isfinite(y[1]) && std::isfinite(y[2])) // else kept, as F keeps them
+    {
+      const auto bind = [this](const ffd::Vec3<double>& at) { return this->Bind(at); };
+      status = ffd::InvertPoint(
+        deformation, bind, ffd::Vec3<double>::From(y), this->Tolerance, this->MaxIterations, x, jacobian);
+    }
+    this->Finish(p, y, x, jacobian, status);
+  }
+};
+
+// The points in the order of the cells that bind them, so that most lane groups (InvertInGroups()) lie in one
+// cell: a point's rest position lies near it. A mesh's vertices may come in any spatial order.
+// `cells` are theirs (GridInversion::Bind()).
+std::vector<vtkIdType> OrderByCell(const GridInversion& inversion, vtkIdType n, std::vector<int>& cells)
+{
+  cells.resize(n);
+  vtkSMPTools::For(0, n, vtkFFDGrain(n, 4.0),
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType p = begin; p < end; ++p)
+      {
+        double y[3];
+        inversion.PointOf(p, y);
+        cells[p] = inversion.Bind(ffd::Vec3<double>::From(y));
+      }
+    });
+  // A counting sort, cell -1 first.
+  std::vector<vtkIdType> first(std::size_t(*std::max_element(cells.begin(), cells.end())) + 3, 0);
+  for (const int c : cells)
+  {
+    ++first[std::size_t(c) + 2];
+  }
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  std::vector<vtkIdType> order(n);
+  for (vtkIdType p = 0; p < n; ++p)
+  {
+    order[first[std::size_t(cells[p]) + 1]++] = p;
+  }
+  return order;
+}
+
+#if FFD_HAVE_LANES
+// Up to 8 points inverted together in SIMD lanes (NewtonInLanes()).
+struct LaneGroup
+{
+  static constexpr int MaxWidth = 8;
+  int Count = 0;                 // its points; the lanes past them repeat its last point
+  double Y[3 * MaxWidth];        // the deformed points, x y z each
+  int Cells[MaxWidth];           // their cells (GridInversion::Bind())
+  double X[3 * MaxWidth];        // the rest positions found
+  ffd::Mat3<double> J[MaxWidth]; // the Jacobian there
+  unsigned Converged = 0;        // the lanes whose rest position was found; the others are left to ffd::InvertPoint
+};
+
+// The cells of the lanes in `active` (GridInversion::Bind(), or `known` where not null); a lane without one
+// leaves `active`, which is returned. The other lanes take the first active lane's cell, so that they never add
+// a cell to evaluate.
+template <typename Lane>
+inline unsigned BindLanes(
+  const GridInversion& inversion, const ffd::Vec3<Lane>& x, const int* known, unsigned active, int* cells)
+{
+  for (int l = 0; l < Lane::Width; ++l)
+  {
+    if (active >> l & 1u)
+    {
+      cells[l] = known ? known[l] : inversion.Bind({ x.x.V[l], x.y.V[l], x.z.V[l] });
+      active &= cells[l] >= 0 ? ~0u : ~(1u << l);
+    }
+  }
+  if (active != 0)
+  {
+    const int first = cells[__builtin_ctz(active)];
+    for (int l = 0; l < Lane::Width; ++l)
+    {
+      cells[l] = active >> l & 1u ? cells[l] : first;
+    }
+  }
+  return active;
+}
+
+// F(x), and J where `jacobian` is not null, at lanes bound to `cells`: all in one cell read each control point
+// once for all lanes; lanes in several cells (a local basis) read each its own cell's (ffd::DeformInLaneCells(),
+// as the evaluation does).
+template <typename Deformation, typename Wide, typename Lane>
+inline ffd::Vec3<Lane> DeformLanes(const Deformation& deformation, const Wide& wide, const ffd::CellSplit& split,
+  const ffd::Vec3<Lane>& x, const int* cells, ffd::Mat3<Lane>* jacobian)
+{
+  // The cells and their lanes as an entry of ffd::BlockCells::List for one group: count, -, (cell, lane bits)...
+  int entry[2 + 2 * Lane::Width] = { 0 };
+  for (int l = 0; l < Lane::Width; ++l)
+  {
+    int k = 0;
+    while (k < entry[0] && entry[2 + 2 * k] != cells[l])
+    {
+      ++k;
+    }
+    entry[0] += k == entry[0];
+    entry[2 + 2 * k] = cells[l];
+    entry[3 + 2 * k] |= 1 << l;
+  }
+  if (entry[0] == 1)
+  {
+    return jacobian ? wide.Deform(x, cells[0], *jacobian) : wide.Deform(x, cells[0]);
+  }
+  const ffd::detail::GroupCells<Lane> group(deformation, split, entry, 0);
+  return jacobian ? ffd::DeformInLaneCells(wide, x, group, *jacobian) : ffd::DeformInLaneCells(wide, x, group);
+}
+
+// The search of a lane group: its iterate, the Jacobian of its last evaluation with one, the lanes still
+// searching and their last residuals.
+template <typename Lane>
+struct LaneSearch
+{
+  ffd::Vec3<Lane> X;
+  ffd::Mat3<Lane> Jacobian;
+  Lane Det;
+  unsigned Active;
+  double Previous[Lane::Width];
+};
+
+// Settles each searching lane after an evaluation of residual `error`: it leaves the search where det J <= 0,
+// where the residual did not fall, or where the steps ran out; it converged (into `group`) where the residual is
+// within the tolerance. Returns the largest residual of the lanes still searching.
+template <typename Lane>
+inline double SettleLanes(const GridInversion& inversion, LaneSearch<Lane>& search, const Lane& error, int step,
+  int iterations, LaneGroup& group)
+{
+  double largest = 0;
+  for (int l = 0; l < Lane::Width; ++l)
+  {
+    const unsigned lane = 1u << l;
+    if (!(search.Active & lane))
+    {
+      continue;
+    }
+    const bool found = error.V[l] <= inversion.Tolerance;
+    if (!(search.Det.V[l] > 0) || (step > 0 && !(error.V[l] < search.Previous[l])) || (!found && step >= iterations))
+    {
+      search.Active &= ~lane;
+    }
+    else if (found)
+    {
+      group.X[3 * l] = search.X.x.V[l];
+      group.X[3 * l + 1] = search.X.y.V[l];
+      group.X[3 * l + 2] = search.X.z.V[l];
+      for (int i = 0; i < 9; ++i)
+      {
+        group.J[l].M[i / 3][i % 3] = search.Jacobian.M[i / 3][i % 3].V[l];
+      }
+      group.Converged |= lane;
+      search.Active &= ~lane;
+    }
+    else
+    {
+      largest = std::max(largest, error.V[l]);
+    }
+    search.Previous[l] = error.V[l];
+  }
+  return largest;
+}
+
+/**
+ * ffd::InvertPoint's Newton iteration in W lanes, without its line search: from x = y, x -= J^-1 (F(x) - y),
+ * each iterate bound again (GridInversion::Bind()). A lane converges where |F(x) - y| <= tolerance with det J > 0,
+ * within `iterations` steps, the residual falling at every step. Any other lane (det J <= 0, a residual that
+ * does not fall, no cell, the steps run out) is left to ffd::InvertPoint, which starts over. Once every residual
+ * is within one Newton step of the tolerance (GridInversion::ChordResidual), the evaluations leave J out, the
+ * steps taking the last J (a chord step), unless the normals need J where x is found.
+ */
+template <int W, typename Deformation>
+inline void NewtonInLanes(
+  const GridInversion& inversion, const Deformation& deformation, int iterations, LaneGroup& group)
+{
+  using Lane = ffd::Lanes<double, W>;
+  const auto wide = deformation.template WithLanes<Lane>();
+  const ffd::CellSplit split = ffd::CellSplit::For(deformation.BasisOf(), deformation.Voxels);
+  ffd::Vec3<Lane> y;
+  Lane::Deinterleave3(group.Y, y.x, y.y, y.z);
+  LaneSearch<Lane> search{ y, ffd::Mat3<Lane>::Identity(), Lane(1.0), (1u << group.Count) - 1, {} };
+  bool withJacobian = true;
+  for (int step = 0;; ++step)
+  {
+    int cells[W];
+    search.Active = BindLanes(inversion, search.X, step == 0 ? group.Cells : nullptr, search.Active, cells);
+    if (search.Active == 0)
+    {
+      return;
+    }
+    const ffd::Vec3<Lane> r =
+      DeformLanes(deformation, wide, split, search.X, cells, withJacobian ? &search.Jacobian : nullptr) - y;
+    if (withJacobian)
+    {
+      search.Det = ffd::Determinant(search.Jacobian);
+    }
+    const double largest = SettleLanes(inversion, search, sqrt(ffd::Dot(r, r)), step, iterations, group);
+    withJacobian = inversion.Out.Normals || !(largest <= inversion.ChordResidual);
+    // J^-1 = Cofactor(J)^T / det J.
+    const ffd::Mat3<Lane> c = ffd::Cofactor(search.Jacobian);
+    const Lane scale = Lane(-1.0) / search.Det;
+    search.X = search.X +
+      scale *
+        ffd::Vec3<Lane>{ c.M[0][0] * r.x + c.M[1][0] * r.y + c.M[2][0] * r.z,
+          c.M[0][1] * r.x + c.M[1][1] * r.y + c.M[2][1] * r.z, c.M[0][2] * r.x + c.M[1][2] * r.y + c.M[2][2] * r.z };
+  }
+}
+
+// NewtonInLanes() compiled for each instruction set (as Filters/CPU/FFDGridLanes.h compiles its passes).
+#define FFD_INVERSE_VARIANT(Suffix, Target, W)                                                                         \
+  template <typename Deformation>                                                                                      \
+  Target void NewtonInLanes##Suffix(                                                                                   \
+    const GridInversion& inversion, const Deformation& deformation, int iterations, LaneGroup& group)                  \
+  {                                                                                                                    \
+    NewtonInLanes<W>(inversion, deformation, iterations, group);                                                       \
+  }
+FFD_INVERSE_VARIANT(AVX512, FFD_TARGET_AVX512, 8)
+FFD_INVERSE_VARIANT(AVX2, FFD_TARGET_AVX2, 4)
+FFD_INVERSE_VARIANT(SSE2, FFD_TARGET_SSE2, 2)
+#undef FFD_INVERSE_VARIANT
+#endif
+
+// The lanes of NewtonInLanes() at `level` (1: none, points go one at a time).
+int LaneWidth(ffd::SimdLevel level)
+{
+#if FFD_HAVE_LANES
+  switch (level)
+  {
+    case ffd::SimdLevel::AVX512:
+#if FFD_WIDEST_LANES >= 3
+      return 8;
+#endif
+      [[fallthrough]];
+    case ffd::SimdLevel::AVX2:
+#if FFD_WIDEST_LANES >= 2
+      return 4;
+#endif
+      [[fallthrough]];
+    case ffd::SimdLevel::SSE2:
+      return 2;
+    case ffd::SimdLevel::None:
+      break;
+  }
+#endif
+  (void)level;
+  return 1;
+}
+
+// The points order[begin, end) in groups of LaneWidth(level), each through NewtonInLanes() first, its lanes
+// that did not converge there through GridInversion::InvertOne(). A few Newton steps in lanes find nearly every
+// point of a smooth deformation; ffd::InvertPoint alone costs several times more per point.
+template <typename Deformation>
+void InvertInGroups(const GridInversion& inversion, const Deformation& deformation, ffd::SimdLevel level,
+  const vtkIdType* order, const int* cells, vtkIdType begin, vtkIdType end)
+{
+  const int width = LaneWidth(level);
+#if FFD_HAVE_LANES
+  constexpr int LaneSteps = 8; // beyond, ffd::InvertPoint's line search does better
+  const int iterations = std::min(inversion.MaxIterations, LaneSteps);
+  for (vtkIdType i = begin; width > 1 && i < end; i += width)
+  {
+    LaneGroup group;
+    group.Count = int(std::min<vtkIdType>(width, end - i));
+    for (int l = 0; l < width; ++l)
+    {
+      const vtkIdType p = order[i + std::min(l, group.Count - 1)];
+      inversion.PointOf(p, group.Y + 3 * l);
+      group.Cells[l] = cells[p];
+    }
+    switch (width)
+    {
+      case 8:
+        NewtonInLanesAVX512(inversion, deformation, iterations, group);
+        break;
+      case 4:
+        NewtonInLanesAVX2(inversion, deformation, iterations, group);
+        break;
+      default:
+        NewtonInLanesSSE2(inversion, deformation, iterations, group);
+    }
+    for (int l = 0; l < group.Count; ++l)
+    {
+      if (group.Converged >> l & 1u)
+      {
+        inversion.Finish(order[i + l], group.Y + 3 * l, ffd::Vec3<double>::From(group.X + 3 * l), group.J[l],
+          InverseStatus::Converged);
+      }
+      else
+      {
+        inversion.InvertOne(deformation, order[i + l]);
+      }
+    }
+  }
+#endif
+  for (vtkIdType i = begin; width == 1 && i < end; ++i)
+  {
+    inversion.InvertOne(deformation, order[i]);
+  }
+}
+
+// Calls f with the float64 deformation of vtkFFDWithGridDeformation() with its basis known at compile time
+// (ffd::WithStaticBasis()): its fixed-size sums unrolled, as vtkFFDDeform's evaluation has them.
+template <int MaxCount, typename F>
+void WithStaticBasisOf(const ffd::GridDeformation<MaxCount, double>& d, F&& f)
+{
+  ffd::WithStaticBasis(d.Basis,
+    [&](auto maxCount, auto basis)
+    {
+      if constexpr (decltype(maxCount)::value == MaxCount)
+      {
+        f(ffd::GridDeformation<MaxCount, double, decltype(basis)::value>{ d.Basis,
+          { d.Voxels[0], d.Voxels[1], d.Voxels[2] }, { d.Dims[0], d.Dims[1], d.Dims[2] }, d.Displacements, d.Frame,
+          nullptr, d.CellVoxels, d.CellSupports });
+      }
+    });
+}
+
+// Grid lattices: Newton's method on the lattice's float64 evaluation, in SIMD lanes over points ordered by cell
+// (InvertInGroups()).
 bool InvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, vtkPoints* points, vtkDataArray* normals,
   double tolerance, int maxIterations, const InverseOutput& out)
 {
   const double* f = deformer.GetLattice().Frame;
   const double diagonal = std::hypot(f[3] + f[6] + f[9], f[4] + f[7] + f[10], f[5] + f[8] + f[11]);
-  const double absolute = tolerance * diagonal;
+  vtkDoubleArray* doubles = vtkDoubleArray::FastDownCast(points->GetData());
+  const GridInversion inversion{ deformer, ffd::Frame<double>::FromArray(f), tolerance * diagonal,
+    std::sqrt(tolerance) * diagonal, maxIterations, points,
+    doubles && doubles->GetNumberOfComponents() == 3 ? doubles->GetPointer(0) : nullptr, normals, out };
+  const vtkIdType n = points->GetNumberOfPoints();
+  std::vector<int> cells;
+  const std::vector<vtkIdType> order = OrderByCell(inversion, n, cells);
+  const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
   bool completed = false;
   vtkFFDWithGridDeformation(deformer,
-    [&](const auto& deformation)
+    [&](const auto& dynamic)
     {
-      const ffd::Frame<double> frame = ffd::Frame<double>::FromArray(deformer.GetLattice().Frame);
-      const auto bind = [&](const ffd::Vec3<double>& x) { return SearchCell(deformer, frame, x); };
-      auto invert = [&](vtkIdType begin, vtkIdType end)
-      {
-        for (vtkIdType p = begin; p < end; ++p)
+      WithStaticBasisOf(dynamic,
+        [&](const auto& deformation)
         {
-          double y[3];
-          points->GetPoint(p, y);
-          ffd::Vec3<double> x = ffd::Vec3<double>::From(y);
-          ffd::Mat3<double> jacobian = ffd::Mat3<double>::Identity();
-          InverseStatus status = InverseStatus::Converged;
-          if (std::isfinite(y[0]) && std::isfinite(y[1]) && std::isfinite(y[2])) // else kept, as F keeps them
-          {
-            status =
-              ffd::InvertPoint(deformation, bind, ffd::Vec3<double>::From(y), absolute, maxIterations, x, jacobian);
-            const double found[3] = { x.x, x.y, x.z };
-            if (deformer.BindPoint(found, vtkFFDDeform::KEEP_POSITION) < 0)
-            {
-              // Outside the lattice's cells F is the identity: y is its own rest position there, and has none
-              // inside.
-              const bool outside = deformer.BindPoint(y, vtkFFDDeform::KEEP_POSITION) < 0;
-              x = ffd::Vec3<double>::From(y);
-              jacobian = ffd::Mat3<double>::Identity();
-              status = outside ? InverseStatus::Converged : InverseStatus::NotConverged;
-            }
-          }
-          std::copy_n(&x.x, 3, out.Points + 3 * p);
-          out.Status[p] = static_cast<unsigned char>(status);
-          if (out.Normals)
-          {
-            double m[3];
-            normals->GetTuple(p, m);
-            double n[3];
-            for (int a = 0; a < 3; ++a)
-            {
-              n[a] = jacobian.M[0][a] * m[0] + jacobian.M[1][a] * m[1] + jacobian.M[2][a] * m[2];
-            }
-            const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-            for (int a = 0; a < 3; ++a)
-            {
-              out.Normals[3 * p + a] = length > 0 ? n[a] / length : m[a];
-            }
-          }
-        }
-      };
-      const vtkIdType n = points->GetNumberOfPoints();
-      completed =
-        vtkFFDForInChunks(self, n, vtkFFDGrain(n, 8.0 * vtkFFDGridWeightsPerPoint(deformer)), invert, 0.0, 1.0);
+          auto invert = [&](vtkIdType begin, vtkIdType end)
+          { InvertInGroups(inversion, deformation, level, order.data(), cells.data(), begin, end); };
+          completed =
+            vtkFFDForInChunks(self, n, vtkFFDGrain(n, 8.0 * vtkFFDGridWeightsPerPoint(deformer)), invert, 0.0, 1.0);
+        });
     });
   return completed;
 }
