@@ -128,8 +128,8 @@ struct vtkFFDCudaBackend::vtkState
             }
             const vtkFFDSparseCells& cells = *sparse->GetSparseCells();
             return this->Grid.BindSparse(key.Frame.data(), key.Basis, key.Divisions.data(),
-              sparse->GetCellOfPoint().data(), cells.GetVoxels().data(), cells.GetSupports().data(),
-              cells.GetNumberOfCells(), controlPoints);
+              sparse->GetCellOfPoint().data(), cells.GetVoxels().data(), cells.GetSupports(), cells.GetNumberOfCells(),
+              controlPoints);
           },
           [&](bool withNormals, bool withDeterminants)
           { return this->Grid.Evaluate(displacements, controlPoints, withNormals, withDeterminants); }))
@@ -220,12 +220,14 @@ bool vtkFFDCudaBackend::DeformGrid(const vtkFFDGridDeformer& grid, const vtkFFDB
 {
   bound = false;
 #ifdef VOXELFFD_HAS_CUDA
-  const std::vector<double>& displacements = grid.GetLattice().Displacements;
+  std::vector<double> storage;
+  const double* displacements = grid.ReadDisplacements(storage);
+  const vtkIdType controlPoints = grid.GetLattice().Points->GetNumberOfTuples();
   const bool ok = vtkState::WithOutputs(outPoints, outDeterminants,
     [&](auto* out, auto* determinants)
     {
-      return this->State->RunGrid(key, grid.GetSparseCells() ? &grid : nullptr, points, normals, displacements.data(),
-        vtkIdType(displacements.size() / 3), out, outNormals, determinants, bound);
+      return this->State->RunGrid(key, grid.GetSparseCells() ? &grid : nullptr, points, normals, displacements,
+        controlPoints, out, outNormals, determinants, bound);
     });
   if (!ok)
   {

@@ -107,7 +107,7 @@ vtkSmartPointer<vtkDataArray> OutputArray(const KeptArrays& kept, vtkDataArray* 
 // The deformers of each lattice kind, the CUDA backend, and the arrays of the update being made.
 struct vtkFFDDeform::vtkInternals
 {
-  vtkFFDGridDeformer Grid;
+  vtkFFDGridDeformer Grid{ false }; // it evaluates: the displacements are read in the evaluation's precision
   vtkFFDTetrahedralDeformer Tetrahedra;
   vtkFFDCudaBackend Cuda;
   // The last outputs' arrays: the next update writes into those that nothing else holds any more (OutputArray()).

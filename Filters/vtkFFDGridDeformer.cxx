@@ -152,7 +152,7 @@ std::string CheckRestPositions(
 
 //------------------------------------------------------------------------------------------------------------
 // The point arrays of a lattice whose cells `view` holds: RestPosition (doubles, where the frame puts them), Active
-// (where present) and the displacements, into `view`.
+// (where present), and the points and RestPosition, into `view` with the displacements where it keeps them.
 std::string ReadPointArrays(vtkPointSet* lattice, vtkFFDGridLattice& view, vtkFFDRestCheck& restChecked)
 {
   const vtkIdType count = lattice->GetNumberOfPoints();
@@ -173,7 +173,18 @@ std::string ReadPointArrays(vtkPointSet* lattice, vtkFFDGridLattice& view, vtkFF
   {
     return why;
   }
-  const vtkIdType bad = vtkFFDReadLatticeDisplacements(lattice, rest, view.Displacements, nullptr);
+  view.Points = lattice->GetPoints()->GetData();
+  view.RestPosition = rest;
+  vtkIdType bad;
+  if (view.KeepDisplacements)
+  {
+    bad = vtkFFDReadLatticeDisplacements(lattice, rest, view.Displacements, nullptr);
+  }
+  else
+  {
+    std::vector<double>().swap(view.Displacements);
+    bad = vtkFFDReadLatticeDisplacements<double>(view.Points, rest, count, nullptr, nullptr);
+  }
   if (bad >= 0)
   {
     return vtkFFDLatticePointProblem(lattice, rest, bad, "Lattice point");
@@ -348,6 +359,35 @@ struct vtkFFDGridBinding
   // and zeroing its buffers at every update is a noticeable part of an update's fixed cost.
   vtkSMPThreadLocal<std::vector<float>> StagingFloat;
   vtkSMPThreadLocal<std::vector<double>> StagingDouble;
+  // The displacements in the evaluation's precision where the lattice does not keep them in it, kept from update
+  // to update (only one precision's at a time).
+  std::vector<float> DisplacementsFloat;
+  std::vector<double> DisplacementsDouble;
+
+  /// The lattice's displacements in the evaluation's precision: those it keeps, where they are doubles, or read
+  /// from its points and RestPosition (checked by SetLattice()), rounded as a copy of those it keeps would be.
+  template <typename Real>
+  const Real* Displacements(const vtkFFDGridLattice& lattice)
+  {
+    std::vector<Real>& values = this->DisplacementsOf(Real());
+    if constexpr (std::is_same<Real, double>::value)
+    {
+      std::vector<float>().swap(this->DisplacementsFloat);
+      if (!lattice.Displacements.empty())
+      {
+        std::vector<double>().swap(values);
+        return lattice.Displacements.data();
+      }
+    }
+    else
+    {
+      std::vector<double>().swap(this->DisplacementsDouble);
+    }
+    const vtkIdType count = lattice.Points->GetNumberOfTuples();
+    values.resize(std::size_t(3 * count));
+    vtkFFDReadLatticeDisplacements(lattice.Points, lattice.RestPosition, count, values.data(), nullptr);
+    return values.data();
+  }
 
   template <typename Real>
   const Real* Listed(const Real* inPoints)
@@ -378,6 +418,8 @@ private:
   std::vector<double>& ListedOf(double) { return this->ListedDouble; }
   vtkSMPThreadLocal<std::vector<float>>& StagingOf(float) { return this->StagingFloat; }
   vtkSMPThreadLocal<std::vector<double>>& StagingOf(double) { return this->StagingDouble; }
+  std::vector<float>& DisplacementsOf(float) { return this->DisplacementsFloat; }
+  std::vector<double>& DisplacementsOf(double) { return this->DisplacementsDouble; }
 };
 
 namespace
@@ -448,18 +490,7 @@ struct EvaluateWorker
     bool& completed)
   {
     const vtkFFDSparseCells* sparse = this->Sparse;
-    // The displacements in the evaluation's precision: the lattice's own in double, a float copy otherwise.
-    std::vector<float> rounded;
-    const Real* displacements = nullptr;
-    if constexpr (std::is_same<Real, double>::value)
-    {
-      displacements = lattice.Displacements.data();
-    }
-    else
-    {
-      rounded.assign(lattice.Displacements.begin(), lattice.Displacements.end());
-      displacements = rounded.data();
-    }
+    const Real* displacements = binding.Displacements<Real>(lattice);
     std::vector<Real> cellTable;
     if (binding.CellTable)
     {
@@ -470,8 +501,8 @@ struct EvaluateWorker
         [&](int begin, int end)
         {
           ffd::FillCellTable(lattice.Basis, displacements, lattice.Divisions, lattice.ControlPointsPerAxis,
-            sparse ? sparse->GetVoxels().data() : nullptr, sparse ? sparse->GetSupports().data() : nullptr,
-            cellTable.data(), begin, end);
+            sparse ? sparse->GetVoxels().data() : nullptr, sparse ? sparse->GetSupports() : nullptr, cellTable.data(),
+            begin, end);
         });
     }
     // One instantiation per basis (ffd::WithStaticBasis); a local basis but the tricubic Bezier one also with
@@ -509,7 +540,7 @@ struct EvaluateWorker
     const Deformation deformation{ lattice.Basis, { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] },
       { lattice.ControlPointsPerAxis[0], lattice.ControlPointsPerAxis[1], lattice.ControlPointsPerAxis[2] },
       displacements, ffd::Frame<Real>::FromArray(lattice.Frame), cellTable,
-      sparse ? sparse->GetVoxels().data() : nullptr, sparse ? sparse->GetSupports().data() : nullptr };
+      sparse ? sparse->GetVoxels().data() : nullptr, sparse ? sparse->GetSupports() : nullptr };
     const vtkIdType n = inPoints->GetNumberOfTuples();
     // The work of a point: the control points it reads, and 16 for its parameters and output.
     double reads = 1.0;
@@ -567,12 +598,27 @@ bool vtkFFDRestCheck::operator==(const vtkFFDRestCheck& other) const
 }
 
 //------------------------------------------------------------------------------------------------------------
-vtkFFDGridDeformer::vtkFFDGridDeformer()
+vtkFFDGridDeformer::vtkFFDGridDeformer(bool keepDisplacements)
   : Binding(new vtkFFDGridBinding)
 {
+  this->Lattice.KeepDisplacements = keepDisplacements;
 }
 
 vtkFFDGridDeformer::~vtkFFDGridDeformer() = default;
+
+//------------------------------------------------------------------------------------------------------------
+const double* vtkFFDGridDeformer::ReadDisplacements(std::vector<double>& storage) const
+{
+  const vtkFFDGridLattice& lattice = this->Lattice;
+  if (lattice.KeepDisplacements)
+  {
+    return lattice.Displacements.data();
+  }
+  const vtkIdType count = lattice.Points->GetNumberOfTuples();
+  storage.resize(std::size_t(3 * count));
+  vtkFFDReadLatticeDisplacements(lattice.Points, lattice.RestPosition, count, storage.data(), nullptr);
+  return storage.data();
+}
 
 //------------------------------------------------------------------------------------------------------------
 std::string vtkFFDGridDeformer::SetLattice(vtkPointSet* lattice)

@@ -14,8 +14,10 @@
 #ifndef vtkFFDGridDeformer_h
 #define vtkFFDGridDeformer_h
 
+#include "vtkDataArray.h"
 #include "vtkFFDBindingKey.h"
 #include "vtkFFDSparseCells.h"
+#include "vtkSmartPointer.h"
 #include "vtkType.h"
 
 #include "FFDGridBasis.h"
@@ -25,7 +27,6 @@
 #include <vector>
 
 class vtkAlgorithm;
-class vtkDataArray;
 class vtkPoints;
 class vtkPointSet;
 struct vtkFFDGridBinding;
@@ -37,8 +38,11 @@ struct vtkFFDGridLattice
   int Divisions[3];
   ffd::GridBasis Basis;
   int ControlPointsPerAxis[3];
-  std::vector<double> Displacements; // 3 per control point: point minus RestPosition
-  bool Sparse = false;               // the control points and cells of vtkFFDGridDeformer::GetSparseCells() only
+  // 3 per control point: point minus RestPosition; empty where the deformer does not keep them (its constructor).
+  std::vector<double> Displacements;
+  bool Sparse = false;           // the control points and cells of vtkFFDGridDeformer::GetSparseCells() only
+  bool KeepDisplacements = true; // whether SetLattice() fills Displacements
+  vtkSmartPointer<vtkDataArray> Points, RestPosition; // the lattice's (doubles, checked)
 };
 
 /// What the last check of a lattice's RestPosition against its frame passed: the arrays (RestPosition, and a sparse
@@ -58,7 +62,13 @@ struct vtkFFDRestCheck
 class vtkFFDGridDeformer
 {
 public:
-  vtkFFDGridDeformer();
+  /**
+   * `keepDisplacements`: whether SetLattice() keeps the displacements in GetLattice().Displacements, as the
+   * readers of a lattice need them. vtkFFDDeform, which only evaluates, does not: Evaluate() reads them itself in
+   * its own precision (float points: 12 bytes a control point, not 24 kept and 12 more while evaluating), the
+   * CUDA backend through ReadDisplacements().
+   */
+  explicit vtkFFDGridDeformer(bool keepDisplacements = true);
   ~vtkFFDGridDeformer();
   vtkFFDGridDeformer(const vtkFFDGridDeformer&) = delete;
   vtkFFDGridDeformer& operator=(const vtkFFDGridDeformer&) = delete;
@@ -73,6 +83,10 @@ public:
 
   /// The lattice of the last SetLattice().
   const vtkFFDGridLattice& GetLattice() const { return this->Lattice; }
+
+  /// The displacements of the last SetLattice()'s lattice: GetLattice().Displacements where kept, else read into
+  /// `storage`.
+  const double* ReadDisplacements(std::vector<double>& storage) const;
 
   /// The cells of the last SetLattice()'s lattice where it is sparse, else null.
   const vtkFFDSparseCells* GetSparseCells() const { return this->Lattice.Sparse ? &this->SparseCells : nullptr; }

@@ -64,7 +64,7 @@ std::vector<Pair> SparseSprings(
   std::vector<Pair> springs;
   std::vector<std::uint16_t> done(particleOf.size(), 0); // per point, a bit per offset already joined
   const int n = supportCount;
-  const int* supports = cells.GetSupports().data();
+  const int* supports = cells.GetSupports();
   for (int cell = 0; cell < cells.GetNumberOfCells(); ++cell)
   {
     const int* support = supports + std::size_t(cell) * std::size_t(n * n * n);

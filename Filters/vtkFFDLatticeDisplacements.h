@@ -52,20 +52,16 @@ inline std::string vtkFFDCheckLatticePrecision(vtkPointSet* lattice, vtkDataArra
 }
 
 /**
- * The deformation of `lattice`, its points minus `rest` (3 components, a tuple per point), 3 doubles per point
- * into `displacements`, and the rest positions into `restValues` when not null. Returns the first point whose
- * position or rest position is not finite or beyond vtkFFDMaxLatticeCoordinate (the outputs then hold such
- * values), or -1; vtkFFDLatticePointProblem() says what is wrong with it.
+ * The deformation of a lattice, its `points` minus `rest` (3 components, `count` tuples each): 3 values per point,
+ * the difference in double rounded to Real, into `displacements`, and the rest positions into `restValues`, each
+ * where not null (with neither, only the check). Returns the first point whose position or rest position is not
+ * finite or beyond vtkFFDMaxLatticeCoordinate (the outputs then hold such values), or -1;
+ * vtkFFDLatticePointProblem() says what is wrong with it.
  */
-inline vtkIdType vtkFFDReadLatticeDisplacements(
-  vtkPointSet* lattice, vtkDataArray* rest, std::vector<double>& displacements, std::vector<double>* restValues)
+template <typename Real>
+vtkIdType vtkFFDReadLatticeDisplacements(
+  vtkDataArray* points, vtkDataArray* rest, vtkIdType count, Real* displacements, double* restValues)
 {
-  const vtkIdType count = lattice->GetNumberOfPoints();
-  displacements.resize(3 * count);
-  if (restValues)
-  {
-    restValues->resize(3 * count);
-  }
   if (count == 0)
   {
     return -1;
@@ -73,9 +69,9 @@ inline vtkIdType vtkFFDReadLatticeDisplacements(
   std::atomic<vtkIdType> firstBad(count);
   // Read through the arrays' own types where they are float or double (vtkArrayDispatch): vtkDataArray's
   // virtual tuple access is a noticeable part of an update's fixed cost.
-  auto read = [&](auto* points, auto* restPositions)
+  auto read = [&](auto* pointValues, auto* restPositions)
   {
-    const auto x = vtk::DataArrayTupleRange<3>(points);
+    const auto x = vtk::DataArrayTupleRange<3>(pointValues);
     const auto x0 = vtk::DataArrayTupleRange<3>(restPositions);
     // In parallel: a lattice of 100 k nodes, read serially, would hold up every update by a millisecond; in
     // tasks of at least 4096 nodes, so that a small lattice is read in one.
@@ -97,22 +93,38 @@ inline vtkIdType vtkFFDReadLatticeDisplacements(
               {
               }
             }
-            displacements[3 * p + c] = d;
+            if (displacements)
+            {
+              displacements[3 * p + c] = Real(d);
+            }
             if (restValues)
             {
-              (*restValues)[3 * p + c] = rest0;
+              restValues[3 * p + c] = rest0;
             }
           }
         }
       });
   };
-  vtkDataArray* points = lattice->GetPoints()->GetData();
   if (!vtkArrayDispatch::Dispatch2ByValueType<vtkArrayDispatch::Reals, vtkArrayDispatch::Reals>::Execute(
         points, rest, read))
   {
     read(points, rest);
   }
   return firstBad == count ? -1 : firstBad.load();
+}
+
+/// vtkFFDReadLatticeDisplacements() of `lattice`'s points, into vectors (resized to 3 values per point).
+inline vtkIdType vtkFFDReadLatticeDisplacements(
+  vtkPointSet* lattice, vtkDataArray* rest, std::vector<double>& displacements, std::vector<double>* restValues)
+{
+  const vtkIdType count = lattice->GetNumberOfPoints();
+  displacements.resize(3 * count);
+  if (restValues)
+  {
+    restValues->resize(3 * count);
+  }
+  return vtkFFDReadLatticeDisplacements(lattice->GetPoints() ? lattice->GetPoints()->GetData() : nullptr, rest, count,
+    displacements.data(), restValues ? restValues->data() : nullptr);
 }
 
 /// What is wrong with point `p` of `lattice`, found by vtkFFDReadLatticeDisplacements(); `what` names the point

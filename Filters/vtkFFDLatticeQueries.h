@@ -45,7 +45,7 @@ void vtkFFDWithGridDeformation(const vtkFFDGridDeformer& deformer, F&& f)
         { view.Divisions[0], view.Divisions[1], view.Divisions[2] },
         { view.ControlPointsPerAxis[0], view.ControlPointsPerAxis[1], view.ControlPointsPerAxis[2] },
         view.Displacements.data(), ffd::Frame<double>::FromArray(view.Frame), nullptr,
-        cells ? cells->GetVoxels().data() : nullptr, cells ? cells->GetSupports().data() : nullptr });
+        cells ? cells->GetVoxels().data() : nullptr, cells ? cells->GetSupports() : nullptr });
     });
 }
 

@@ -334,7 +334,7 @@ vtkSmartPointer<vtkPointSet> vtkFFDRefineLattice::RefineOnce(vtkPointSet* coarse
         owner[fineCells.GetSupports()[std::size_t(c) * m3 + s]] = c;
       }
     }
-    const int* coarseSupports = cells->GetSupports().data();
+    const int* coarseSupports = cells->GetSupports();
     vtkSMPTools::For(0, fineCells.GetNumberOfCells(),
       [&](int begin, int end)
       {

@@ -7,13 +7,16 @@
 #include "vtkIdList.h"
 #include "vtkIntArray.h"
 #include "vtkPointData.h"
+#include "vtkSMPThreadLocal.h"
 #include "vtkSMPThreadLocalObject.h"
 #include "vtkSMPTools.h"
+#include "vtkTypeInt32Array.h"
 #include "vtkUnstructuredGrid.h"
 
 #include <algorithm>
 #include <atomic>
 #include <sstream>
+#include <type_traits>
 #include <utility>
 
 namespace
@@ -209,31 +212,62 @@ std::string vtkFFDSparseCells::Read(vtkUnstructuredGrid* lattice, ffd::GridBasis
       " have the same VoxelIndex: a sparse lattice has one cell per voxel." + Transformed + fix;
   }
 
-  // Each cell's support, its points placed by their LatticeIndex.
+  // Each cell's support, its points placed by their LatticeIndex: the lattice's connectivity itself where it
+  // already is that, which only the B-spline's cells (in support order) can be, else a copy.
   const CellReader reader{ cells, voxels, indices, numPoints, basis, divisions, ffd::SupportSize(basis, divisions[0]) };
   const int n3 = reader.N * reader.N * reader.N;
   this->Keys.resize(order.size());
   this->Voxels.resize(3 * order.size());
-  this->Supports.resize(size_t(n3) * order.size());
-  std::atomic<vtkIdType> firstBad(numCells);
-  vtkSMPThreadLocalObject<vtkIdList> ids;
-  vtkSMPTools::For(0, numCells,
-    [&](vtkIdType begin, vtkIdType end)
-    {
-      for (vtkIdType r = begin; r < end; ++r)
+  this->Supports = nullptr;
+  // Places every cell's points into `supports`, or, where it is null, into a buffer compared with `own` (the
+  // connectivity; `differs` tells whether any cell's is not its support). Returns the first cell that is not a
+  // support (numCells where there is none).
+  auto place = [&](int* supports, const int* own, std::atomic<bool>& differs)
+  {
+    std::atomic<vtkIdType> firstBad(numCells);
+    vtkSMPThreadLocalObject<vtkIdList> ids;
+    vtkSMPThreadLocal<std::vector<int>> buffers;
+    vtkSMPTools::For(0, numCells,
+      [&](vtkIdType begin, vtkIdType end)
       {
-        const int cell = order[r].second;
-        this->Keys[r] = order[r].first;
-        std::copy(voxels + 3 * cell, voxels + 3 * cell + 3, this->Voxels.data() + 3 * r);
-        if (!reader.Place(cell, voxels + 3 * cell, ids.Local(), this->Supports.data() + size_t(n3) * r, nullptr))
+        std::vector<int>& buffer = buffers.Local();
+        buffer.resize(n3);
+        for (vtkIdType r = begin; r < end; ++r)
         {
-          vtkIdType seen = firstBad.load();
-          while (r < seen && !firstBad.compare_exchange_weak(seen, r))
+          const int cell = order[r].second;
+          this->Keys[r] = order[r].first;
+          std::copy(voxels + 3 * cell, voxels + 3 * cell + 3, this->Voxels.data() + 3 * r);
+          int* support = supports ? supports + size_t(n3) * r : buffer.data();
+          if (!reader.Place(cell, voxels + 3 * cell, ids.Local(), support, nullptr))
           {
+            vtkIdType seen = firstBad.load();
+            while (r < seen && !firstBad.compare_exchange_weak(seen, r))
+            {
+            }
+          }
+          else if (!supports && !std::equal(support, support + n3, own + size_t(n3) * r))
+          {
+            differs = true;
           }
         }
-      }
-    });
+      });
+    return firstBad.load();
+  };
+  static_assert(std::is_same<vtkTypeInt32, int>::value, "32-bit cell ids are ints");
+  const bool inOrder = std::all_of(
+    order.begin(), order.end(), [&](const std::pair<std::int64_t, int>& o) { return o.second == &o - order.data(); });
+  std::atomic<bool> differs(true);
+  vtkIdType firstBad = numCells;
+  if (basis == ffd::GridBasis::CubicBSpline && inOrder && !cells->IsStorage64Bit())
+  {
+    differs = false;
+    firstBad = place(nullptr, cells->GetConnectivityArray32()->GetPointer(0), differs);
+  }
+  if (differs && firstBad == numCells)
+  {
+    this->SupportsCopy.resize(size_t(n3) * order.size());
+    firstBad = place(this->SupportsCopy.data(), nullptr, differs);
+  }
   if (firstBad < numCells)
   {
     std::string why;
@@ -243,6 +277,17 @@ std::string vtkFFDSparseCells::Read(vtkUnstructuredGrid* lattice, ffd::GridBasis
     reader.Place(cell, voxels + 3 * cell, idList, support.data(), &why);
     return why + fix;
   }
+  if (differs)
+  {
+    this->Connectivity = nullptr;
+    this->Supports = this->SupportsCopy.data();
+  }
+  else
+  {
+    std::vector<int>().swap(this->SupportsCopy);
+    this->Connectivity = cells->GetConnectivityArray32();
+    this->Supports = cells->GetConnectivityArray32()->GetPointer(0);
+  }
 
   // FNV-1a over the cells' voxels (what a binding depends on) and supports (what a device holds).
   std::uint64_t hash = 14695981039346656037ull;
@@ -250,9 +295,9 @@ std::string vtkFFDSparseCells::Read(vtkUnstructuredGrid* lattice, ffd::GridBasis
   {
     hash = (hash ^ std::uint64_t(key)) * 1099511628211ull;
   }
-  for (const int id : this->Supports)
+  for (const int* id = this->Supports; id != this->Supports + size_t(n3) * order.size(); ++id)
   {
-    hash = (hash ^ std::uint64_t(id)) * 1099511628211ull;
+    hash = (hash ^ std::uint64_t(*id)) * 1099511628211ull;
   }
   this->Fingerprint = hash;
   std::copy(source, source + 3, this->Source);

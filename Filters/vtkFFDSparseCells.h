@@ -9,11 +9,15 @@
  * voxel's flat index i + nx (j + ny k) (the order of the dense lattice's cells, so that both deform bit for bit
  * alike), each with its voxel's indices and the point ids of its support in support order (i fastest), each point
  * placed by its `LatticeIndex`, whatever its place in the cell. The cells are read again only when the lattice's
- * cells or indices change, not when its points move.
+ * cells or indices change, not when its points move. Where the lattice's connectivity already is that (the cells of
+ * vtkFFDBuildLattice's CUBIC_BSPLINE lattice: 32-bit ids, in voxel order, each in support order), the supports are
+ * that array itself, held, not a copy of it (4 bytes per id: 100 MB at 1024^3 voxels).
  */
 #ifndef vtkFFDSparseCells_h
 #define vtkFFDSparseCells_h
 
+#include "vtkDataArray.h"
+#include "vtkSmartPointer.h"
 #include "vtkType.h"
 
 #include "FFDGridBasis.h"
@@ -36,7 +40,7 @@ public:
   /// The cells: their number, each one's voxel (3 ints) and support (SupportCount()^3 point ids).
   int GetNumberOfCells() const { return static_cast<int>(this->Keys.size()); }
   const std::vector<int>& GetVoxels() const { return this->Voxels; }
-  const std::vector<int>& GetSupports() const { return this->Supports; }
+  const int* GetSupports() const { return this->Supports; }
 
   /// The cell of the voxel whose flat index is `key` (i + nx (j + ny k)), or -1 where the lattice has none.
   int Find(std::int64_t key) const;
@@ -47,7 +51,9 @@ public:
 private:
   std::vector<std::int64_t> Keys; // each cell's voxel's flat index, increasing
   std::vector<int> Voxels;
-  std::vector<int> Supports;
+  const int* Supports = nullptr;              // SupportCount()^3 a cell: into one of the two below
+  std::vector<int> SupportsCopy;              // where the lattice's connectivity is not them
+  vtkSmartPointer<vtkDataArray> Connectivity; // where it is: the lattice's own, held
   std::uint64_t Fingerprint = 0;
   // What the cells were read from: the lattice's cells, indices and points, by identity and time.
   const void* Source[3] = { nullptr, nullptr, nullptr };

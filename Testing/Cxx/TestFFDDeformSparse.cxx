@@ -708,3 +708,104 @@ TEST(vtkFFDDeformSparse, TransformedLatticesFollowOrSayWhatTheTransformDid)
     EXPECT_LE(error, 1e-12) << name;
   }
 }
+
+TEST(vtkFFDDeformSparse, BuiltBSplineLatticeDeformsAsItsOtherFormsBitForBit)
+{
+  // vtkFFDBuildLattice's sparse cubic B-spline lattice is evaluated from its own connectivity (each cell already
+  // is its voxel's support, in order, in 32-bit ids), where the same lattice with one cell's points in another
+  // order, or its ids in 64 bits, is evaluated from a copy: all three give the dense lattice's output bytes, the
+  // same displacements at the same LatticeIndex, for double and float points, both outside policies.
+  std::mt19937 rng(1722);
+  const vtkSmartPointer<vtkPolyData> mesh = ffdtest::WithPointNormals(ReadTestMesh("bear"));
+  vtkNew<vtkPolyData> floatMesh;
+  floatMesh->DeepCopy(mesh);
+  vtkNew<vtkPoints> floatPoints;
+  floatPoints->SetDataTypeToFloat();
+  floatPoints->DeepCopy(mesh->GetPoints());
+  floatMesh->SetPoints(floatPoints);
+  vtkNew<vtkFFDVoxelize> voxelize;
+  voxelize->SetInputData(mesh);
+  voxelize->SetDivisions(12, 13, 14);
+  vtkNew<vtkFFDBuildLattice> build;
+  build->SetInputConnection(voxelize->GetOutputPort());
+  build->SetBasis(vtkFFDBuildLattice::CUBIC_BSPLINE);
+  build->SetLatticeForm(vtkFFDBuildLattice::DENSE);
+  build->Update();
+  auto dense = vtkSmartPointer<vtkStructuredGrid>::New();
+  dense->DeepCopy(build->GetOutputDataObject(0));
+  build->SetLatticeForm(vtkFFDBuildLattice::SPARSE);
+  build->Update();
+  vtkUnstructuredGrid* built = vtkUnstructuredGrid::SafeDownCast(build->GetOutputDataObject(0));
+  ASSERT_NE(built, nullptr);
+  ASSERT_FALSE(built->GetCells()->IsStorage64Bit());
+  ASSERT_LT(built->GetNumberOfPoints(), dense->GetNumberOfPoints());
+
+  // The same random displacement at each LatticeIndex in both forms.
+  int dims[3];
+  dense->GetDimensions(dims);
+  auto sparse = vtkSmartPointer<vtkUnstructuredGrid>::New();
+  sparse->ShallowCopy(built);
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->DeepCopy(built->GetPoints());
+  sparse->SetPoints(points);
+  vtkDataArray* index = sparse->GetPointData()->GetArray(vtkFFDDataContract::LatticeIndexArrayName());
+  std::uniform_real_distribution<double> move(-0.03, 0.03);
+  const double diagonal = ffdtest::Diagonal(ffdtest::FrameOf(sparse));
+  for (vtkIdType p = 0; p < sparse->GetNumberOfPoints(); ++p)
+  {
+    const double* ijk = index->GetTuple3(p);
+    const vtkIdType d = vtkIdType(ijk[0]) + dims[0] * (vtkIdType(ijk[1]) + dims[1] * vtkIdType(ijk[2]));
+    double x[3], y[3];
+    points->GetPoint(p, x);
+    dense->GetPoint(d, y);
+    for (int c = 0; c < 3; ++c)
+    {
+      const double shift = move(rng) * diagonal;
+      x[c] += shift;
+      y[c] += shift;
+    }
+    points->SetPoint(p, x);
+    dense->GetPoints()->SetPoint(d, y);
+  }
+
+  // One cell's points reversed, its ids still 32-bit and the cells in voxel order; and every id in 64 bits.
+  auto reversed = vtkSmartPointer<vtkUnstructuredGrid>::New();
+  reversed->DeepCopy(sparse);
+  vtkNew<vtkIdList> ids;
+  reversed->GetCells()->GetCellAtId(3, ids);
+  std::reverse(ids->GetPointer(0), ids->GetPointer(0) + ids->GetNumberOfIds());
+  reversed->GetCells()->ReplaceCellAtId(3, ids);
+  ASSERT_FALSE(reversed->GetCells()->IsStorage64Bit());
+  auto wide = vtkSmartPointer<vtkUnstructuredGrid>::New();
+  wide->DeepCopy(sparse);
+  ASSERT_TRUE(wide->GetCells()->ConvertTo64BitStorage());
+
+  int compared = 0;
+  for (vtkPointSet* input : { static_cast<vtkPointSet*>(mesh), static_cast<vtkPointSet*>(floatMesh) })
+  {
+    for (int policy : { vtkFFDDeform::KEEP_POSITION, vtkFFDDeform::CLAMP_TO_EDGE })
+    {
+      std::string ran;
+      const std::vector<char> want = DeformedBytes(input, dense, policy, vtkFFDDeform::CPU, ran);
+      ASSERT_GT(want.size(), 0u);
+      for (vtkUnstructuredGrid* lattice : { sparse.Get(), reversed.Get(), wide.Get() })
+      {
+        ASSERT_TRUE(want == DeformedBytes(input, lattice, policy, vtkFFDDeform::CPU, ran))
+          << "policy " << policy << " points of type " << input->GetPoints()->GetDataType() << " lattice "
+          << (lattice == sparse        ? "as built"
+                 : lattice == reversed ? "with a cell reversed"
+                                       : "of 64-bit ids");
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 2 * 2 * 3);
+  vtkNew<vtkFFDDeform> deform; // the displacements move the mesh
+  deform->SetInputData(mesh);
+  deform->SetLatticeData(sparse);
+  deform->Update();
+  EXPECT_GT(ffdtest::MaxRelativeMotion(
+              mesh, vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0)), ffdtest::FrameOf(sparse)),
+    1e-3);
+}
