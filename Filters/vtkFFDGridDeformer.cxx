@@ -151,8 +151,75 @@ std::string CheckRestPositions(
 }
 
 //------------------------------------------------------------------------------------------------------------
+std::vector<double>& DisplacementsIn(vtkFFDGridLattice& view, double)
+{
+  return view.Displacements;
+}
+
+std::vector<float>& DisplacementsIn(vtkFFDGridLattice& view, float)
+{
+  return view.FloatDisplacements;
+}
+
+// Reads view's displacements (`count`) from its Points and RestPosition into its vector of precision Real, the other
+// one freed unless it keeps doubles, or, where Real is void, only checks them. Returns what
+// vtkFFDReadLatticeDisplacements() returns.
+template <typename Real>
+vtkIdType ReadDisplacementsAs(vtkFFDGridLattice& view, vtkIdType count)
+{
+  if constexpr (std::is_void<Real>::value)
+  {
+    std::vector<double>().swap(view.Displacements);
+    std::vector<float>().swap(view.FloatDisplacements);
+    return vtkFFDReadLatticeDisplacements<double>(view.Points, view.RestPosition, count, nullptr, nullptr);
+  }
+  else
+  {
+    if constexpr (std::is_same<Real, double>::value)
+    {
+      std::vector<float>().swap(view.FloatDisplacements);
+    }
+    else if (!view.KeepDisplacements)
+    {
+      std::vector<double>().swap(view.Displacements);
+    }
+    std::vector<Real>& values = DisplacementsIn(view, Real());
+    values.resize(std::size_t(3 * count));
+    return vtkFFDReadLatticeDisplacements(view.Points, view.RestPosition, count, values.data(), nullptr);
+  }
+}
+
+// ReadDisplacementsAs() in view's ReadPrecision.
+vtkIdType ReadDisplacements(vtkFFDGridLattice& view, vtkIdType count)
+{
+  switch (view.ReadPrecision)
+  {
+    case VTK_DOUBLE:
+      return ReadDisplacementsAs<double>(view, count);
+    case VTK_FLOAT:
+      return ReadDisplacementsAs<float>(view, count);
+    default:
+      return ReadDisplacementsAs<void>(view, count);
+  }
+}
+
+// The displacements of view in the evaluation's precision Real: those SetLattice() read in it, or read now (checked by
+// SetLattice()); a deformer that does not keep doubles reads them in Real from then on.
+template <typename Real>
+const Real* EvaluationDisplacements(vtkFFDGridLattice& view)
+{
+  const int precision = std::is_same<Real, double>::value ? VTK_DOUBLE : VTK_FLOAT;
+  if (view.ReadPrecision != precision)
+  {
+    ReadDisplacementsAs<Real>(view, view.Points->GetNumberOfTuples());
+    view.ReadPrecision = view.KeepDisplacements ? VTK_DOUBLE : precision;
+  }
+  return DisplacementsIn(view, Real()).data();
+}
+
+//------------------------------------------------------------------------------------------------------------
 // The point arrays of a lattice whose cells `view` holds: RestPosition (doubles, where the frame puts them), Active
-// (where present), and the points and RestPosition, into `view` with the displacements where it keeps them.
+// (where present), and the points and RestPosition, into `view` with the displacements in its ReadPrecision.
 std::string ReadPointArrays(vtkPointSet* lattice, vtkFFDGridLattice& view, vtkFFDRestCheck& restChecked)
 {
   const vtkIdType count = lattice->GetNumberOfPoints();
@@ -175,16 +242,7 @@ std::string ReadPointArrays(vtkPointSet* lattice, vtkFFDGridLattice& view, vtkFF
   }
   view.Points = lattice->GetPoints()->GetData();
   view.RestPosition = rest;
-  vtkIdType bad;
-  if (view.KeepDisplacements)
-  {
-    bad = vtkFFDReadLatticeDisplacements(lattice, rest, view.Displacements, nullptr);
-  }
-  else
-  {
-    std::vector<double>().swap(view.Displacements);
-    bad = vtkFFDReadLatticeDisplacements<double>(view.Points, rest, count, nullptr, nullptr);
-  }
+  const vtkIdType bad = ReadDisplacements(view, count);
   if (bad >= 0)
   {
     return vtkFFDLatticePointProblem(lattice, rest, bad, "Lattice point");
@@ -359,35 +417,6 @@ struct vtkFFDGridBinding
   // and zeroing its buffers at every update is a noticeable part of an update's fixed cost.
   vtkSMPThreadLocal<std::vector<float>> StagingFloat;
   vtkSMPThreadLocal<std::vector<double>> StagingDouble;
-  // The displacements in the evaluation's precision where the lattice does not keep them in it, kept from update
-  // to update (only one precision's at a time).
-  std::vector<float> DisplacementsFloat;
-  std::vector<double> DisplacementsDouble;
-
-  /// The lattice's displacements in the evaluation's precision: those it keeps, where they are doubles, or read
-  /// from its points and RestPosition (checked by SetLattice()), rounded as a copy of those it keeps would be.
-  template <typename Real>
-  const Real* Displacements(const vtkFFDGridLattice& lattice)
-  {
-    std::vector<Real>& values = this->DisplacementsOf(Real());
-    if constexpr (std::is_same<Real, double>::value)
-    {
-      std::vector<float>().swap(this->DisplacementsFloat);
-      if (!lattice.Displacements.empty())
-      {
-        std::vector<double>().swap(values);
-        return lattice.Displacements.data();
-      }
-    }
-    else
-    {
-      std::vector<double>().swap(this->DisplacementsDouble);
-    }
-    const vtkIdType count = lattice.Points->GetNumberOfTuples();
-    values.resize(std::size_t(3 * count));
-    vtkFFDReadLatticeDisplacements(lattice.Points, lattice.RestPosition, count, values.data(), nullptr);
-    return values.data();
-  }
 
   template <typename Real>
   const Real* Listed(const Real* inPoints)
@@ -418,8 +447,6 @@ private:
   std::vector<double>& ListedOf(double) { return this->ListedDouble; }
   vtkSMPThreadLocal<std::vector<float>>& StagingOf(float) { return this->StagingFloat; }
   vtkSMPThreadLocal<std::vector<double>>& StagingOf(double) { return this->StagingDouble; }
-  std::vector<float>& DisplacementsOf(float) { return this->DisplacementsFloat; }
-  std::vector<double>& DisplacementsOf(double) { return this->DisplacementsDouble; }
 };
 
 namespace
@@ -482,6 +509,7 @@ template <typename Real>
 struct EvaluateWorker
 {
   const vtkFFDSparseCells* Sparse; // null for a dense lattice
+  const Real* Displacements;       // the lattice's, in Real (EvaluationDisplacements())
 
   template <typename PointArrayT>
   void operator()(PointArrayT* inPoints, const vtkFFDGridLattice& lattice, vtkFFDGridBinding& binding,
@@ -490,7 +518,7 @@ struct EvaluateWorker
     bool& completed)
   {
     const vtkFFDSparseCells* sparse = this->Sparse;
-    const Real* displacements = binding.Displacements<Real>(lattice);
+    const Real* displacements = this->Displacements;
     std::vector<Real> cellTable;
     if (binding.CellTable)
     {
@@ -602,6 +630,7 @@ vtkFFDGridDeformer::vtkFFDGridDeformer(bool keepDisplacements)
   : Binding(new vtkFFDGridBinding)
 {
   this->Lattice.KeepDisplacements = keepDisplacements;
+  this->Lattice.ReadPrecision = keepDisplacements ? VTK_DOUBLE : 0; // else that of the last evaluation
 }
 
 vtkFFDGridDeformer::~vtkFFDGridDeformer() = default;
@@ -610,7 +639,7 @@ vtkFFDGridDeformer::~vtkFFDGridDeformer() = default;
 const double* vtkFFDGridDeformer::ReadDisplacements(std::vector<double>& storage) const
 {
   const vtkFFDGridLattice& lattice = this->Lattice;
-  if (lattice.KeepDisplacements)
+  if (lattice.ReadPrecision == VTK_DOUBLE)
   {
     return lattice.Displacements.data();
   }
@@ -704,7 +733,7 @@ bool vtkFFDGridDeformer::Evaluate(vtkPoints* points, vtkDataArray* normals, vtkD
   {
     using RealArray = std::remove_pointer_t<decltype(out)>;
     using Real = typename RealArray::ValueType;
-    EvaluateWorker<Real> worker{ this->GetSparseCells() };
+    EvaluateWorker<Real> worker{ this->GetSparseCells(), EvaluationDisplacements<Real>(this->Lattice) };
     auto* determinants = static_cast<RealArray*>(outDeterminants);
     if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(points->GetData(), worker, this->Lattice,
           *this->Binding, normals, outNormals, out, determinants, self, progressBegin, progressEnd, completed))

@@ -38,10 +38,14 @@ struct vtkFFDGridLattice
   int Divisions[3];
   ffd::GridBasis Basis;
   int ControlPointsPerAxis[3];
-  // 3 per control point: point minus RestPosition; empty where the deformer does not keep them (its constructor).
+  // 3 per control point: point minus RestPosition, read by SetLattice() in ReadPrecision: VTK_DOUBLE into
+  // Displacements (always, where the deformer keeps them: its constructor), VTK_FLOAT into FloatDisplacements, or
+  // neither (0); a deformer that does not keep them reads them in the precision of its last evaluation.
   std::vector<double> Displacements;
-  bool Sparse = false;           // the control points and cells of vtkFFDGridDeformer::GetSparseCells() only
-  bool KeepDisplacements = true; // whether SetLattice() fills Displacements
+  std::vector<float> FloatDisplacements;
+  int ReadPrecision = VTK_DOUBLE;
+  bool KeepDisplacements = true;
+  bool Sparse = false; // the control points and cells of vtkFFDGridDeformer::GetSparseCells() only
   vtkSmartPointer<vtkDataArray> Points, RestPosition; // the lattice's (doubles, checked)
 };
 
@@ -64,9 +68,10 @@ class vtkFFDGridDeformer
 public:
   /**
    * `keepDisplacements`: whether SetLattice() keeps the displacements in GetLattice().Displacements, as the
-   * readers of a lattice need them. vtkFFDDeform, which only evaluates, does not: Evaluate() reads them itself in
-   * its own precision (float points: 12 bytes a control point, not 24 kept and 12 more while evaluating), the
-   * CUDA backend through ReadDisplacements().
+   * readers of a lattice need them. vtkFFDDeform, which only evaluates, does not: they are read in the evaluation's
+   * precision (float points: 12 bytes a control point, not 24 kept and 12 more while evaluating), by Evaluate() at
+   * the first, by SetLattice() while it checks them from the next on; the CUDA backend reads them through
+   * ReadDisplacements().
    */
   explicit vtkFFDGridDeformer(bool keepDisplacements = true);
   ~vtkFFDGridDeformer();

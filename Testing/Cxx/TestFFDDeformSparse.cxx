@@ -809,3 +809,70 @@ TEST(vtkFFDDeformSparse, BuiltBSplineLatticeDeformsAsItsOtherFormsBitForBit)
               mesh, vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0)), ffdtest::FrameOf(sparse)),
     1e-3);
 }
+
+TEST(vtkFFDDeformSparse, ReupdatesInEitherPrecisionGiveAFreshFiltersBytes)
+{
+  // vtkFFDDeform reads a lattice's displacements in the precision of its last evaluation: one filter updated in
+  // turn with float and double points, its lattice moved in between, gives at every update the bytes of a new
+  // filter, for a dense and a sparse lattice, with and without normals and det J.
+  std::mt19937 rng(1723);
+  const vtkSmartPointer<vtkPolyData> mesh = ffdtest::WithPointNormals(ReadTestMesh("bear"));
+  vtkNew<vtkPolyData> floatMesh;
+  floatMesh->DeepCopy(mesh);
+  vtkNew<vtkPoints> floatPoints;
+  floatPoints->SetDataTypeToFloat();
+  floatPoints->DeepCopy(mesh->GetPoints());
+  floatMesh->SetPoints(floatPoints);
+  const ffdref::Frame f = FrameAround(mesh);
+  const int n[3] = { 5, 6, 7 };
+  const vtkSmartPointer<vtkStructuredGrid> dense = ffdtest::MakeLattice(f, vtkFFDBuildLattice::CUBIC_BSPLINE, n);
+  const vtkSmartPointer<vtkUnstructuredGrid> sparse = SparseOf(dense, VoxelsOf(mesh, f, n), rng);
+  auto bytesOf = [](vtkFFDDeform* deform)
+  {
+    vtkPointSet* out = vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0));
+    std::vector<char> bytes;
+    for (vtkDataArray* a : { out->GetPoints()->GetData(), out->GetPointData()->GetNormals(),
+           out->GetPointData()->GetArray(vtkFFDDeform::JacobianDeterminantArrayName()) })
+    {
+      if (a)
+      {
+        const char* p = static_cast<const char*>(a->GetVoidPointer(0));
+        bytes.insert(bytes.end(), p, p + a->GetDataSize() * a->GetDataTypeSize());
+      }
+    }
+    return bytes;
+  };
+  int compared = 0;
+  for (vtkPointSet* lattice : { static_cast<vtkPointSet*>(dense), static_cast<vtkPointSet*>(sparse) })
+  {
+    for (bool withJacobian : { false, true })
+    {
+      vtkNew<vtkFFDDeform> reused;
+      reused->SetLatticeData(lattice);
+      reused->SetBackend(vtkFFDDeform::CPU);
+      reused->SetTransformNormals(withJacobian);
+      reused->SetComputeJacobianDeterminant(withJacobian);
+      for (vtkPointSet* input :
+        { static_cast<vtkPointSet*>(floatMesh), static_cast<vtkPointSet*>(floatMesh), static_cast<vtkPointSet*>(mesh),
+          static_cast<vtkPointSet*>(mesh), static_cast<vtkPointSet*>(floatMesh), static_cast<vtkPointSet*>(mesh) })
+      {
+        ffdtest::Perturb(lattice, rng, 0.01 * ffdtest::Diagonal(f));
+        reused->SetInputData(input);
+        reused->Update();
+        vtkNew<vtkFFDDeform> fresh;
+        fresh->SetInputData(input);
+        fresh->SetLatticeData(lattice);
+        fresh->SetBackend(vtkFFDDeform::CPU);
+        fresh->SetTransformNormals(withJacobian);
+        fresh->SetComputeJacobianDeterminant(withJacobian);
+        fresh->Update();
+        const std::vector<char> want = bytesOf(fresh);
+        ASSERT_GT(want.size(), 0u);
+        ASSERT_TRUE(want == bytesOf(reused))
+          << "update " << compared << " points of type " << input->GetPoints()->GetDataType();
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 2 * 2 * 6);
+}
