@@ -32,6 +32,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <vector>
 
@@ -116,9 +117,12 @@ struct GridInversion
 
   void PointOf(vtkIdType p, double y[3]) const
   {
-    if (this->Coordinates)
+    if (this->Coordinates) // element by element: GCC calls memmove for std::copy_n, then stalls reading y
     {
-      std::copy_n(this->Coordinates + 3 * p, 3, y);
+      const double* c = this->Coordinates + 3 * p;
+      y[0] = c[0];
+      y[1] = c[1];
+      y[2] = c[2];
       return;
     }
     this->Points->GetPoint(p, y);
@@ -156,7 +160,10 @@ struct GridInversion
       jacobian = ffd::Mat3<double>::Identity();
       status = outside ? InverseStatus::Converged : InverseStatus::NotConverged;
     }
-    std::copy_n(&x.x, 3, this->Out.Points + 3 * p);
+    double* out = this->Out.Points + 3 * p;
+    out[0] = x.x;
+    out[1] = x.y;
+    out[2] = x.z;
     this->Out.Status[p] = static_cast<unsigned char>(status);
     if (!this->Out.Normals)
     {
@@ -195,34 +202,39 @@ struct GridInversion
   }
 };
 
-// The points in the order of the cells that bind them, so that most lane groups (InvertInGroups()) lie in one
-// cell: a point's rest position lies near it. A mesh's vertices may come in any spatial order.
-// `cells` are theirs (GridInversion::Bind()).
+// The points in tiles of OrderTile consecutive points, each tile's in the order of the cells that bind them
+// (GridInversion::Bind(), into `cells`), so that most lane groups (InvertInGroups()) lie in one cell, a point's
+// rest position lying near it, while a tile's points stay in cache: a mesh's vertices may come in any spatial
+// order. A counting sort of each tile by cell modulo OrderBuckets (whole cells for up to that many).
+constexpr vtkIdType OrderTile = 16384;
+constexpr int OrderBuckets = 4096;
 std::vector<vtkIdType> OrderByCell(const GridInversion& inversion, vtkIdType n, std::vector<int>& cells)
 {
   cells.resize(n);
-  vtkSMPTools::For(0, n, vtkFFDGrain(n, 4.0),
-    [&](vtkIdType begin, vtkIdType end)
+  std::vector<vtkIdType> order(n);
+  vtkSMPTools::For(0, (n + OrderTile - 1) / OrderTile, 1,
+    [&](vtkIdType firstTile, vtkIdType endTile)
     {
-      for (vtkIdType p = begin; p < end; ++p)
+      std::vector<vtkIdType> first(OrderBuckets + 1);
+      for (vtkIdType t = firstTile; t < endTile; ++t)
       {
-        double y[3];
-        inversion.PointOf(p, y);
-        cells[p] = inversion.Bind(ffd::Vec3<double>::From(y));
+        const vtkIdType begin = t * OrderTile, end = std::min(n, begin + OrderTile);
+        std::fill(first.begin(), first.end(), begin);
+        for (vtkIdType p = begin; p < end; ++p)
+        {
+          double y[3];
+          inversion.PointOf(p, y);
+          cells[p] = inversion.Bind(ffd::Vec3<double>::From(y));
+          ++first[((cells[p] + 1) & (OrderBuckets - 1)) + 1]; // cell -1 first
+        }
+        std::partial_sum(first.begin() + 1, first.end(), first.begin() + 1,
+          [begin](vtkIdType a, vtkIdType b) { return a + b - begin; });
+        for (vtkIdType p = begin; p < end; ++p)
+        {
+          order[first[(cells[p] + 1) & (OrderBuckets - 1)]++] = p;
+        }
       }
     });
-  // A counting sort, cell -1 first.
-  std::vector<vtkIdType> first(std::size_t(*std::max_element(cells.begin(), cells.end())) + 3, 0);
-  for (const int c : cells)
-  {
-    ++first[std::size_t(c) + 2];
-  }
-  std::partial_sum(first.begin(), first.end(), first.begin());
-  std::vector<vtkIdType> order(n);
-  for (vtkIdType p = 0; p < n; ++p)
-  {
-    order[first[std::size_t(cells[p]) + 1]++] = p;
-  }
   return order;
 }
 
@@ -239,18 +251,41 @@ struct LaneGroup
   unsigned Converged = 0;        // the lanes whose rest position was found; the others are left to ffd::InvertPoint
 };
 
-// The cells of the lanes in `active` (GridInversion::Bind(), or `known` where not null); a lane without one
-// leaves `active`, which is returned. The other lanes take the first active lane's cell, so that they never add
-// a cell to evaluate.
+// The lanes at x that ffd::BindToCells() binds to `cell` (under clamping): along each axis of n cells, the
+// parameter clamped to [0, 1] times n, truncated, within [0, n - 1], is the cell's index. Tested in lanes: most
+// iterates stay in their cell, and binding them one by one would cost a fifth of the search.
+template <typename Deformation, typename Wide, typename Lane>
+inline unsigned StayingLanes(
+  const Deformation& deformation, const Wide& wide, const ffd::CellSplit& split, const ffd::Vec3<Lane>& x, int cell)
+{
+  using Mask = typename Lane::IndexVector;
+  int c[3];
+  deformation.CellIndices(split, cell, c);
+  const ffd::Vec3<Lane> stu = wide.Frame.ToParametric(x);
+  const Lane largest(std::numeric_limits<double>::max());
+  Mask stays = ~Mask{};
+  for (int a = 0; a < 3; ++a)
+  {
+    const int n = ffd::BindingCells(deformation.BasisOf(), deformation.Voxels[a]);
+    const Lane q = Clamp01(stu[a]) * Lane(n);
+    const Mask below = c[a] == n - 1 ? ~Mask{} : q.V < Lane(c[a] + 1).V;
+    stays &= InRange(stu[a], -largest, largest) & (q.V >= Lane(c[a]).V) & below;
+  }
+  return Lane::Bits(stays);
+}
+
+// The cells of the lanes in `active`: `known` where not null, else theirs in `cells` for the lanes of `keep`,
+// else GridInversion::Bind()'s. A lane without one leaves `active`, which is returned. The other lanes take the
+// first active lane's cell, so that they never add a cell to evaluate.
 template <typename Lane>
-inline unsigned BindLanes(
-  const GridInversion& inversion, const ffd::Vec3<Lane>& x, const int* known, unsigned active, int* cells)
+inline unsigned BindLanes(const GridInversion& inversion, const ffd::Vec3<Lane>& x, const int* known, unsigned keep,
+  unsigned active, int* cells)
 {
   for (int l = 0; l < Lane::Width; ++l)
   {
     if (active >> l & 1u)
     {
-      cells[l] = known ? known[l] : inversion.Bind({ x.x.V[l], x.y.V[l], x.z.V[l] });
+      cells[l] = known ? known[l] : keep >> l & 1u ? cells[l] : inversion.Bind({ x.x.V[l], x.y.V[l], x.z.V[l] });
       active &= cells[l] >= 0 ? ~0u : ~(1u << l);
     }
   }
@@ -365,10 +400,12 @@ inline void NewtonInLanes(
   Lane::Deinterleave3(group.Y, y.x, y.y, y.z);
   LaneSearch<Lane> search{ y, ffd::Mat3<Lane>::Identity(), Lane(1.0), (1u << group.Count) - 1, {} };
   bool withJacobian = true;
+  int cells[W];
   for (int step = 0;; ++step)
   {
-    int cells[W];
-    search.Active = BindLanes(inversion, search.X, step == 0 ? group.Cells : nullptr, search.Active, cells);
+    const bool one = step > 0 && std::all_of(cells, cells + W, [&](int c) { return c == cells[0]; });
+    const unsigned keep = one ? StayingLanes(deformation, wide, split, search.X, cells[0]) : 0u;
+    search.Active = BindLanes(inversion, search.X, step == 0 ? group.Cells : nullptr, keep, search.Active, cells);
     if (search.Active == 0)
     {
       return;
@@ -452,14 +489,18 @@ void InvertInGroups(const GridInversion& inversion, const Deformation& deformati
       inversion.PointOf(p, group.Y + 3 * l);
       group.Cells[l] = cells[p];
     }
-    switch (width)
+    switch (width) // the wider variants only where compiled in, as in FFDGridLanes.h
     {
+#if FFD_WIDEST_LANES >= 3
       case 8:
         NewtonInLanesAVX512(inversion, deformation, iterations, group);
         break;
+#endif
+#if FFD_WIDEST_LANES >= 2
       case 4:
         NewtonInLanesAVX2(inversion, deformation, iterations, group);
         break;
+#endif
       default:
         NewtonInLanesSSE2(inversion, deformation, iterations, group);
     }
@@ -484,18 +525,37 @@ void InvertInGroups(const GridInversion& inversion, const Deformation& deformati
 }
 
 // Calls f with the float64 deformation of vtkFFDWithGridDeformation() with its basis known at compile time
-// (ffd::WithStaticBasis()): its fixed-size sums unrolled, as vtkFFDDeform's evaluation has them.
+// (ffd::WithStaticBasis()), its fixed-size sums unrolled, and, for a local basis, its `cells` cells in power form
+// (ffd::FillCellTable(), as vtkFFDDeform's evaluation fills it): F with its Jacobian by Horner's rule costs about
+// half the sums of the control points' weights and their derivatives.
 template <int MaxCount, typename F>
-void WithStaticBasisOf(const ffd::GridDeformation<MaxCount, double>& d, F&& f)
+void WithStaticBasisOf(const ffd::GridDeformation<MaxCount, double>& d, int cells, F&& f)
 {
   ffd::WithStaticBasis(d.Basis,
     [&](auto maxCount, auto basis)
     {
-      if constexpr (decltype(maxCount)::value == MaxCount)
+      constexpr int Basis = decltype(basis)::value;
+      if constexpr (decltype(maxCount)::value != MaxCount)
       {
-        f(ffd::GridDeformation<MaxCount, double, decltype(basis)::value>{ d.Basis,
+        return; // not d's basis
+      }
+      else if constexpr (Basis == int(ffd::GridBasis::Bernstein)) // one cell: no table
+      {
+        f(ffd::GridDeformation<MaxCount, double, Basis>{ d.Basis, { d.Voxels[0], d.Voxels[1], d.Voxels[2] },
+          { d.Dims[0], d.Dims[1], d.Dims[2] }, d.Displacements, d.Frame, nullptr, d.CellVoxels, d.CellSupports });
+      }
+      else
+      {
+        std::vector<double> table(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(d.Basis)));
+        vtkSMPTools::For(0, cells, 256,
+          [&](int begin, int end)
+          {
+            ffd::FillCellTable(
+              d.Basis, d.Displacements, d.Voxels, d.Dims, d.CellVoxels, d.CellSupports, table.data(), begin, end);
+          });
+        f(ffd::GridDeformation<MaxCount, double, Basis, double, true>{ d.Basis,
           { d.Voxels[0], d.Voxels[1], d.Voxels[2] }, { d.Dims[0], d.Dims[1], d.Dims[2] }, d.Displacements, d.Frame,
-          nullptr, d.CellVoxels, d.CellSupports });
+          table.data(), d.CellVoxels, d.CellSupports });
       }
     });
 }
@@ -515,11 +575,19 @@ bool InvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, vtkPoi
   std::vector<int> cells;
   const std::vector<vtkIdType> order = OrderByCell(inversion, n, cells);
   const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
+  const vtkFFDGridLattice& lattice = deformer.GetLattice();
+  const vtkFFDSparseCells* sparse = deformer.GetSparseCells();
+  int cellCount = 1;
+  for (int a = 0; a < 3; ++a)
+  {
+    cellCount *= ffd::BindingCells(lattice.Basis, lattice.Divisions[a]);
+  }
+  cellCount = sparse ? sparse->GetNumberOfCells() : cellCount;
   bool completed = false;
   vtkFFDWithGridDeformation(deformer,
     [&](const auto& dynamic)
     {
-      WithStaticBasisOf(dynamic,
+      WithStaticBasisOf(dynamic, cellCount,
         [&](const auto& deformation)
         {
           auto invert = [&](vtkIdType begin, vtkIdType end)

@@ -45,7 +45,6 @@
 #include "vtkStructuredGrid.h"
 #include "vtkTransformFilter.h"
 #include "vtkTriangleFilter.h"
-#include "vtkWarpTransform.h"
 #include "vtkXMLPolyDataReader.h"
 
 #include <immintrin.h>
@@ -794,36 +793,42 @@ double FrameDiagonal(vtkDataObject* lattice)
     (f[5] + f[8] + f[11]) * (f[5] + f[8] + f[11]));
 }
 
-/// One row of the inverse table: how a rest position was found from the deformed mesh, its time and errors.
+/// One row of the inverse table: a filter that maps the deformed mesh back to rest positions, its times and errors.
 struct InverseRow
 {
   const char* Name;
-  Timing Time;
-  double RestError;     // largest |x - x*| / d: x found, x* the mesh's own rest point, d the frame's diagonal
-  double ResidualError; // largest |F(x) - y| / d: F evaluated by vtkFFDDeform, y the deformed point
+  vtkAlgorithm* Filter;
+  std::vector<double> Times;
+  double RestError = 0.0;     // largest |x - x*| / d: x found, x* the mesh's own rest point, d the frame's diagonal
+  double ResidualError = 0.0; // largest |F(x) - y| / d: F evaluated by vtkFFDDeform, y the deformed point
 };
 
-/// Times Update() of `filter`, whose output are rest positions, `repeats` times (Modified() before each); its
-/// errors from the last output, against the rest mesh and, mapped by `forward` again, against the deformed mesh.
-InverseRow TimeInverse(const char* name, vtkAlgorithm* filter, int repeats, vtkPolyData* rest, vtkPolyData* deformed,
+/// Times Update() of each row's filter `repeats` times (Modified() before each), the rows taking turns so that
+/// a shared machine's load weighs on them alike; then their errors from their last outputs, against the rest
+/// mesh and, mapped by `forward` again, against the deformed mesh.
+void TimeInverses(std::vector<InverseRow>& rows, int repeats, vtkPolyData* rest, vtkPolyData* deformed,
   vtkFFDDeform* forward, double diagonal)
 {
-  const auto update = [filter]()
+  for (int r = 0; r < repeats; ++r)
   {
-    filter->Modified();
-    const Clock::time_point begin = Clock::now();
-    filter->Update();
-    return Seconds(begin);
-  };
-  InverseRow row{ name, Repeat(update, repeats, 0.0), 0.0, 0.0 };
-  vtkPointSet* found = vtkPointSet::SafeDownCast(filter->GetOutputDataObject(0));
-  row.RestError = MaxDistance(found, rest) / diagonal;
-  vtkNew<vtkPolyData> copy;
-  copy->ShallowCopy(found);
-  forward->SetInputData(copy);
-  forward->Update();
-  row.ResidualError = MaxDistance(forward->GetOutput(), deformed) / diagonal;
-  return row;
+    for (InverseRow& row : rows)
+    {
+      row.Filter->Modified();
+      const Clock::time_point begin = Clock::now();
+      row.Filter->Update();
+      row.Times.push_back(Seconds(begin));
+    }
+  }
+  for (InverseRow& row : rows)
+  {
+    vtkPointSet* found = vtkPointSet::SafeDownCast(row.Filter->GetOutputDataObject(0));
+    row.RestError = MaxDistance(found, rest) / diagonal;
+    vtkNew<vtkPolyData> copy;
+    copy->ShallowCopy(found);
+    forward->SetInputData(copy);
+    forward->Update();
+    row.ResidualError = MaxDistance(forward->GetOutput(), deformed) / diagonal;
+  }
 }
 
 /**
@@ -831,7 +836,8 @@ InverseRow TimeInverse(const char* name, vtkAlgorithm* filter, int repeats, vtkP
  * coefficients as in the bases section), at VTK's default InverseTolerance (0.001, in world units) and at
  * 1e-12 of the frame's diagonal (as vtkFFDInverseDeform's default Tolerance), in one run: the mesh (float64)
  * is deformed once by CUBIC_BSPLINE over VtkDivisions^3 voxels, its control points moved as in the other sections;
- * each inverse maps it back. Median and best of `repeats` updates on all threads. Returns false on failure.
+ * each inverse maps it back. Median and best of `repeats` updates on all threads, taking turns. Returns false on
+ * failure.
  */
 bool RunInverseSection(vtkPolyData* mesh, bool quick)
 {
@@ -848,42 +854,46 @@ bool RunInverseSection(vtkPolyData* mesh, bool quick)
   forward->Update();
   vtkNew<vtkPolyData> deformed;
   deformed->DeepCopy(forward->GetOutput());
-  VtkBSpline vtk;
-  if (deformed->GetNumberOfPoints() != rest->GetNumberOfPoints() || !vtk.SetUp(deformed, lattice, VtkDivisions))
+  VtkBSpline vtk[2]; // at the default InverseTolerance, and at 1e-12 d
+  for (VtkBSpline& v : vtk)
   {
-    std::fprintf(stderr, "The inverse section could not deform the mesh, or its frame is not axis-aligned\n");
-    return false;
+    if (deformed->GetNumberOfPoints() != rest->GetNumberOfPoints() || !v.SetUp(deformed, lattice, VtkDivisions))
+    {
+      std::fprintf(stderr, "The inverse section could not deform the mesh, or its frame is not axis-aligned\n");
+      return false;
+    }
+    v.Filter->SetTransform(v.Transform->GetInverse());
+    v.Filter->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
   }
-  vtk.Filter->SetTransform(vtk.Transform->GetInverse());
-  vtk.Filter->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
+  // Set on the forward transform: its inverse copies it at each update.
+  vtk[1].Transform->SetInverseTolerance(1e-12 * diagonal);
   vtkNew<vtkFFDInverseDeform> ours;
   ours->SetInputData(deformed);
   ours->SetLatticeData(lattice.Grid);
-  const int repeats = quick ? 1 : 5;
-  std::vector<InverseRow> rows;
-  rows.push_back(TimeInverse("vtkFFDInverseDeform, Tolerance 1e-12", ours, repeats, rest, deformed, forward, diagonal));
+  const int repeats = quick ? 1 : 7;
+  std::vector<InverseRow> rows = { { "vtkFFDInverseDeform, Tolerance 1e-12", ours },
+    { "VTK GetInverse(), InverseTolerance 0.001", vtk[0].Filter },
+    { "VTK GetInverse(), InverseTolerance 1e-12 d", vtk[1].Filter } };
+  TimeInverses(rows, repeats, rest, deformed, forward, diagonal);
   const vtkIdType unreliable = ours->GetNumberOfFoldedPoints() + ours->GetNumberOfUnconvergedPoints();
-  rows.push_back(
-    TimeInverse("VTK GetInverse(), InverseTolerance 0.001", vtk.Filter, repeats, rest, deformed, forward, diagonal));
-  vtkWarpTransform::SafeDownCast(vtk.Transform->GetInverse())->SetInverseTolerance(1e-12 * diagonal);
-  rows.push_back(
-    TimeInverse("VTK GetInverse(), InverseTolerance 1e-12 d", vtk.Filter, repeats, rest, deformed, forward, diagonal));
 
   std::printf("\nInverse: the mesh (%lld points, float64) deformed by CUBIC_BSPLINE over %d^3 voxels (%d^3 control "
               "points, moved as above), mapped back to its rest positions; %d threads;\nmedian and best of %d "
-              "updates; d: the frame's diagonal (%.4g); x - x*: to the mesh's own points; F(x) - y: x mapped "
-              "forward again by vtkFFDDeform; vs ours: the median's ratio to vtkFFDInverseDeform's.\n"
-              "vtkFFDInverseDeform: %lld points folded or not converged.\n\n",
+              "updates, the filters taking turns; d: the frame's diagonal (%.4g); x - x*: to the mesh's own points; "
+              "F(x) - y: x mapped forward again by vtkFFDDeform;\nvs ours: the median's ratio to "
+              "vtkFFDInverseDeform's. vtkFFDInverseDeform: %lld points folded or not converged.\n\n",
     static_cast<long long>(rest->GetNumberOfPoints()), VtkDivisions, VtkDivisions + 3,
     vtkSMPTools::GetEstimatedNumberOfThreads(), repeats, diagonal, static_cast<long long>(unreliable));
-  std::printf("| inverse                                   | median (s) | best (s) | max |x - x*| / d | "
+  std::printf("| inverse                                    | median (s) | best (s) | max |x - x*| / d | "
               "max |F(x) - y| / d | vs ours |\n");
-  std::printf("|-------------------------------------------|-----------:|---------:|----------------:|"
+  std::printf("|--------------------------------------------|-----------:|---------:|----------------:|"
               "------------------:|--------:|\n");
+  const double ourMedian = BestAndMedian(rows[0].Times).Median;
   for (const InverseRow& r : rows)
   {
-    std::printf("| %-41s | %10.4f | %8.4f | %15.1e | %18.1e | %6.1fx |\n", r.Name, r.Time.Median, r.Time.Best,
-      r.RestError, r.ResidualError, r.Time.Median / rows[0].Time.Median);
+    const Timing t = BestAndMedian(r.Times);
+    std::printf("| %-42s | %10.4f | %8.4f | %15.1e | %18.1e | %6.1fx |\n", r.Name, t.Median, t.Best, r.RestError,
+      r.ResidualError, t.Median / ourMedian);
   }
   std::fflush(stdout);
   return unreliable == 0;
