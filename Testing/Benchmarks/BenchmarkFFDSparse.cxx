@@ -19,6 +19,10 @@
  *   throughput  re-update of the armadillo subdivided twice, sparse against dense, 16^3 to 64^3, every local basis.
  *   --quick     the bear only, up to 256^3: a smoke check (seconds).
  *   --backend   vtkFFDDeform's backend (default cpu; auto takes CUDA where a device is).
+ * One row alone, as each table row runs it: BenchmarkFFDSparse --row mesh.vtp levels divisions basis sparse|dense
+ * cpu|auto (basis as vtkFFDBuildLattice::Bases: 1 TRILINEAR, 4 CUBIC_BSPLINE); it prints "row" and the columns' raw
+ * values: points, active voxels, active control points, peak MB, above mesh MB, B/point, B/voxel, voxelize s,
+ * build s, bind s, re-update s, M points/s, backend.
  */
 
 #include "vtkFFDBuildLattice.h"
