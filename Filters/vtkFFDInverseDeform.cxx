@@ -32,8 +32,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
+#include <utility>
 #include <vector>
 
 vtkStandardNewMacro(vtkFFDInverseDeform);
@@ -202,53 +204,52 @@ struct GridInversion
   }
 };
 
-// The points in tiles of OrderTile consecutive points, each tile's in the order of the cells that bind them
-// (GridInversion::Bind(), into `cells`), so that most lane groups (InvertInGroups()) lie in one cell, a point's
-// rest position lying near it, while a tile's points stay in cache: a mesh's vertices may come in any spatial
-// order. A counting sort of each tile by cell modulo OrderBuckets (whole cells for up to that many).
-constexpr vtkIdType OrderTile = 16384;
-constexpr int OrderBuckets = 4096;
-std::vector<vtkIdType> OrderByCell(const GridInversion& inversion, vtkIdType n, std::vector<int>& cells)
+// A tile of consecutive points in the order of the cells that bind them (GridInversion::Bind()), so that most
+// lane groups (InvertInGroups()) lie in one cell, a point's rest position lying near it: a mesh's vertices may
+// come in any spatial order. A tile is ordered and inverted in one go, its points and results in cache.
+struct OrderedTile
 {
-  cells.resize(n);
-  std::vector<vtkIdType> order(n);
-  vtkSMPTools::For(0, (n + OrderTile - 1) / OrderTile, 1,
-    [&](vtkIdType firstTile, vtkIdType endTile)
+  static constexpr int Buckets = 4096; // a counting sort by cell modulo Buckets: whole cells for up to that many
+  std::vector<vtkIdType> Order;        // the tile's point ids, ordered
+  std::vector<int> Cells;              // their cells, in that order
+  std::vector<int> Bound;              // the cell of each point of the tile, in the tile's order
+  std::vector<vtkIdType> First;        // per bucket, where its points go in Order
+
+  void Sort(const GridInversion& inversion, vtkIdType begin, vtkIdType end)
+  {
+    const vtkIdType count = end - begin;
+    this->Order.resize(count);
+    this->Cells.resize(count);
+    this->Bound.resize(count);
+    this->First.assign(Buckets + 1, 0);
+    for (vtkIdType i = 0; i < count; ++i)
     {
-      std::vector<vtkIdType> first(OrderBuckets + 1);
-      for (vtkIdType t = firstTile; t < endTile; ++t)
-      {
-        const vtkIdType begin = t * OrderTile, end = std::min(n, begin + OrderTile);
-        std::fill(first.begin(), first.end(), begin);
-        for (vtkIdType p = begin; p < end; ++p)
-        {
-          double y[3];
-          inversion.PointOf(p, y);
-          cells[p] = inversion.Bind(ffd::Vec3<double>::From(y));
-          ++first[((cells[p] + 1) & (OrderBuckets - 1)) + 1]; // cell -1 first
-        }
-        std::partial_sum(first.begin() + 1, first.end(), first.begin() + 1,
-          [begin](vtkIdType a, vtkIdType b) { return a + b - begin; });
-        for (vtkIdType p = begin; p < end; ++p)
-        {
-          order[first[(cells[p] + 1) & (OrderBuckets - 1)]++] = p;
-        }
-      }
-    });
-  return order;
-}
+      double y[3];
+      inversion.PointOf(begin + i, y);
+      this->Bound[i] = inversion.Bind(ffd::Vec3<double>::From(y));
+      ++this->First[((this->Bound[i] + 1) & (Buckets - 1)) + 1]; // cell -1 first
+    }
+    std::partial_sum(this->First.begin(), this->First.end(), this->First.begin());
+    for (vtkIdType i = 0; i < count; ++i)
+    {
+      const vtkIdType at = this->First[(this->Bound[i] + 1) & (Buckets - 1)]++;
+      this->Order[at] = begin + i;
+      this->Cells[at] = this->Bound[i];
+    }
+  }
+};
 
 #if FFD_HAVE_LANES
 // Up to 8 points inverted together in SIMD lanes (NewtonInLanes()).
 struct LaneGroup
 {
   static constexpr int MaxWidth = 8;
-  int Count = 0;                 // its points; the lanes past them repeat its last point
-  double Y[3 * MaxWidth];        // the deformed points, x y z each
-  int Cells[MaxWidth];           // their cells (GridInversion::Bind())
-  double X[3 * MaxWidth];        // the rest positions found
-  ffd::Mat3<double> J[MaxWidth]; // the Jacobian there
-  unsigned Converged = 0;        // the lanes whose rest position was found; the others are left to ffd::InvertPoint
+  int Count = 0;          // its points; the lanes past them repeat its last point
+  double Y[3 * MaxWidth]; // the deformed points, x y z each
+  int Cells[MaxWidth];    // their cells (GridInversion::Bind())
+  double X[3 * MaxWidth]; // the rest positions found
+  double J[9][MaxWidth];  // the Jacobian there, by element (row by row) and lane
+  unsigned Converged = 0; // the lanes whose rest position was found; the others are left to ffd::InvertPoint
 };
 
 // The lanes at x that ffd::BindToCells() binds to `cell` (under clamping): along each axis of n cells, the
@@ -307,6 +308,10 @@ template <typename Deformation, typename Wide, typename Lane>
 inline ffd::Vec3<Lane> DeformLanes(const Deformation& deformation, const Wide& wide, const ffd::CellSplit& split,
   const ffd::Vec3<Lane>& x, const int* cells, ffd::Mat3<Lane>* jacobian)
 {
+  if (std::all_of(cells, cells + Lane::Width, [cells](int c) { return c == cells[0]; }))
+  {
+    return jacobian ? wide.Deform(x, cells[0], *jacobian) : wide.Deform(x, cells[0]);
+  }
   // The cells and their lanes as an entry of ffd::BlockCells::List for one group: count, -, (cell, lane bits)...
   int entry[2 + 2 * Lane::Width] = { 0 };
   for (int l = 0; l < Lane::Width; ++l)
@@ -320,16 +325,12 @@ inline ffd::Vec3<Lane> DeformLanes(const Deformation& deformation, const Wide& w
     entry[2 + 2 * k] = cells[l];
     entry[3 + 2 * k] |= 1 << l;
   }
-  if (entry[0] == 1)
-  {
-    return jacobian ? wide.Deform(x, cells[0], *jacobian) : wide.Deform(x, cells[0]);
-  }
   const ffd::detail::GroupCells<Lane> group(deformation, split, entry, 0);
   return jacobian ? ffd::DeformInLaneCells(wide, x, group, *jacobian) : ffd::DeformInLaneCells(wide, x, group);
 }
 
 // The search of a lane group: its iterate, the Jacobian of its last evaluation with one, the lanes still
-// searching and their last residuals.
+// searching and their last residuals, and the rest positions found with J there.
 template <typename Lane>
 struct LaneSearch
 {
@@ -337,46 +338,49 @@ struct LaneSearch
   ffd::Mat3<Lane> Jacobian;
   Lane Det;
   unsigned Active;
-  double Previous[Lane::Width];
+  Lane Previous;
+  ffd::Vec3<Lane> Found;
+  ffd::Mat3<Lane> FoundJacobian;
+  unsigned Converged;
 };
 
-// Settles each searching lane after an evaluation of residual `error`: it leaves the search where det J <= 0,
-// where the residual did not fall, or where the steps ran out; it converged (into `group`) where the residual is
+// Settles the searching lanes after an evaluation of residual `error`, in lanes: a lane leaves the search where
+// det J <= 0, where the residual did not fall, or where the steps ran out; it converged where the residual is
 // within the tolerance. Returns the largest residual of the lanes still searching.
 template <typename Lane>
-inline double SettleLanes(const GridInversion& inversion, LaneSearch<Lane>& search, const Lane& error, int step,
-  int iterations, LaneGroup& group)
+inline double SettleLanes(
+  const GridInversion& inversion, LaneSearch<Lane>& search, const Lane& error, int step, int iterations)
 {
-  double largest = 0;
-  for (int l = 0; l < Lane::Width; ++l)
+  using Mask = typename Lane::IndexVector;
+  const Mask found = error.V <= Lane(inversion.Tolerance).V;
+  Mask drop = ~IsPositive(search.Det);
+  if (step > 0)
   {
-    const unsigned lane = 1u << l;
-    if (!(search.Active & lane))
+    drop |= ~(error.V < search.Previous.V);
+  }
+  if (step >= iterations)
+  {
+    drop |= ~found;
+  }
+  const unsigned converged = Lane::Bits(found & ~drop) & search.Active;
+  search.Active &= ~(Lane::Bits(drop) | converged);
+  search.Previous = error;
+  if (converged)
+  {
+    const Mask in = ffd::detail::MaskOfBits<Lane>(converged, std::make_index_sequence<Lane::Width>());
+    search.Found = { Select(in, search.X.x, search.Found.x), Select(in, search.X.y, search.Found.y),
+      Select(in, search.X.z, search.Found.z) };
+    for (int i = 0; i < 9; ++i)
     {
-      continue;
+      search.FoundJacobian.M[i / 3][i % 3] =
+        Select(in, search.Jacobian.M[i / 3][i % 3], search.FoundJacobian.M[i / 3][i % 3]);
     }
-    const bool found = error.V[l] <= inversion.Tolerance;
-    if (!(search.Det.V[l] > 0) || (step > 0 && !(error.V[l] < search.Previous[l])) || (!found && step >= iterations))
-    {
-      search.Active &= ~lane;
-    }
-    else if (found)
-    {
-      group.X[3 * l] = search.X.x.V[l];
-      group.X[3 * l + 1] = search.X.y.V[l];
-      group.X[3 * l + 2] = search.X.z.V[l];
-      for (int i = 0; i < 9; ++i)
-      {
-        group.J[l].M[i / 3][i % 3] = search.Jacobian.M[i / 3][i % 3].V[l];
-      }
-      group.Converged |= lane;
-      search.Active &= ~lane;
-    }
-    else
-    {
-      largest = std::max(largest, error.V[l]);
-    }
-    search.Previous[l] = error.V[l];
+    search.Converged |= converged;
+  }
+  double largest = 0;
+  for (unsigned active = search.Active; active; active &= active - 1)
+  {
+    largest = std::max(largest, error.V[__builtin_ctz(active)]);
   }
   return largest;
 }
@@ -398,7 +402,8 @@ inline void NewtonInLanes(
   const ffd::CellSplit split = ffd::CellSplit::For(deformation.BasisOf(), deformation.Voxels);
   ffd::Vec3<Lane> y;
   Lane::Deinterleave3(group.Y, y.x, y.y, y.z);
-  LaneSearch<Lane> search{ y, ffd::Mat3<Lane>::Identity(), Lane(1.0), (1u << group.Count) - 1, {} };
+  const ffd::Mat3<Lane> identity = ffd::Mat3<Lane>::Identity();
+  LaneSearch<Lane> search{ y, identity, Lane(1.0), (1u << group.Count) - 1, Lane(0.0), y, identity, 0u };
   bool withJacobian = true;
   int cells[W];
   for (int step = 0;; ++step)
@@ -408,6 +413,12 @@ inline void NewtonInLanes(
     search.Active = BindLanes(inversion, search.X, step == 0 ? group.Cells : nullptr, keep, search.Active, cells);
     if (search.Active == 0)
     {
+      Lane::Interleave3(search.Found.x, search.Found.y, search.Found.z, group.X);
+      for (int i = 0; i < 9; ++i)
+      {
+        std::memcpy(group.J[i], &search.FoundJacobian.M[i / 3][i % 3].V, sizeof(Lane));
+      }
+      group.Converged = search.Converged;
       return;
     }
     const ffd::Vec3<Lane> r =
@@ -416,7 +427,7 @@ inline void NewtonInLanes(
     {
       search.Det = ffd::Determinant(search.Jacobian);
     }
-    const double largest = SettleLanes(inversion, search, sqrt(ffd::Dot(r, r)), step, iterations, group);
+    const double largest = SettleLanes(inversion, search, sqrt(ffd::Dot(r, r)), step, iterations);
     withJacobian = inversion.Out.Normals || !(largest <= inversion.ChordResidual);
     // J^-1 = Cofactor(J)^T / det J.
     const ffd::Mat3<Lane> c = ffd::Cofactor(search.Jacobian);
@@ -468,9 +479,9 @@ int LaneWidth(ffd::SimdLevel level)
   return 1;
 }
 
-// The points order[begin, end) in groups of LaneWidth(level), each through NewtonInLanes() first, its lanes
-// that did not converge there through GridInversion::InvertOne(). A few Newton steps in lanes find nearly every
-// point of a smooth deformation; ffd::InvertPoint alone costs several times more per point.
+// The points order[begin, end) (of cells cells[begin, end)) in groups of LaneWidth(level), each through NewtonInLanes()
+// first, its lanes that did not converge there through GridInversion::InvertOne(). A few Newton steps in lanes find
+// nearly every point of a smooth deformation; ffd::InvertPoint alone costs several times more per point.
 template <typename Deformation>
 void InvertInGroups(const GridInversion& inversion, const Deformation& deformation, ffd::SimdLevel level,
   const vtkIdType* order, const int* cells, vtkIdType begin, vtkIdType end)
@@ -485,9 +496,9 @@ void InvertInGroups(const GridInversion& inversion, const Deformation& deformati
     group.Count = int(std::min<vtkIdType>(width, end - i));
     for (int l = 0; l < width; ++l)
     {
-      const vtkIdType p = order[i + std::min(l, group.Count - 1)];
-      inversion.PointOf(p, group.Y + 3 * l);
-      group.Cells[l] = cells[p];
+      const vtkIdType at = i + std::min(l, group.Count - 1);
+      inversion.PointOf(order[at], group.Y + 3 * l);
+      group.Cells[l] = cells[at];
     }
     switch (width) // the wider variants only where compiled in, as in FFDGridLanes.h
     {
@@ -508,8 +519,13 @@ void InvertInGroups(const GridInversion& inversion, const Deformation& deformati
     {
       if (group.Converged >> l & 1u)
       {
-        inversion.Finish(order[i + l], group.Y + 3 * l, ffd::Vec3<double>::From(group.X + 3 * l), group.J[l],
-          InverseStatus::Converged);
+        ffd::Mat3<double> jacobian;
+        for (int e = 0; e < 9; ++e)
+        {
+          jacobian.M[e / 3][e % 3] = group.J[e][l];
+        }
+        inversion.Finish(
+          order[i + l], group.Y + 3 * l, ffd::Vec3<double>::From(group.X + 3 * l), jacobian, InverseStatus::Converged);
       }
       else
       {
@@ -560,8 +576,8 @@ void WithStaticBasisOf(const ffd::GridDeformation<MaxCount, double>& d, int cell
     });
 }
 
-// Grid lattices: Newton's method on the lattice's float64 evaluation, in SIMD lanes over points ordered by cell
-// (InvertInGroups()).
+// Grid lattices: Newton's method on the lattice's float64 evaluation, in SIMD lanes over tiles of points ordered
+// by cell (OrderedTile, InvertInGroups()).
 bool InvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, vtkPoints* points, vtkDataArray* normals,
   double tolerance, int maxIterations, const InverseOutput& out)
 {
@@ -572,8 +588,9 @@ bool InvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, vtkPoi
     std::sqrt(tolerance) * diagonal, maxIterations, points,
     doubles && doubles->GetNumberOfComponents() == 3 ? doubles->GetPointer(0) : nullptr, normals, out };
   const vtkIdType n = points->GetNumberOfPoints();
-  std::vector<int> cells;
-  const std::vector<vtkIdType> order = OrderByCell(inversion, n, cells);
+  // Tiles of at most 16,384 points (384 kB of float64 coordinates), at least 16 a thread.
+  const vtkIdType tile = std::max<vtkIdType>(
+    1024, std::min<vtkIdType>(16384, n / (16 * std::max(1, vtkSMPTools::GetEstimatedNumberOfThreads()))));
   const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
   const vtkFFDGridLattice& lattice = deformer.GetLattice();
   const vtkFFDSparseCells* sparse = deformer.GetSparseCells();
@@ -590,10 +607,17 @@ bool InvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, vtkPoi
       WithStaticBasisOf(dynamic, cellCount,
         [&](const auto& deformation)
         {
-          auto invert = [&](vtkIdType begin, vtkIdType end)
-          { InvertInGroups(inversion, deformation, level, order.data(), cells.data(), begin, end); };
-          completed =
-            vtkFFDForInChunks(self, n, vtkFFDGrain(n, 8.0 * vtkFFDGridWeightsPerPoint(deformer)), invert, 0.0, 1.0);
+          auto invert = [&](vtkIdType firstTile, vtkIdType endTile)
+          {
+            OrderedTile ordered;
+            for (vtkIdType t = firstTile; t < endTile; ++t)
+            {
+              const vtkIdType begin = t * tile, end = std::min(n, begin + tile);
+              ordered.Sort(inversion, begin, end);
+              InvertInGroups(inversion, deformation, level, ordered.Order.data(), ordered.Cells.data(), 0, end - begin);
+            }
+          };
+          completed = vtkFFDForInChunks(self, (n + tile - 1) / tile, 1, invert, 0.0, 1.0);
         });
     });
   return completed;
