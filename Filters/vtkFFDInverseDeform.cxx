@@ -588,9 +588,9 @@ bool InvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, vtkPoi
     std::sqrt(tolerance) * diagonal, maxIterations, points,
     doubles && doubles->GetNumberOfComponents() == 3 ? doubles->GetPointer(0) : nullptr, normals, out };
   const vtkIdType n = points->GetNumberOfPoints();
-  // Tiles of at most 16,384 points (384 kB of float64 coordinates), at least 16 a thread.
-  const vtkIdType tile = std::max<vtkIdType>(
-    1024, std::min<vtkIdType>(16384, n / (16 * std::max(1, vtkSMPTools::GetEstimatedNumberOfThreads()))));
+  // Tiles of at most 16,384 points (384 kB of float64 coordinates), 64 or more where there are enough points; a
+  // size of n alone, not of the threads.
+  const vtkIdType tile = std::max<vtkIdType>(1024, std::min<vtkIdType>(16384, n / 64));
   const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
   const vtkFFDGridLattice& lattice = deformer.GetLattice();
   const vtkFFDSparseCells* sparse = deformer.GetSparseCells();
@@ -607,17 +607,19 @@ bool InvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, vtkPoi
       WithStaticBasisOf(dynamic, cellCount,
         [&](const auto& deformation)
         {
-          auto invert = [&](vtkIdType firstTile, vtkIdType endTile)
+          // The tiles that start in [first, last), whole: a point's lane group, and so its result, is the same
+          // however the threads split the points.
+          auto invert = [&](vtkIdType first, vtkIdType last)
           {
             OrderedTile ordered;
-            for (vtkIdType t = firstTile; t < endTile; ++t)
+            for (vtkIdType begin = (first + tile - 1) / tile * tile; begin < last; begin += tile)
             {
-              const vtkIdType begin = t * tile, end = std::min(n, begin + tile);
+              const vtkIdType end = std::min(n, begin + tile);
               ordered.Sort(inversion, begin, end);
               InvertInGroups(inversion, deformation, level, ordered.Order.data(), ordered.Cells.data(), 0, end - begin);
             }
           };
-          completed = vtkFFDForInChunks(self, (n + tile - 1) / tile, 1, invert, 0.0, 1.0);
+          completed = vtkFFDForInChunks(self, n, tile, invert, 0.0, 1.0);
         });
     });
   return completed;

@@ -10,9 +10,12 @@
  * char, ffd::InverseStatus): 0 where x was found, 1 where the deformation folds (det J <= 0, so a point can have
  * several rest positions), 2 where the search did not converge.
  *
- * Grid lattices (every basis, dense or sparse): Newton's method with a backtracking line search on the lattice's
- * own evaluation (ffd::InvertPoint, Filters/Kernels/FFDInverse.h), from y minus the displacement at y, each iterate
- * bound to its cell again, until |F(x) - y| <= Tolerance times the frame's diagonal. The search runs on F extended
+ * Grid lattices (every basis, dense or sparse): Newton's method on the lattice's own evaluation, each iterate bound
+ * to its cell again, until |F(x) - y| <= Tolerance times the frame's diagonal. The points go in tiles of consecutive
+ * points, each ordered by cell, several at a time in the SIMD lanes of vtkFFDDeform's evaluation, from x = y, a
+ * local basis's cells in power form. A point whose search there does not settle cleanly (det J <= 0, a residual
+ * that does not fall, 8 steps) starts over alone with a backtracking line search (ffd::InvertPoint,
+ * Filters/Kernels/FFDInverse.h) from y minus the displacement at y, which reports it. The search runs on F extended
  * beyond the lattice's cells (beyond the frame as CLAMP_TO_EDGE extends it; in a sparse lattice's voxels without
  * a cell, by the nearest cell within two voxels), where KEEP_POSITION makes F jump, so that a point pushed out of
  * the cells finds its rest position inside; a search that ends outside the cells gives y itself, its own rest
