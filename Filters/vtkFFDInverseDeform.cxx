@@ -27,6 +27,8 @@
 #include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
 
+#include "FFDCellTable.h"
+#include "FFDCpuTuning.h"
 #include "FFDGridLanes.h"
 #include "FFDInverse.h"
 
@@ -541,37 +543,41 @@ void InvertInGroups(const GridInversion& inversion, const Deformation& deformati
 }
 
 // Calls f with the float64 deformation of vtkFFDWithGridDeformation() with its basis known at compile time
-// (ffd::WithStaticBasis()), its fixed-size sums unrolled, and, for a local basis, its `cells` cells in power form
-// (ffd::FillCellTable(), as vtkFFDDeform's evaluation fills it): F with its Jacobian by Horner's rule costs about
-// half the sums of the control points' weights and their derivatives.
+// (ffd::WithStaticBasis()), its fixed-size sums unrolled, and, for a local basis whose `cells` cells are few enough
+// for `points` points (ffd::WorthCellTable(), as vtkFFDDeform decides), its cells in power form
+// (ffd::FillCellTable()): F with its Jacobian by Horner's rule costs about half the sums of the control points'
+// weights and their derivatives. The table then takes at most 32 bytes a point (trilinear; 6 for the cubic
+// B-spline), where a sparse lattice of millions of cells would otherwise need GBs.
 template <int MaxCount, typename F>
-void WithStaticBasisOf(const ffd::GridDeformation<MaxCount, double>& d, int cells, F&& f)
+void WithStaticBasisOf(const ffd::GridDeformation<MaxCount, double>& d, int cells, vtkIdType points, F&& f)
 {
   ffd::WithStaticBasis(d.Basis,
     [&](auto maxCount, auto basis)
     {
       constexpr int Basis = decltype(basis)::value;
-      if constexpr (decltype(maxCount)::value != MaxCount)
+      if constexpr (decltype(maxCount)::value == MaxCount)
       {
-        return; // not d's basis
-      }
-      else if constexpr (Basis == int(ffd::GridBasis::Bernstein)) // one cell: no table
-      {
-        f(ffd::GridDeformation<MaxCount, double, Basis>{ d.Basis, { d.Voxels[0], d.Voxels[1], d.Voxels[2] },
-          { d.Dims[0], d.Dims[1], d.Dims[2] }, d.Displacements, d.Frame, nullptr, d.CellVoxels, d.CellSupports });
-      }
-      else
-      {
-        std::vector<double> table(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(d.Basis)));
-        vtkSMPTools::For(0, cells, 256,
-          [&](int begin, int end)
+        using Plain = ffd::GridDeformation<MaxCount, double, Basis>;
+        const Plain plain{ d.Basis, { d.Voxels[0], d.Voxels[1], d.Voxels[2] }, { d.Dims[0], d.Dims[1], d.Dims[2] },
+          d.Displacements, d.Frame, nullptr, d.CellVoxels, d.CellSupports };
+        if constexpr (Basis != int(ffd::GridBasis::Bernstein)) // one cell: no table
+        {
+          if (ffd::WorthCellTable(d.Basis, cells, points))
           {
-            ffd::FillCellTable(
-              d.Basis, d.Displacements, d.Voxels, d.Dims, d.CellVoxels, d.CellSupports, table.data(), begin, end);
-          });
-        f(ffd::GridDeformation<MaxCount, double, Basis, double, true>{ d.Basis,
-          { d.Voxels[0], d.Voxels[1], d.Voxels[2] }, { d.Dims[0], d.Dims[1], d.Dims[2] }, d.Displacements, d.Frame,
-          table.data(), d.CellVoxels, d.CellSupports });
+            std::vector<double> table(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(d.Basis)));
+            vtkSMPTools::For(0, cells, 256,
+              [&](int begin, int end)
+              {
+                ffd::FillCellTable(
+                  d.Basis, d.Displacements, d.Voxels, d.Dims, d.CellVoxels, d.CellSupports, table.data(), begin, end);
+              });
+            f(ffd::GridDeformation<MaxCount, double, Basis, double, true>{ plain.Basis,
+              { d.Voxels[0], d.Voxels[1], d.Voxels[2] }, { d.Dims[0], d.Dims[1], d.Dims[2] }, d.Displacements, d.Frame,
+              table.data(), d.CellVoxels, d.CellSupports });
+            return;
+          }
+        }
+        f(plain);
       }
     });
 }
@@ -604,7 +610,7 @@ bool InvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, vtkPoi
   vtkFFDWithGridDeformation(deformer,
     [&](const auto& dynamic)
     {
-      WithStaticBasisOf(dynamic, cellCount,
+      WithStaticBasisOf(dynamic, cellCount, n,
         [&](const auto& deformation)
         {
           // The tiles that start in [first, last), whole: a point's lane group, and so its result, is the same
