@@ -216,6 +216,13 @@ bool vtkFFDSparseLattice::Build(vtkAlgorithm* self, ffd::GridBasis basis, const 
   vtkTypeInt64 dims[3];
   for (int a = 0; a < 3; ++a)
   {
+    // Control points along an axis are counted by an int (3 per voxel and the B-spline's ring at most).
+    if (divisions[a] > (VTK_INT_MAX - 3) / 3)
+    {
+      vtkErrorWithObjectMacro(self, << what << ": " << divisions[a] << " divisions along axis " << a
+                                    << " have more control points than an int counts: use fewer divisions.");
+      return false;
+    }
     this->PointsPerAxis[a] = ffd::ControlPointsAlongAxis(basis, divisions[a]);
     dims[a] = this->PointsPerAxis[a];
   }
