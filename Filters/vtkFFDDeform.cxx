@@ -158,16 +158,12 @@ vtkTypeBool vtkFFDDeform::ProcessRequest(
   {
     return vtkFFDEmptyOutputs(outputVector); // an earlier output would show what the inputs no longer give
   }
+  // A lattice that varies in time (vtkFFDSimulateLattice) must make the mesh re-execute at each time.
   return vtkFFDCatchAllocationFailure(this, outputVector,
     [&]
     {
-      const vtkTypeBool done = this->Superclass::ProcessRequest(request, inputVector, outputVector);
-      // A lattice that varies in time (vtkFFDSimulateLattice) must make the mesh re-execute at each time.
-      if (done)
-      {
-        vtkFFDPipelineKeys::AnnounceTimes(request, inputVector, 2, outputVector);
-      }
-      return done;
+      return vtkFFDPipelineKeys::AnnounceTimes(
+        this->Superclass::ProcessRequest(request, inputVector, outputVector), request, inputVector, 2, outputVector);
     });
 }
 

@@ -745,16 +745,12 @@ int vtkFFDInverseDeform::FillInputPortInformation(int port, vtkInformation* info
 vtkTypeBool vtkFFDInverseDeform::ProcessRequest(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  // A lattice that varies in time (vtkFFDSimulateLattice) must make the mesh re-execute at each time.
   return vtkFFDCatchAllocationFailure(this, outputVector,
     [&]
     {
-      const vtkTypeBool done = this->Superclass::ProcessRequest(request, inputVector, outputVector);
-      // A lattice that varies in time (vtkFFDSimulateLattice) must make the mesh re-execute at each time.
-      if (done)
-      {
-        vtkFFDPipelineKeys::AnnounceTimes(request, inputVector, 2, outputVector);
-      }
-      return done;
+      return vtkFFDPipelineKeys::AnnounceTimes(
+        this->Superclass::ProcessRequest(request, inputVector, outputVector), request, inputVector, 2, outputVector);
     });
 }
 

@@ -86,12 +86,12 @@ bool vtkFFDPipelineKeys::AnnouncedLattice(vtkInformation* inInfo, int& basis, in
 }
 
 //------------------------------------------------------------------------------
-void vtkFFDPipelineKeys::AnnounceTimes(
-  vtkInformation* request, vtkInformationVector** inputs, int ports, vtkInformationVector* outputs)
+int vtkFFDPipelineKeys::AnnounceTimes(
+  int done, vtkInformation* request, vtkInformationVector** inputs, int ports, vtkInformationVector* outputs)
 {
-  if (!request->Has(vtkDemandDrivenPipeline::REQUEST_INFORMATION()))
+  if (!done || !request->Has(vtkDemandDrivenPipeline::REQUEST_INFORMATION()))
   {
-    return;
+    return done;
   }
   vtkInformation* outInfo = outputs->GetInformationObject(0);
   using SDDP = vtkStreamingDemandDrivenPipeline;
@@ -126,7 +126,7 @@ void vtkFFDPipelineKeys::AnnounceTimes(
   outInfo->Remove(SDDP::TIME_RANGE());
   if (!timed)
   {
-    return;
+    return done;
   }
   if (stepped)
   {
@@ -135,4 +135,5 @@ void vtkFFDPipelineKeys::AnnounceTimes(
     outInfo->Set(SDDP::TIME_STEPS(), steps.data(), static_cast<int>(steps.size()));
   }
   outInfo->Set(SDDP::TIME_RANGE(), range, 2);
+  return done;
 }

@@ -41,11 +41,12 @@ public:
    * information vectors), as the executive does of input 0's alone: the union of their TIME_RANGEs, and of their
    * TIME_STEPS where each input that has a range has steps (else the output is continuous in time). A filter whose
    * other input varies in time (a lattice from vtkFFDSimulateLattice) then re-executes when the time changes; the
-   * executive requests the time asked of the output from every input. Call it after the executive's pass of
-   * `request` (its REQUEST_INFORMATION passes input 0's times only); other requests are left alone.
+   * executive requests the time asked of the output from every input. Call it with what the executive's pass of
+   * `request` returned (its REQUEST_INFORMATION passes input 0's times only), which it returns: a failed pass and
+   * other requests are left alone.
    */
-  static void AnnounceTimes(
-    vtkInformation* request, vtkInformationVector** inputs, int ports, vtkInformationVector* outputs);
+  static int AnnounceTimes(
+    int done, vtkInformation* request, vtkInformationVector** inputs, int ports, vtkInformationVector* outputs);
 };
 
 #endif
