@@ -345,8 +345,9 @@ class Dynamics(ParaViewTestCase):
 
 class Clients(ParaViewTestCase):
     """The plugin loads in pvpython and in the GUI, and its filters run there: their statistics are the output's
-    field data, right after the update (information properties read 0 until UpdatePropertyInformation()), and
-    Divisions 0 is an error that leaves the client running (it died of SIGFPE in RequestData, issue 30 item 1)."""
+    field data, right after the update (information properties read 0 until UpdatePropertyInformation()), a
+    dense lattice shows its control points under a spaced label (issue 30 item 4), and Divisions 0 is an error that
+    leaves the client running (it died of SIGFPE in RequestData, item 1)."""
 
     SCRIPT = """
 import json
@@ -354,7 +355,8 @@ from paraview.simple import *
 LoadPlugin({plugin!r}, ns=globals())
 mesh = XMLPolyDataReader(FileName=[{mesh!r}])
 voxels = FFDVoxelize(Input=mesh, Divisions=[3, 3, 3])
-deformed = FFDDeform(Input=mesh, Lattice=FFDBuildLattice(Input=voxels, Basis="Cubic B-Spline"), Backend="CPU")
+lattice = FFDBuildLattice(Input=voxels, Basis="Cubic B-Spline", LatticeForm="Dense")
+deformed = FFDDeform(Input=mesh, Lattice=lattice, Backend="CPU")
 deformed.UpdatePipeline()
 no_voxels = FFDVoxelize(Input=mesh, Divisions=[0, 4, 4])
 no_voxels.UpdatePipeline()
@@ -362,7 +364,9 @@ open({report!r}, "w").write(json.dumps(dict(
     active=voxels.FieldData["NumberOfActiveVoxels"].GetRange()[0],
     cells=voxels.GetDataInformation().GetNumberOfCells(),
     backend=deformed.FieldData["LastBackendUsed"].GetStringValue(0),
-    cells_of_divisions_0=no_voxels.GetDataInformation().GetNumberOfCells())))
+    cells_of_divisions_0=no_voxels.GetDataInformation().GetNumberOfCells(),
+    label=lattice.GetXMLLabel(),
+    representation=Show(lattice, CreateView("RenderView")).SMProxy.GetProperty("Representation").GetElement(0))))
 """
 
     def expected_voxels(self):
@@ -385,6 +389,8 @@ open({report!r}, "w").write(json.dumps(dict(
         self.assertEqual(result["cells"], expected)
         self.assertEqual(result["backend"], "CPU")
         self.assertEqual(result["cells_of_divisions_0"], 0)
+        self.assertEqual(result["label"], "FFD Build Lattice")  # spaced, as ParaView's own labels
+        self.assertEqual(result["representation"], "Points")  # a dense lattice's control points, not its outline
 
     def test_pvpython(self):
         self.check_client(lambda script: [PVPYTHON, "--dr", script])
