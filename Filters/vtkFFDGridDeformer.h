@@ -7,7 +7,8 @@
  * vtkFFDBuildLattice (see vtkFFDDataContract). SetLattice() reads and checks a lattice and keeps its control
  * points' displacements; Bind() finds every point's cell (ffd::BindToGrid) and lists the blocks of points
  * for the SIMD passes, unless the binding is already for these points, the same rest frame, divisions, basis and
- * policy; Evaluate() deforms the bound points on vtkSMPTools threads. Filters/README.md says how the passes work.
+ * policy; Evaluate() deforms the bound points on vtkSMPTools threads. docs/evaluation-design.md says how the
+ * passes work.
  * A lattice is dense (a control point per lattice index) or sparse (vtkFFDSparseCells): both bind and evaluate
  * through the same passes, a sparse lattice's cells numbered in the dense lattice's order.
  */
