@@ -365,7 +365,7 @@ int BindOne(const BindSettings& s, const ffd::Vec3<double>& p)
   // A sparse lattice's cell of the point's voxel, -1 where it has none.
   int v[3];
   return ffd::BindToCells(s.Frame, s.Voxels, p, s.ClampOutside, v)
-    ? s.SparseCells->Find(v[0] + std::int64_t(s.Voxels[0]) * (v[1] + std::int64_t(s.Voxels[1]) * v[2]))
+    ? s.SparseCells->Find(vtkFFDFlatIndex(v[0], v[1], v[2], s.Voxels))
     : -1;
 }
 

@@ -2,6 +2,7 @@
 #include "vtkFFDLatticeBody.h"
 
 #include "vtkFFDDataContract.h"
+#include "vtkFFDFlatIndex.h"
 #include "vtkFFDGridDeformer.h"
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDSparseCells.h"
@@ -37,13 +38,13 @@ std::vector<Pair> DenseSprings(const int dims[3], const std::vector<int>& partic
     {
       for (int i = 0; i < dims[0]; ++i)
       {
-        const int a = particleOf[i + dims[0] * (j + dims[1] * k)];
+        const int a = particleOf[vtkFFDFlatIndex(i, j, k, dims)];
         for (int o = 0; a >= 0 && o < offsets; ++o)
         {
           const int n[3] = { i + Offsets[o][0], j + Offsets[o][1], k + Offsets[o][2] };
           if (n[0] < dims[0] && n[1] >= 0 && n[1] < dims[1] && n[2] >= 0 && n[2] < dims[2])
           {
-            const int b = particleOf[n[0] + dims[0] * (n[1] + dims[1] * n[2])];
+            const int b = particleOf[vtkFFDFlatIndex(n[0], n[1], n[2], dims)];
             if (b >= 0)
             {
               springs.push_back({ a, b });

@@ -11,6 +11,7 @@
 #ifndef vtkFFDOpenVDB_h
 #define vtkFFDOpenVDB_h
 
+#include "vtkFFDFlatIndex.h"
 #include "vtkSMPTools.h"
 #include "vtkType.h"
 
@@ -47,7 +48,7 @@ std::vector<vtkTypeInt64> vtkFFDSortedIndices(const TreeT& tree, const vtkTypeIn
         for (auto it = leaves[l]->cbeginValueOn(); it; ++it)
         {
           const openvdb::Coord x = it.getCoord();
-          *out++ = x.x() + dims[0] * (x.y() + dims[1] * vtkTypeInt64(x.z()));
+          *out++ = vtkFFDFlatIndex(x.x(), x.y(), x.z(), dims);
         }
       }
     });

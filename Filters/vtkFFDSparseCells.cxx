@@ -4,6 +4,7 @@
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkFFDDataContract.h"
+#include "vtkFFDFlatIndex.h"
 #include "vtkIdList.h"
 #include "vtkIntArray.h"
 #include "vtkPointData.h"
@@ -200,7 +201,7 @@ std::string vtkFFDSparseCells::Read(vtkUnstructuredGrid* lattice, ffd::GridBasis
       for (vtkIdType c = begin; c < end; ++c)
       {
         const int* v = voxels + 3 * c;
-        order[c] = { v[0] + std::int64_t(divisions[0]) * (v[1] + std::int64_t(divisions[1]) * v[2]), int(c) };
+        order[c] = { vtkFFDFlatIndex(v[0], v[1], v[2], divisions), int(c) };
       }
     });
   vtkSMPTools::Sort(order.begin(), order.end());

@@ -16,6 +16,7 @@
 #define vtkFFDSparseLattice_h
 
 #include "vtkCellArray.h"
+#include "vtkFFDFlatIndex.h"
 #include "vtkSmartPointer.h"
 #include "vtkType.h"
 
@@ -65,13 +66,6 @@ private:
   struct Internals;
   std::unique_ptr<Internals> Internal;
 };
-
-/// The flat index i + dims[0] (j + dims[1] k) of a voxel or control point of a grid of `dims`: the sparse sets'
-/// key, an int64 since grids of 1024^3 and beyond overflow an int.
-inline vtkTypeInt64 vtkFFDFlatIndex(int i, int j, int k, const int dims[3])
-{
-  return i + vtkTypeInt64(dims[0]) * (j + vtkTypeInt64(dims[1]) * k);
-}
 
 /// Position of control point (i, j, k) of a lattice of `basis` at rest: the one formula of the dense and sparse
 /// lattices and of the voxel grid's corners (the TRILINEAR lattice's points), so that they agree bit for bit.

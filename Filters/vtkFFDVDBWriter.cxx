@@ -221,7 +221,7 @@ bool CheckPoints(vtkAlgorithm* self, const LatticeView& view)
   for (vtkIdType p = 0; p < view.NumPoints; ++p)
   {
     const int* ijk = view.Indices + 3 * p;
-    if (ijk[0] + dims[0] * (ijk[1] + dims[1] * ijk[2]) != sorted[p])
+    if (vtkFFDFlatIndex(ijk[0], ijk[1], ijk[2], dims) != sorted[p])
     {
       vtkErrorWithObjectMacro(self, << "Point " << p << " of the input has LatticeIndex (" << ijk[0] << ", " << ijk[1]
                                     << ", " << ijk[2] << "), where vtkFFDBuildLattice puts another control point: "
