@@ -6,8 +6,8 @@
  * The second stage of the voxel FFD pipeline. The input is a voxel grid (vtkFFDVoxelize's output, or any
  * vtkDataSet with the `FFDFrame` and `FFDDivisions` field arrays and a `VoxelIndex` cell array of 3 ints giving
  * the (i, j, k) of each active voxel, each voxel once). The output is the control lattice of a basis in its rest
- * position, double precision, with the data contract's arrays (README, "Data contract"), in one of two forms
- * (LatticeForm):
+ * position, double precision, with the data contract's arrays (docs/pipeline-and-data-contract.md, "Data contract"), in
+ * one of two forms (LatticeForm):
  * - DENSE: a vtkStructuredGrid of every control point, point (i, j, k) being i + nI*(j + nJ*k) (VTK structured
  *   order, `points.reshape(nK, nJ, nI, 3)` in numpy), with `FFDFrame`, `FFDDivisions`, `FFDBasis` (field data),
  *   `RestPosition` and `Active` (point data). Control points that influence no active voxel under the basis are

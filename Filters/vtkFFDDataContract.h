@@ -3,7 +3,8 @@
  * @class   vtkFFDDataContract
  * @brief   names and accessors of the arrays that voxel grids and lattices carry
  *
- * vtkFFDVoxelize, vtkFFDBuildLattice and vtkFFDDeform agree on a small data contract (README, "Data contract"):
+ * vtkFFDVoxelize, vtkFFDBuildLattice and vtkFFDDeform agree on a small data contract
+ * (docs/pipeline-and-data-contract.md, "Data contract"):
  *
  * | name           | where                 | what                                                         |
  * |----------------|-----------------------|--------------------------------------------------------------|
@@ -16,7 +17,8 @@
  * | `LatticeIndex` | point data, 3 ints    | (i, j, k) of a sparse lattice's control point                |
  *
  * Voxel grids are vtkUnstructuredGrids of the active voxels; lattices are dense (vtkStructuredGrid) or sparse
- * (vtkUnstructuredGrid of the active control points and one cell per active voxel): README, "Data contract".
+ * (vtkUnstructuredGrid of the active control points and one cell per active voxel): docs/pipeline-and-data-contract.md,
+ * "Data contract".
  *
  * This class gathers those names and the checked reads and writes of the field arrays, so that every filter
  * (and a Python script) reads them the same way. The Get methods return false, leaving the output untouched,

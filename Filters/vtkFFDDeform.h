@@ -18,14 +18,14 @@
  * touches only the 8, 27 or 64 control points of the point's voxel. GetNumberOfBindings() counts the bindings.
  * An input whose vertex order is spatially random keeps more with its binding: a copy of its points in the
  * order they are evaluated in, about 23 bytes a point in float32 (35 in float64), and a few hundred KB a
- * thread (README, "What the filters do", says how it is used).
+ * thread (docs/pipeline-and-data-contract.md, "What the filters do", says how it is used).
  *
  * Points outside the frame keep their input position (KEEP_POSITION, the default) or take the displacement at
  * the frame point of their parameters clamped to [0, 1] (CLAMP_TO_EDGE; the nearest point of a box frame; not
- * vtkBSplineTransform's Edge mode, which repeats edge coefficients and so differs outside: see README);
- * non-finite points always keep theirs. Points on a face or corner of the frame are inside. Normals (the
- * input's active point normals) are transformed by the cofactor of the Jacobian (det J times its inverse
- * transpose, the same direction where det J > 0) and renormalized; cell normals, which a non-affine
+ * vtkBSplineTransform's Edge mode, which repeats edge coefficients and so differs outside: see
+ * docs/pipeline-and-data-contract.md); non-finite points always keep theirs. Points on a face or corner of the frame
+ * are inside. Normals (the input's active point normals) are transformed by the cofactor of the Jacobian (det J times
+ * its inverse transpose, the same direction where det J > 0) and renormalized; cell normals, which a non-affine
  * deformation invalidates, are dropped. With ComputeJacobianDeterminant on, the output gets a
  * `JacobianDeterminant` point array (1 where points keep their position) in which folds show as values <= 0.
  *

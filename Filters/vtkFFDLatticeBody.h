@@ -5,7 +5,7 @@
  *
  * Private to the Filters module (not wrapped): what vtkFFDLatticeDynamics simulates, read from a lattice of
  * vtkFFDBuildLattice (dense or sparse) or vtkFFDBuildTetrahedralLattice through vtkFFDDeform's own readers, and
- * from the mesh whose points share the mass (README, "Dynamics"):
+ * from the mesh whose points share the mass (docs/dynamics.md):
  * - particles: the control points whose `Active` is not 0 (all where the lattice has no `Active`);
  * - springs: between particles one lattice step apart along an axis, a voxel face's diagonal or its body's
  *   (the first 3, 9 or 13 of the 13 half-neighbourhood offsets), found on a dense lattice's grid, within a sparse

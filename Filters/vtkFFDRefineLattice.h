@@ -5,7 +5,7 @@
  *
  * The input is a grid lattice of vtkFFDBuildLattice (dense or sparse, at rest or deformed); the output is the
  * lattice of the same frame and basis over 2n voxels per axis (each voxel split into eight), repeated `Levels`
- * times, whose deformation is the input's, for every basis (README, "Level of detail"): trilinear by midpoints,
+ * times, whose deformation is the input's, for every basis (docs/level-of-detail.md): trilinear by midpoints,
  * the Bezier sub-regions by de Casteljau at each voxel's middle, the cubic B-spline by knot insertion, the global
  * Bernstein basis by degree elevation (ffd::RefineRow, Filters/Kernels/FFDRefinement.h). Only the displacements
  * (points minus `RestPosition`) are refined: the output's rest positions are those vtkFFDBuildLattice gives, so

@@ -3,8 +3,8 @@
  * @class   vtkFFDSparseCells
  * @brief   a sparse lattice's cells, read and checked: each one's voxel and support, and the cell of a voxel
  *
- * Private to the Filters module (not wrapped). A sparse lattice (README, "Data contract") is a
- * vtkUnstructuredGrid of control points with their `LatticeIndex` and a cell per active voxel with its
+ * Private to the Filters module (not wrapped). A sparse lattice (docs/pipeline-and-data-contract.md, "Data contract")
+ * is a vtkUnstructuredGrid of control points with their `LatticeIndex` and a cell per active voxel with its
  * `VoxelIndex`. Read() turns its cells into what ffd::GridDeformation evaluates: the cells ordered by their
  * voxel's flat index i + nx (j + ny k) (the order of the dense lattice's cells, so that both deform bit for bit
  * alike), each with its voxel's indices and the point ids of its support in support order (i fastest), each point

@@ -3,7 +3,8 @@
  * @class   vtkFFDVDBReader
  * @brief   reads a sparse lattice and its voxel grid from an OpenVDB file (.vdb) that vtkFFDVDBWriter wrote
  *
- * A source with two outputs, both vtkUnstructuredGrids of the data contract (README, "Data contract"):
+ * A source with two outputs, both vtkUnstructuredGrids of the data contract
+ * (docs/pipeline-and-data-contract.md, "Data contract"):
  * - port 0, the sparse lattice: the lattice vtkFFDBuildLattice builds over the file's active voxels, with its
  *   points where the file puts them. A lattice written from vtkFFDBuildLattice's sparse output comes back
  *   identical: points and `RestPosition` bit for bit, `Active`, `LatticeIndex`, the cells with their types, point
@@ -11,17 +12,17 @@
  *   increasing voxel order, as vtkFFDVoxelize gives the voxels).
  * - port 1, the voxel grid of those voxels, exactly as vtkFFDVoxelize makes it.
  *
- * The file's grids and metadata are vtkFFDVDBWriter's (README, ".vdb files"); the metadata, not the grids'
- * transforms, gives the frame, divisions and basis. The `displacement` grid is the deformation: a control point
- * is at the `position` grid's value where that value minus its rest position is the displacement, bit for bit,
+ * The file's grids and metadata are vtkFFDVDBWriter's (docs/interchange-and-files.md, ".vdb files"); the metadata, not
+ * the grids' transforms, gives the frame, divisions and basis. The `displacement` grid is the deformation: a control
+ * point is at the `position` grid's value where that value minus its rest position is the displacement, bit for bit,
  * as the writer leaves it, and at its rest position plus the displacement where another tool changed the
  * displacement.
  *
  * The file is read whole into memory (its size checked first against the memory the system can give) and
  * parsed by OpenVDB from there, so that no read goes past its end. OpenVDB trusts the sizes in a file, so the
- * checksum that vtkFFDVDBWriter appends (README, ".vdb files") is checked before OpenVDB parses a byte: a file it
- * wrote that was changed or cut since is an error, never a crash or other data. A file without the checksum
- * (another tool's) is parsed as it is: one cut short is an error; damage inside it is OpenVDB's to find. Both
+ * checksum that vtkFFDVDBWriter appends (docs/interchange-and-files.md, ".vdb files") is checked before OpenVDB parses
+ * a byte: a file it wrote that was changed or cut since is an error, never a crash or other data. A file without the
+ * checksum (another tool's) is parsed as it is: one cut short is an error; damage inside it is OpenVDB's to find. Both
  * outputs cost memory in proportion to the active voxels and control points, checked before they are made.
  * Errors (reported with vtkErrorMacro, both outputs then empty): no FileName; a file that is missing, unreadable,
  * damaged, cut short or not a .vdb file (OpenVDB's exceptions are caught and reported); a missing grid or one of

@@ -3,10 +3,10 @@
  * @class   vtkFFDVDBWriter
  * @brief   writes a sparse lattice into an OpenVDB file (.vdb) that Blender, Houdini and OpenVDB's tools open
  *
- * The input is a sparse lattice of a local basis (vtkFFDBuildLattice's SPARSE form, README "Data contract"),
- * its points moved or not. The file holds three grids, each with the frame and divisions as grid metadata
- * (`ffd_frame_origin`, `ffd_frame_s`, `ffd_frame_t`, `ffd_frame_u`: Vec3d; `ffd_divisions`: Vec3i), the lattice's
- * two also with the basis (`ffd_basis`: a string, GetBasisAsString()'s name):
+ * The input is a sparse lattice of a local basis (vtkFFDBuildLattice's SPARSE form, docs/pipeline-and-data-contract.md,
+ * "Data contract"), its points moved or not. The file holds three grids, each with the frame and divisions as grid
+ * metadata (`ffd_frame_origin`, `ffd_frame_s`, `ffd_frame_t`, `ffd_frame_u`: Vec3d; `ffd_divisions`: Vec3i), the
+ * lattice's two also with the basis (`ffd_basis`: a string, GetBasisAsString()'s name):
  * - `active_voxels`, a BoolGrid, true and active at each cell's `VoxelIndex` (i, j, k); its transform puts voxel
  *   (i, j, k)'s centre, X0 + ((i + 1/2)/nx) S + ((j + 1/2)/ny) T + ((k + 1/2)/nz) U, at index (i, j, k), so that a
  *   voxel drawn as OpenVDB draws voxels is the lattice's voxel. A bool grid rather than a mask grid: Houdini's VDB
@@ -30,8 +30,8 @@
  * The file is written whole to a temporary file beside FileName, every write, the flush and the close checked,
  * and only then renamed over FileName (keeping an existing file's permissions): a write that fails part-way (a
  * full disk, a quota, a read-only folder) is an error that leaves the file at FileName as it was and no temporary
- * file behind. After OpenVDB's bytes comes a checksum of them (README, ".vdb files"), which vtkFFDVDBReader checks
- * before parsing and other tools never read.
+ * file behind. After OpenVDB's bytes comes a checksum of them (docs/interchange-and-files.md, ".vdb files"), which
+ * vtkFFDVDBReader checks before parsing and other tools never read.
  *
  * @sa vtkFFDVDBReader vtkFFDBuildLattice
  */

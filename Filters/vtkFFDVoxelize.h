@@ -13,11 +13,11 @@
  *
  * A voxel is active when at least one input point lies in it (points on a face shared by two voxels count for the
  * one with the higher index; points outside an explicit frame count for none). The output is sparse, a
- * vtkUnstructuredGrid of the active voxels only (README, "Data contract"): one VTK_HEXAHEDRON per active voxel, in
- * increasing voxel order (i fastest, then j, then k), with its (i, j, k) in the `VoxelIndex` cell array (3 ints);
- * its points are the active voxels' corners, each once, in increasing corner order, corner (i, j, k) at
- * X0 + (i/nx) S + (j/ny) T + (k/nz) U in double precision. The frame and divisions are stored as the `FFDFrame`
- * and `FFDDivisions` field arrays (vtkFFDDataContract). Any VTK filter or ParaView draws it as it is.
+ * vtkUnstructuredGrid of the active voxels only (docs/pipeline-and-data-contract.md, "Data contract"): one
+ * VTK_HEXAHEDRON per active voxel, in increasing voxel order (i fastest, then j, then k), with its (i, j, k) in the
+ * `VoxelIndex` cell array (3 ints); its points are the active voxels' corners, each once, in increasing corner order,
+ * corner (i, j, k) at X0 + (i/nx) S + (j/ny) T + (k/nz) U in double precision. The frame and divisions are stored as
+ * the `FFDFrame` and `FFDDivisions` field arrays (vtkFFDDataContract). Any VTK filter or ParaView draws it as it is.
  *
  * Memory and time follow the input's points and the active voxels, never nx*ny*nz, so divisions of 1024^3 and
  * beyond are cheap over a small mesh: the active voxels are found in parallel with OpenVDB (a MaskTree per thread,

@@ -13,10 +13,10 @@
  * vertices give nothing. Unlike vtkExtractEdges of VTK 9.1, it skips hidden cells, which a data set whose hidden
  * cells must not be drawn needs.
  *
- * A sparse lattice (a `LatticeIndex` point array, README "Data contract") gives its control net instead of its
- * cells' edges: a line between each two control points whose lattice indices differ by one along one axis, the
- * grid lines a dense lattice shows, where both points exist. (Its cells' edges would show a Bezier sub-region's
- * corners only, and a B-spline's cells, sets of points, have none.)
+ * A sparse lattice (a `LatticeIndex` point array, docs/pipeline-and-data-contract.md, "Data contract") gives its
+ * control net instead of its cells' edges: a line between each two control points whose lattice indices differ by one
+ * along one axis, the grid lines a dense lattice shows, where both points exist. (Its cells' edges would show a Bezier
+ * sub-region's corners only, and a B-spline's cells, sets of points, have none.)
  *
  * @sa vtkFFDLatticeActor vtkFFDVoxelize vtkExtractEdges
  */

@@ -4,7 +4,7 @@
 # The README's two Quick start commands:
 #   Utilities/setup.sh demo [demo options]   set up, build, run the main demo (Examples/Python/deform_mesh.py)
 #   Utilities/setup.sh test [ctest options]  set up, build (the ParaView plugin too), run every test through ctest
-# and the sanitizer run that CI adds (README, Tests):
+# and the sanitizer run that CI adds (docs/testing.md, "Tests"):
 #   Utilities/setup.sh sanitize [ctest options]  the same set-up, then every test of an ASan + UBSan build
 # Set-up = install the missing Debian 12 packages, fetch the real meshes, configure once, build. Every step is
 # skipped when its result is already there, so a second run only costs a no-op ninja.

@@ -8,10 +8,10 @@
  * evaluation recomputes them from the point, which it reads anyway for the displacement form, in the point's
  * own precision, so the binding costs 4 bytes per point and loses no digit of a double-precision point.
  *
- * A sparse lattice (README, "Data contract") binds the same way, then numbers its cells from 0 in increasing
- * order of that flat index (a point in a voxel without a cell keeps its position): the order of the cells, and
- * so every grouping of points by cell, is the dense lattice's, and a sparse lattice deforms its points bit for
- * bit as the dense one does.
+ * A sparse lattice (docs/pipeline-and-data-contract.md, "Data contract") binds the same way, then numbers its cells
+ * from 0 in increasing order of that flat index (a point in a voxel without a cell keeps its position): the order of
+ * the cells, and so every grouping of points by cell, is the dense lattice's, and a sparse lattice deforms its points
+ * bit for bit as the dense one does.
  *
  * Outside policy: a point outside the frame keeps its position, or, with clamping, takes the displacement of
  * the frame point of its parameters clamped to [0, 1] (the nearest point of a box frame), and the Jacobian

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// vtkFFDDeform with sparse lattices (README, "Data contract"): built here by hand from a dense lattice and the
-// voxels of the mesh's points, with cells and points in random order, so that these tests depend neither on
-// vtkFFDVoxelize nor on vtkFFDBuildLattice. A sparse lattice deforms a mesh bit for bit as the dense lattice
+// vtkFFDDeform with sparse lattices (docs/pipeline-and-data-contract.md, "Data contract"): built here by hand from a
+// dense lattice and the voxels of the mesh's points, with cells and points in random order, so that these tests depend
+// neither on vtkFFDVoxelize nor on vtkFFDBuildLattice. A sparse lattice deforms a mesh bit for bit as the dense lattice
 // does (positions, normals, det J, every outside policy); a point in a voxel without a cell keeps its position;
 // malformed sparse lattices are refused with an error.
 

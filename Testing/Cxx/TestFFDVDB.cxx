@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// vtkFFDVDBWriter and vtkFFDVDBReader (README, ".vdb files"): for every local basis, the bear's sparse lattice, its
-// points moved at random, written and read back identical bit for bit (every array, the cells, the field data),
-// with the voxel grid vtkFFDVoxelize makes and the same deformation; OpenVDB's own vdb_print reads the file; a
-// displacement that another tool changed is the deformation read back; every bad input and every malformed file
+// vtkFFDVDBWriter and vtkFFDVDBReader (docs/interchange-and-files.md, ".vdb files"): for every local basis, the bear's
+// sparse lattice, its points moved at random, written and read back identical bit for bit (every array, the cells, the
+// field data), with the voxel grid vtkFFDVoxelize makes and the same deformation; OpenVDB's own vdb_print reads the
+// file; a displacement that another tool changed is the deformation read back; every bad input and every malformed file
 // (made here with OpenVDB) gives an error and empty outputs, never a crash; every byte flipped and every cut of a
 // written file is an error or the file read back identical, in a child process under an address-space limit; a write
 // that fails part-way leaves the old file as it was. File size and times are printed.
@@ -862,7 +862,8 @@ TEST(vtkFFDVDB, AFailedWriteLeavesTheFileAsItWasAndNoTemporaryFile)
 
 TEST(vtkFFDVDB, FileSizeAndTimesOfTheBear)
 {
-  // Printed for the record (README, ".vdb files"); the bounds only catch a file or a time out of proportion.
+  // Printed for the record (docs/interchange-and-files.md, ".vdb files"); the bounds only catch a file or a time out of
+  // proportion.
   vtkSmartPointer<vtkPolyData> bear = ReadTestMesh("bear");
   std::mt19937 rng(512);
   for (int n : { 12, 256 })

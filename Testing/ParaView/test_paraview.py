@@ -231,7 +231,7 @@ class Mpi(ParaViewTestCase):
         self.check(3)
 
     def test_demo_on_two_processes(self):
-        # Examples/ParaView/deform_mesh.py as the README runs it under MPI: the reader straight before
+        # Examples/ParaView/deform_mesh.py as docs/paraview.md runs it under MPI: the reader straight before
         # FFDVoxelize, which asks it for this process's piece, so that the bear is read and deformed once
         # (its vertices counted over the processes), not once a process.
         with tempfile.TemporaryDirectory() as folder:

@@ -1,9 +1,9 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""The command line `python3 -m vtkffd` (README, "Command line"), run as a user runs it, in a subprocess on the bear
-written to .off, .vtp and .ply files: `build` writes the lattice of the same voxelize -> build pipeline run
-in-process, and `deform` of it, or of a lattice moved in-process and saved, gives the points of the in-process
-vtkFFDDeform. Both sides run the same filters on the same inputs (the files keep float64 exactly), so the
+"""The command line `python3 -m vtkffd` (docs/interchange-and-files.md, "Command line"), run as a user runs it, in a
+subprocess on the bear written to .off, .vtp and .ply files: `build` writes the lattice of the same voxelize -> build
+pipeline run in-process, and `deform` of it, or of a lattice moved in-process and saved, gives the points of the
+in-process vtkFFDDeform. Both sides run the same filters on the same inputs (the files keep float64 exactly), so the
 tolerance is 0: bit for bit. Also: `info`'s counts, `convert` round trips, vtkffd.meshio's OFF files (read back bit
 for bit, comments, colours, malformed files), --help, bad input (one line naming the problem, no traceback: files
 cut short or garbled, numbers out of range), writes that fail part-way (the file that was there is kept), and

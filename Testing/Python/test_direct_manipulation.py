@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""Direct manipulation and inverse mapping from Python (README, "Direct manipulation", "Inverse mapping"): mesh
+"""Direct manipulation and inverse mapping from Python (docs/manipulation-and-inverse.md): mesh
 point ids and targets from numpy, the moved lattice's deformation checked with numpy; a manipulated mesh mapped
 back to rest with vtkFFDInverseDeform.
 

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""Interchange from Python (README, "Interchange"): vtkffd.interchange's lattices at rest against
+"""Interchange from Python (docs/interchange-and-files.md, "Interchange"): vtkffd.interchange's lattices at rest against
 vtkFFDBuildLattice's; PyGeM .prm files and ITK .tfm files written by hand in the tests and evaluated by numpy
 references of PyGeM's and ITK's formulas, written here from their sources (pygem/ffd.py and pygem/utils.py;
 itkBSplineTransform.hxx, itkBSplineInterpolationWeightFunction.hxx); vtkBSplineTransform and vtkGridTransform
@@ -150,7 +150,8 @@ def read_text(path):
 
 
 def tetrahedral_lattice():
-    """A control mesh of one tetrahedron with RestPosition and no FFDFrame (README, "Data contract")."""
+    """A control mesh of one tetrahedron with RestPosition and no FFDFrame
+    (docs/pipeline-and-data-contract.md, "Data contract")."""
     corners = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
     points = vtkPoints()
     points.SetData(numpy_to_vtk(corners, deep=True))

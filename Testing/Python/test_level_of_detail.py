@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""Level of detail from Python (README, "Level of detail"): exact refinement, coarsening by least squares,
+"""Level of detail from Python (docs/level-of-detail.md): exact refinement, coarsening by least squares,
 detail lattices chosen with numpy, and several blocks on one mesh, each checked with numpy against the deformation
 it must reproduce.
 
@@ -56,7 +56,7 @@ class TestLevelOfDetail(unittest.TestCase):
         self.rng = np.random.default_rng(20261126)
 
     def test_a_refined_lattice_deforms_the_cow_as_the_coarse_one(self):
-        # Two float64 sums of at most 35 937 weighted displacements each (README, "Level of detail"): 1e-12 of
+        # Two float64 sums of at most 35 937 weighted displacements each (docs/level-of-detail.md): 1e-12 of
         # the diagonal bounds their difference.
         for basis in BASES:
             _, _, coarse = build_lattice(self.cow, (3, 2, 2), basis)

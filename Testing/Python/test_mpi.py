@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""A mesh split among MPI processes (README, "Several processes"): with vtkMPIController as the global controller,
+"""A mesh split among MPI processes (docs/mpi.md): with vtkMPIController as the global controller,
 vtkFFDVoxelize on 2 and 3 processes, each holding a piece of the bear (every N-th point, in reverse order),
 gives every process the voxel grid that one process makes of the whole bear, bit for bit (axis-aligned and
 principal-axes frames); each process builds the same lattice, deforms its piece, and the pieces put together are

@@ -1,10 +1,10 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""The .vdb files from Python (README, ".vdb files"): a sparse cubic B-spline lattice over the bear, its points
-moved through numpy, written by vtkFFDVDBWriter and read back by vtkFFDVDBReader bit for bit (points, every point,
-cell and field array, the cells), the voxel grid of output port 1 that of vtkFFDVoxelize, the same deformation;
-a dense lattice, a missing file and a damaged one are errors with empty outputs; a write that fails part-way
-leaves the file that was there as it was.
+"""The .vdb files from Python (docs/interchange-and-files.md, ".vdb files"): a sparse cubic B-spline lattice over the
+bear, its points moved through numpy, written by vtkFFDVDBWriter and read back by vtkFFDVDBReader bit for bit (points,
+every point, cell and field array, the cells), the voxel grid of output port 1 that of vtkFFDVoxelize, the same
+deformation; a dense lattice, a missing file and a damaged one are errors with empty outputs; a write that fails
+part-way leaves the file that was there as it was.
 
 Run with Debian's /usr/bin/python3, PYTHONPATH=<build>/lib/python3/dist-packages and VOXELFFD_MESH_DIR set to the
 folder of the meshes (ctest does both). Exits non-zero when a test fails.

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Image regression test of a sparse lattice and a sparse voxel grid (README, "Data contract"): the bear voxelized
-// with 8 x 10 x 5 voxels and a sparse TRIQUADRATIC_BEZIER lattice over its active voxels only. The control points
-// around the right ear (the viewer's left) are selected by their LatticeIndex and dragged up and out through
-// vtkFFDLatticeRepresentation (the widget's geometry), as a drag would move them; the mesh follows through
-// vtkFFDDeform without a new binding, and equals a fresh vtkFFDDeform of the moved lattice. Drawn with
+// Image regression test of a sparse lattice and a sparse voxel grid (docs/pipeline-and-data-contract.md,
+// "Data contract"): the bear voxelized with 8 x 10 x 5 voxels and a sparse TRIQUADRATIC_BEZIER lattice over its active
+// voxels only. The control points around the right ear (the viewer's left) are selected by their LatticeIndex and
+// dragged up and out through vtkFFDLatticeRepresentation (the widget's geometry), as a drag would move them; the mesh
+// follows through vtkFFDDeform without a new binding, and equals a fresh vtkFFDDeform of the moved lattice. Drawn with
 // vtkFFDLatticeActor: the control net between existing control points only, and the active voxels' boxes only.
 // Compared with Testing/Data/Baseline/TestFFDSparseLatticeImage.png.
 #include "FFDImageTestScene.h"

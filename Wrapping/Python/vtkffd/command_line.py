@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 """The command line `python3 -m vtkffd`: build a lattice around a mesh, deform a mesh by a lattice (or map it back),
-describe or convert a lattice file. main() is its entry point; README, "Command line", shows it at work.
+describe or convert a lattice file. main() is its entry point; docs/interchange-and-files.md, "Command line", shows it
+at work.
 
 Meshes are read and written by vtkffd.meshio, lattices by vtkffd.interchange, each by its file's extension; a
 write that fails leaves the file that was there. A user's mistake (a missing file, an unknown extension, a file

@@ -1,12 +1,12 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""Lattices to and from other tools (README, "Interchange"): PyGeM's FFD parameter files (.prm), VTK's
-vtkBSplineTransform and vtkGridTransform, ITK's BSplineTransform in its text transform files (.tfm), and the
+"""Lattices to and from other tools (docs/interchange-and-files.md, "Interchange"): PyGeM's FFD parameter files (.prm),
+VTK's vtkBSplineTransform and vtkGridTransform, ITK's BSplineTransform in its text transform files (.tfm), and the
 lattice files of VTK and OpenVDB, chosen by extension (read_lattice, write_lattice).
 
-Every import returns a dense lattice (vtkStructuredGrid, README "Data contract") built by vtkFFDBuildLattice
-(lattice_at_rest) with its points moved by the other tool's displacements, so that vtkFFDDeform deforms a mesh
-as that tool does inside the frame. Outside the frame each tool keeps its own rule: PyGeM and ITK leave points
-where they are, as vtkFFDDeform does by default; vtkGridTransform clamps to its grid's edge, as
+Every import returns a dense lattice (vtkStructuredGrid, docs/pipeline-and-data-contract.md, "Data contract") built by
+vtkFFDBuildLattice (lattice_at_rest) with its points moved by the other tool's displacements, so that vtkFFDDeform
+deforms a mesh as that tool does inside the frame. Outside the frame each tool keeps its own rule: PyGeM and ITK leave
+points where they are, as vtkFFDDeform does by default; vtkGridTransform clamps to its grid's edge, as
 vtkFFDDeform's ClampToEdge policy does; vtkBSplineTransform's border modes extend the spline in ways that no
 policy reproduces.
 
