@@ -96,10 +96,10 @@ vtkIdType FirstMovedRestPosition(vtkPointSet* lattice, vtkDataArray* rest, const
 }
 
 //------------------------------------------------------------------------------------------------------------
-// A grid lattice's rest positions are fixed by its frame (README, "Data contract"). They leave it where a transform
-// moved RestPosition as a vector together with the points (vtkTransformFilter's TransformAllInputVectors, on by
-// default in ParaView's Transform): the lattice would then deform nothing however it was rotated or scaled. The
-// check runs again only when the arrays or the frame change (`checked`).
+// A grid lattice's rest positions are fixed by its frame (docs/pipeline-and-data-contract.md, "Data contract"). They
+// leave it where a transform moved RestPosition as a vector together with the points (vtkTransformFilter's
+// TransformAllInputVectors, on by default in ParaView's Transform): the lattice would then deform nothing however it
+// was rotated or scaled. The check runs again only when the arrays or the frame change (`checked`).
 std::string CheckRestPositions(
   vtkPointSet* lattice, vtkDataArray* rest, const vtkFFDGridLattice& view, vtkFFDRestCheck& checked)
 {

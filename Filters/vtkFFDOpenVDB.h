@@ -5,8 +5,8 @@
  *
  * OpenVDB's headers cost ~12 s per translation unit, so only vtkFFDSparseLattice.cxx (the sparse sets),
  * vtkFFDVDBWriter.cxx and vtkFFDVDBReader.cxx (the .vdb files) include them, through this header: the sorted
- * active coordinates of a tree, and the layout of the .vdb files (README, ".vdb files") with their checksum trailer,
- * named once for the writer and the reader.
+ * active coordinates of a tree, and the layout of the .vdb files (docs/interchange-and-files.md, ".vdb files") with
+ * their checksum trailer, named once for the writer and the reader.
  */
 #ifndef vtkFFDOpenVDB_h
 #define vtkFFDOpenVDB_h
@@ -56,7 +56,7 @@ std::vector<vtkTypeInt64> vtkFFDSortedIndices(const TreeT& tree, const vtkTypeIn
   return indices;
 }
 
-/// The grids and metadata of a VoxelFFD .vdb file (README, ".vdb files").
+/// The grids and metadata of a VoxelFFD .vdb file (docs/interchange-and-files.md, ".vdb files").
 namespace vtkFFDVDB
 {
 /// The active voxels: a BoolGrid, true and active at voxel (i, j, k), whose index space puts (i, j, k) at the

@@ -243,7 +243,8 @@ bool CheckPoints(vtkAlgorithm* self, const LatticeView& view)
   return true;
 }
 
-/// The file's three grids (README, ".vdb files"): empty, with the error reported, where two cells share a voxel.
+/// The file's three grids (docs/interchange-and-files.md, ".vdb files"): empty, with the error reported, where two
+/// cells share a voxel.
 openvdb::GridCPtrVec MakeGrids(vtkAlgorithm* self, const LatticeView& view)
 {
   openvdb::initialize();
