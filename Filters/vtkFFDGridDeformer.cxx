@@ -143,7 +143,7 @@ std::string CheckRestPositions(
            "transform moved them as vectors (VTK's vtkTransformFilter / ParaView's Transform with "
            "TransformAllInputVectors on); transform the lattice with that option off, so that only its points move. "
            "Without a transform, rebuild the lattice with vtkFFDBuildLattice, or keep its RestPosition where the "
-           "frame puts it (README, \"Data contract\").";
+           "frame puts it (docs/pipeline-and-data-contract.md, \"Data contract\").";
     return msg.str();
   }
   checked = key;

@@ -116,8 +116,8 @@ std::string vtkFFDSparseCells::Read(vtkUnstructuredGrid* lattice, ffd::GridBasis
   vtkIntArray* latticeIndex =
     IndexArray(lattice->GetPointData(), vtkFFDDataContract::LatticeIndexArrayName(), numPoints);
   vtkIntArray* voxelIndex = IndexArray(lattice->GetCellData(), vtkFFDDataContract::VoxelIndexArrayName(), numCells);
-  const std::string fix = " Build the lattice with vtkFFDBuildLattice, or keep its data contract (README, \"Data "
-                          "contract\").";
+  const std::string fix = " Build the lattice with vtkFFDBuildLattice, or keep its data contract "
+                          "(docs/pipeline-and-data-contract.md, \"Data contract\").";
   // An index array of 3 components but not of ints is what a transform of double precision leaves.
   auto notInts = [](vtkFieldData* data, const char* name)
   {

@@ -234,7 +234,7 @@ bool FindGrids(vtkFFDVDBReader* self, const openvdb::GridPtrVec& grids, Grids& f
     {
       vtkErrorWithObjectMacro(self, << "The grid \"" << names[g] << "\" of " << self->GetFileName()
                                     << " has no metadata " << missing
-                                    << ": write the file with vtkFFDVDBWriter, or add it (README, \".vdb files\").");
+                                    << ": write the file with vtkFFDVDBWriter, or add it (docs/interchange-and-files.md, \".vdb files\").");
       return false;
     }
   }

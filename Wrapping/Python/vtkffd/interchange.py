@@ -666,8 +666,8 @@ def _require_lattice_arrays(data, path):
     rest = data.GetPointData().GetArray(vtkFFDDataContract.RestPositionArrayName())
     if data.GetPoints() is None or rest is None or rest.GetNumberOfComponents() != 3 or \
             rest.GetNumberOfTuples() != data.GetNumberOfPoints():
-        raise ValueError("%s holds no lattice: its points have no RestPosition of 3 components each (README, "
-                         "\"Data contract\")" % path)
+        raise ValueError("%s holds no lattice: its points have no RestPosition of 3 components each "
+                         "(docs/pipeline-and-data-contract.md, \"Data contract\")" % path)
 
 
 def read_lattice(path):
