@@ -18,6 +18,7 @@
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
 #include "vtkUnstructuredGrid.h"
 
 #include <Eigen/Dense>
@@ -26,6 +27,8 @@
 #include <cmath>
 #include <map>
 #include <sstream>
+#include <string>
+#include <vector>
 
 vtkStandardNewMacro(vtkFFDDirectManipulation);
 
@@ -82,6 +85,182 @@ Eigen::MatrixXd SolveMove(const Eigen::MatrixXd& w, const Eigen::MatrixXd& chang
     return w.transpose() * gram.ldlt().solve(change);
   }
   return Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(w).solve(change);
+}
+
+/// False, said why, where there is no mesh, not one position per target id, or no usable regularization.
+bool CheckSettings(
+  vtkFFDDirectManipulation* self, vtkPointSet* mesh, vtkPoints* positions, vtkIdType count, double regularization)
+{
+  if (!mesh || !mesh->GetPoints())
+  {
+    vtkErrorWithObjectMacro(
+      self, << "No mesh: SetMeshConnection() (input 1) to the mesh at rest that the lattice deforms.");
+    return false;
+  }
+  if (!positions || positions->GetNumberOfPoints() != count)
+  {
+    vtkErrorWithObjectMacro(self, << "There are " << count << " target point ids but "
+                                  << (positions ? positions->GetNumberOfPoints() : 0)
+                                  << " target positions: give one position per id.");
+    return false;
+  }
+  if (!std::isfinite(regularization) || regularization < 0)
+  {
+    vtkErrorWithObjectMacro(self, << "Regularization is " << regularization
+                                  << ": give SetRegularization() a finite number >= 0 (0, the default: the "
+                                     "pseudo-inverse).");
+    return false;
+  }
+  return true;
+}
+
+/// The targets' rest points, into `rest`, and where the lattice takes them now; nullptr, said why, where the
+/// targets cannot be used or deformed.
+vtkSmartPointer<vtkPointSet> PlaceTargets(vtkFFDDirectManipulation* self, vtkIdTypeArray* ids, vtkPoints* positions,
+  vtkPointSet* mesh, vtkPointSet* lattice, vtkPoints* rest)
+{
+  const std::string unusable = ReadTargets(ids, positions, mesh, rest);
+  if (!unusable.empty())
+  {
+    vtkErrorWithObjectMacro(self, << unusable);
+    return nullptr;
+  }
+  vtkNew<vtkPolyData> targets;
+  targets->SetPoints(rest);
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(targets);
+  deform->SetLatticeData(lattice);
+  deform->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
+  deform->Update();
+  vtkSmartPointer<vtkPointSet> now = vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0));
+  if (!now || now->GetNumberOfPoints() != ids->GetNumberOfValues())
+  {
+    vtkErrorWithObjectMacro(self, << "Could not deform the targets by the lattice (see the error above).");
+    return nullptr;
+  }
+  return now;
+}
+
+/// An entry of W: the weight of a target on a control point.
+struct Entry
+{
+  vtkIdType Target;
+  vtkIdType ControlPoint;
+  double Weight;
+};
+
+/// The nonzero entries of W, each target's weights on the control points of its cell, and each target's cell
+/// (-1: outside the lattice, said so); false, said why, where the targets cannot be bound to the lattice.
+bool TargetWeights(vtkFFDDirectManipulation* self, vtkPointSet* lattice, vtkPoints* rest, std::vector<Entry>& entries,
+  std::vector<int>& cellOf)
+{
+  const vtkIdType count = rest->GetNumberOfPoints();
+  auto add = [&](vtkIdType target, vtkIdType controlPoint, double weight)
+  {
+    if (weight != 0)
+    {
+      entries.push_back({ target, controlPoint, weight });
+    }
+  };
+  bool rebound = false;
+  if (vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice))
+  {
+    vtkFFDTetrahedralDeformer tetrahedra;
+    const std::string why = tetrahedra.SetLattice(vtkUnstructuredGrid::SafeDownCast(lattice));
+    if (!why.empty() || !tetrahedra.Bind(rest, vtkFFDTetrahedralDeformer::KEEP_POSITION, nullptr, 0, 1, rebound))
+    {
+      vtkErrorWithObjectMacro(self, << "Cannot bind the targets to the lattice. " << why);
+      return false;
+    }
+    cellOf = tetrahedra.GetCellOfPoint();
+    vtkFFDForEachTetrahedronWeight(tetrahedra, rest, 0, count, add);
+  }
+  else
+  {
+    vtkFFDGridDeformer grid;
+    const std::string why = grid.SetLattice(lattice);
+    if (!why.empty() || !grid.Bind(rest, vtkFFDDeform::KEEP_POSITION, nullptr, 0, 1, rebound))
+    {
+      vtkErrorWithObjectMacro(self, << "Cannot bind the targets to the lattice. " << why);
+      return false;
+    }
+    cellOf = grid.GetCellOfPoint();
+    vtkFFDForEachGridWeight(grid, rest, 0, count, add);
+  }
+  const vtkIdType outside = std::count(cellOf.begin(), cellOf.end(), -1);
+  if (outside > 0)
+  {
+    vtkWarningWithObjectMacro(
+      self, << outside << " of the " << count << " targets lie outside the lattice: they cannot be moved.");
+  }
+  return true;
+}
+
+/// The control points that move some target, in increasing order, and the column of W of each.
+std::vector<vtkIdType> MovingControlPoints(const std::vector<Entry>& entries, std::map<vtkIdType, Eigen::Index>& column)
+{
+  for (const Entry& e : entries)
+  {
+    column.emplace(e.ControlPoint, 0);
+  }
+  std::vector<vtkIdType> controlPoints;
+  for (auto& c : column)
+  {
+    c.second = Eigen::Index(controlPoints.size());
+    controlPoints.push_back(c.first);
+  }
+  return controlPoints;
+}
+
+/// W: a row per target, a column per control point that moves some target.
+Eigen::MatrixXd WeightMatrix(
+  const std::vector<Entry>& entries, std::map<vtkIdType, Eigen::Index>& column, vtkIdType count)
+{
+  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(count, Eigen::Index(column.size()));
+  for (const Entry& e : entries)
+  {
+    w(Eigen::Index(e.Target), column[e.ControlPoint]) = e.Weight;
+  }
+  return w;
+}
+
+/// T - F: from where the lattice takes each target's point now to the target (0 for a target outside).
+Eigen::MatrixXd TargetChanges(vtkPoints* positions, vtkPointSet* now, const std::vector<int>& cellOf)
+{
+  const vtkIdType count = now->GetNumberOfPoints();
+  Eigen::MatrixXd change(count, 3);
+  for (vtkIdType t = 0; t < count; ++t)
+  {
+    double target[3], at[3];
+    positions->GetPoint(t, target);
+    now->GetPoint(t, at);
+    for (int c = 0; c < 3; ++c)
+    {
+      change(t, c) = cellOf[t] >= 0 ? target[c] - at[c] : 0.0;
+    }
+  }
+  return change;
+}
+
+/// The lattice's points with `controlPoints` moved by the rows of `move`; `moved` counts those that moved.
+vtkSmartPointer<vtkPoints> MovedPoints(
+  vtkPointSet* lattice, const std::vector<vtkIdType>& controlPoints, const Eigen::MatrixXd& move, vtkIdType& moved)
+{
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->DeepCopy(lattice->GetPoints());
+  for (std::size_t c = 0; c < controlPoints.size(); ++c)
+  {
+    double x[3];
+    points->GetPoint(controlPoints[c], x);
+    for (int a = 0; a < 3; ++a)
+    {
+      x[a] += move(Eigen::Index(c), a);
+    }
+    points->SetPoint(controlPoints[c], x);
+    moved += move.row(Eigen::Index(c)).squaredNorm() > 0;
+  }
+  return points.Get();
 }
 } // namespace
 
@@ -203,101 +382,26 @@ int vtkFFDDirectManipulation::RequestData(
   {
     return 1; // nothing asked: the lattice as it is
   }
-  if (!mesh || !mesh->GetPoints())
+  auto fail = [output]
   {
-    vtkErrorMacro(<< "No mesh: SetMeshConnection() (input 1) to the mesh at rest that the lattice deforms.");
     output->Initialize();
     return 0;
-  }
-  if (!this->TargetPositions || this->TargetPositions->GetNumberOfPoints() != count)
+  };
+  if (!CheckSettings(this, mesh, this->TargetPositions, count, this->Regularization))
   {
-    vtkErrorMacro(<< "There are " << count << " target point ids but "
-                  << (this->TargetPositions ? this->TargetPositions->GetNumberOfPoints() : 0)
-                  << " target positions: give one position per id.");
-    output->Initialize();
-    return 0;
+    return fail();
   }
 
-  if (!std::isfinite(this->Regularization) || this->Regularization < 0)
-  {
-    vtkErrorMacro(<< "Regularization is " << this->Regularization
-                  << ": give SetRegularization() a finite number >= 0 (0, the default: the pseudo-inverse).");
-    output->Initialize();
-    return 0;
-  }
-
-  // The targets' rest points, and where the lattice takes them now.
+  // The targets' rest points, where the lattice takes them now, and W: each target's weights.
   vtkNew<vtkPoints> rest;
   rest->SetDataTypeToDouble();
-  const std::string unusable = ReadTargets(this->TargetPointIds, this->TargetPositions, mesh, rest);
-  if (!unusable.empty())
-  {
-    vtkErrorMacro(<< unusable);
-    output->Initialize();
-    return 0;
-  }
-  vtkNew<vtkPolyData> targets;
-  targets->SetPoints(rest);
-  vtkNew<vtkFFDDeform> deform;
-  deform->SetInputData(targets);
-  deform->SetLatticeData(lattice);
-  deform->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
-  deform->Update();
-  vtkPointSet* now = vtkPointSet::SafeDownCast(deform->GetOutputDataObject(0));
-  if (!now || now->GetNumberOfPoints() != count)
-  {
-    vtkErrorMacro(<< "Could not deform the targets by the lattice (see the error above).");
-    output->Initialize();
-    return 0;
-  }
-
-  // W: each target's weights, over the control points that move some target.
-  struct Entry
-  {
-    vtkIdType Target;
-    vtkIdType ControlPoint;
-    double Weight;
-  };
+  const vtkSmartPointer<vtkPointSet> now =
+    PlaceTargets(this, this->TargetPointIds, this->TargetPositions, mesh, lattice, rest);
   std::vector<Entry> entries;
-  auto add = [&](vtkIdType target, vtkIdType controlPoint, double weight)
-  {
-    if (weight != 0)
-    {
-      entries.push_back({ target, controlPoint, weight });
-    }
-  };
-  bool rebound = false;
   std::vector<int> cellOf;
-  if (vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice))
+  if (!now || !TargetWeights(this, lattice, rest, entries, cellOf))
   {
-    vtkFFDTetrahedralDeformer tetrahedra;
-    const std::string why = tetrahedra.SetLattice(vtkUnstructuredGrid::SafeDownCast(lattice));
-    if (!why.empty() || !tetrahedra.Bind(rest, vtkFFDTetrahedralDeformer::KEEP_POSITION, nullptr, 0, 1, rebound))
-    {
-      vtkErrorMacro(<< "Cannot bind the targets to the lattice. " << why);
-      output->Initialize();
-      return 0;
-    }
-    cellOf = tetrahedra.GetCellOfPoint();
-    vtkFFDForEachTetrahedronWeight(tetrahedra, rest, 0, count, add);
-  }
-  else
-  {
-    vtkFFDGridDeformer grid;
-    const std::string why = grid.SetLattice(lattice);
-    if (!why.empty() || !grid.Bind(rest, vtkFFDDeform::KEEP_POSITION, nullptr, 0, 1, rebound))
-    {
-      vtkErrorMacro(<< "Cannot bind the targets to the lattice. " << why);
-      output->Initialize();
-      return 0;
-    }
-    cellOf = grid.GetCellOfPoint();
-    vtkFFDForEachGridWeight(grid, rest, 0, count, add);
-  }
-  const vtkIdType outside = std::count(cellOf.begin(), cellOf.end(), -1);
-  if (outside > 0)
-  {
-    vtkWarningMacro(<< outside << " of the " << count << " targets lie outside the lattice: they cannot be moved.");
+    return fail();
   }
   // The distance from target t to where the lattice takes its point now.
   auto apart = [&](vtkIdType t)
@@ -308,11 +412,8 @@ int vtkFFDDirectManipulation::RequestData(
     return std::sqrt(vtkMath::Distance2BetweenPoints(target, at));
   };
   std::map<vtkIdType, Eigen::Index> column;
-  for (const Entry& e : entries)
-  {
-    column.emplace(e.ControlPoint, 0);
-  }
-  if (column.empty())
+  const std::vector<vtkIdType> controlPoints = MovingControlPoints(entries, column);
+  if (controlPoints.empty())
   {
     // No target inside: no control point can move them (and W would have no column to decompose).
     for (vtkIdType t = 0; t < count; ++t)
@@ -321,61 +422,24 @@ int vtkFFDDirectManipulation::RequestData(
     }
     return 1;
   }
-  std::vector<vtkIdType> controlPoints;
-  for (auto& c : column)
-  {
-    c.second = Eigen::Index(controlPoints.size());
-    controlPoints.push_back(c.first);
-  }
   std::ostringstream request;
   request << "Direct manipulation of " << count << " targets over " << controlPoints.size() << " control points";
   if (!vtkFFDCheckMemory(this, request.str(), 8.0 * double(count) * double(controlPoints.size() + count + 6)))
   {
-    output->Initialize();
-    return 0;
-  }
-  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(count, Eigen::Index(controlPoints.size()));
-  for (const Entry& e : entries)
-  {
-    w(Eigen::Index(e.Target), column[e.ControlPoint]) = e.Weight;
-  }
-  Eigen::MatrixXd change(count, 3);
-  for (vtkIdType t = 0; t < count; ++t)
-  {
-    double target[3], at[3];
-    this->TargetPositions->GetPoint(t, target);
-    now->GetPoint(t, at);
-    for (int c = 0; c < 3; ++c)
-    {
-      change(t, c) = cellOf[t] >= 0 ? target[c] - at[c] : 0.0;
-    }
+    return fail();
   }
 
+  const Eigen::MatrixXd w = WeightMatrix(entries, column, count);
+  const Eigen::MatrixXd change = TargetChanges(this->TargetPositions, now, cellOf);
   const Eigen::MatrixXd move = SolveMove(w, change, this->Regularization);
   if (!move.allFinite())
   {
     vtkErrorMacro(<< "The solve failed with Regularization " << this->Regularization
                   << (this->Regularization > 0 ? ": give SetRegularization() a smaller number."
                                                : ": set a Regularization above 0."));
-    output->Initialize();
-    return 0;
+    return fail();
   }
-
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  points->DeepCopy(lattice->GetPoints());
-  for (std::size_t c = 0; c < controlPoints.size(); ++c)
-  {
-    double x[3];
-    points->GetPoint(controlPoints[c], x);
-    for (int a = 0; a < 3; ++a)
-    {
-      x[a] += move(Eigen::Index(c), a);
-    }
-    points->SetPoint(controlPoints[c], x);
-    this->NumberOfMovedControlPoints += move.row(Eigen::Index(c)).squaredNorm() > 0;
-  }
-  output->SetPoints(points);
+  output->SetPoints(MovedPoints(lattice, controlPoints, move, this->NumberOfMovedControlPoints));
   const Eigen::MatrixXd missed = change - w * move;
   for (vtkIdType t = 0; t < count; ++t)
   {
