@@ -20,6 +20,7 @@
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
+#include "vtkSmartPointer.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
 
@@ -208,6 +209,194 @@ TetrahedralMesh Subdivide(const TetrahedralMesh& coarse)
   }
   return fine;
 }
+
+/// The input's finite points (`coordinates`, 3 a point) and their centroid, an exact sum over every process
+/// rounded once; a distributed mesh's points shared by pieces (marked as copies in its ghost array) count once.
+/// False, said why, where there are fewer than 4 in all.
+bool FinitePointsAndCentroid(vtkFFDBuildTetrahedralLattice* self, vtkPointSet* input,
+  vtkMultiProcessController* controller, std::vector<double>& coordinates, double centroid[3])
+{
+  const vtkSmartPointer<vtkDataArray> owned = vtkFFDOwnedPoints(input);
+  const vtkIdType numberOfOwned = owned->GetNumberOfTuples();
+  coordinates.reserve(3 * numberOfOwned);
+  std::vector<ffd::ExactSum> sums(4); // x, y, z, count
+  for (vtkIdType id = 0; id < numberOfOwned; ++id)
+  {
+    double x[3];
+    owned->GetTuple(id, x);
+    if (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))
+    {
+      coordinates.insert(coordinates.end(), x, x + 3);
+      for (int c = 0; c < 3; ++c)
+      {
+        sums[c].Add(x[c]);
+      }
+      sums[3].Add(1.0);
+    }
+  }
+  vtkFFDSumOverProcesses(controller, sums);
+  const double finite = sums[3].Value();
+  if (finite < 4)
+  {
+    vtkErrorWithObjectMacro(self,
+      "The input has " << finite << " finite points; a tetrahedral lattice needs at "
+                       << "least 4 that are not coplanar.");
+    return false;
+  }
+  for (int c = 0; c < 3; ++c)
+  {
+    centroid[c] = sums[c].Value() / finite;
+  }
+  return true;
+}
+
+/// The hull of every process's points in lexicographic order, into `coordinates` (all of them) and
+/// `triangles`: the same however the points are ordered and split (Qhull's handling of nearly coplanar points
+/// depends on the points it is given and their order, so each process takes all of them, 24 bytes a point).
+/// False, said why, where it cannot be computed.
+bool HullOverProcesses(vtkFFDBuildTetrahedralLattice* self, vtkMultiProcessController* controller,
+  std::vector<double>& coordinates, std::vector<std::array<int, 3>>& triangles)
+{
+  coordinates = vtkFFDGatherOverProcesses(controller, coordinates);
+  SortPoints(coordinates);
+  const std::string qhullMessage = ConvexHull(coordinates, triangles);
+  if (!qhullMessage.empty() || triangles.empty())
+  {
+    vtkErrorWithObjectMacro(self,
+      "The convex hull of the input's points cannot be computed (are they coplanar?). Qhull says: " << qhullMessage);
+    return false;
+  }
+  return true;
+}
+
+/// One tetrahedron per hull triangle and the centroid (node 0); the hull's nodes moved out by `padding`.
+TetrahedralMesh HullFan(const double centroid[3], const std::vector<double>& coordinates,
+  const std::vector<std::array<int, 3>>& triangles, double padding)
+{
+  TetrahedralMesh mesh;
+  mesh.Nodes.assign(centroid, centroid + 3);
+  std::unordered_map<int, vtkIdType> nodeOfPoint;
+  auto node = [&](int point)
+  {
+    const auto found = nodeOfPoint.find(point);
+    if (found != nodeOfPoint.end())
+    {
+      return found->second;
+    }
+    const vtkIdType id = static_cast<vtkIdType>(mesh.Nodes.size() / 3);
+    for (int c = 0; c < 3; ++c)
+    {
+      mesh.Nodes.push_back(centroid[c] + (1.0 + padding) * (coordinates[3 * point + c] - centroid[c]));
+    }
+    nodeOfPoint.emplace(point, id);
+    return id;
+  };
+  for (const auto& triangle : triangles)
+  {
+    const vtkIdType a = node(triangle[0]), b = node(triangle[1]), c = node(triangle[2]);
+    // Qhull's triangulation of a facet with coplanar points may add triangles of no area: no volume either.
+    if (ffd::CheckTetrahedron(mesh.Node(0), mesh.Node(a), mesh.Node(b), mesh.Node(c)) == ffd::FrameStatus::Valid)
+    {
+      mesh.Add(0, a, b, c);
+    }
+  }
+  return mesh;
+}
+
+/// False, said why, where `levels` subdivisions of `hullFaces` tetrahedra would be too many or too large.
+bool CheckSubdivisions(vtkFFDBuildTetrahedralLattice* self, vtkIdType hullFaces, int levels)
+{
+  // A tetrahedron of the result costs about 300 bytes in all: its ids while subdividing (twice 32), the output's
+  // cell arrays (41), the binding of the input's points and the maps of the deformation (about 130), and its
+  // share of the nodes (at most one node per tetrahedron, 3 copies of 24 bytes and the midpoints' index).
+  const double finalTetrahedra = double(hullFaces) * std::pow(8.0, levels);
+  std::ostringstream request;
+  request << "SubdivisionLevels " << levels << " (" << hullFaces << " hull faces, so " << finalTetrahedra
+          << " tetrahedra)";
+  if (finalTetrahedra > double(vtkFFDTetrahedralDeformer::MaxTetrahedra))
+  {
+    vtkErrorWithObjectMacro(self, << request.str() << " exceeds the " << vtkFFDTetrahedralDeformer::MaxTetrahedra
+                                  << " tetrahedra a lattice may have: choose fewer levels.");
+    return false;
+  }
+  return vtkFFDCheckMemory(self, request.str(), 300.0 * finalTetrahedra);
+}
+
+/// The output: the mesh's nodes at rest, its tetrahedra, RestPosition.
+void FillLattice(const TetrahedralMesh& mesh, vtkUnstructuredGrid* output)
+{
+  const vtkIdType numberOfNodes = static_cast<vtkIdType>(mesh.Nodes.size() / 3);
+  const vtkIdType numberOfTetrahedra = static_cast<vtkIdType>(mesh.Tetrahedra.size() / 4);
+  vtkNew<vtkDoubleArray> nodes;
+  nodes->SetNumberOfComponents(3);
+  nodes->SetNumberOfTuples(numberOfNodes);
+  std::copy(mesh.Nodes.begin(), mesh.Nodes.end(), nodes->GetPointer(0));
+  vtkNew<vtkPoints> points;
+  points->SetData(nodes);
+  vtkNew<vtkDoubleArray> rest;
+  rest->DeepCopy(nodes);
+  rest->SetName(vtkFFDDataContract::RestPositionArrayName());
+  vtkNew<vtkIdTypeArray> offsets;
+  offsets->SetNumberOfValues(numberOfTetrahedra + 1);
+  for (vtkIdType t = 0; t <= numberOfTetrahedra; ++t)
+  {
+    offsets->SetValue(t, 4 * t);
+  }
+  vtkNew<vtkIdTypeArray> connectivity;
+  connectivity->SetNumberOfValues(4 * numberOfTetrahedra);
+  std::copy(mesh.Tetrahedra.begin(), mesh.Tetrahedra.end(), connectivity->GetPointer(0));
+  vtkNew<vtkCellArray> cells;
+  cells->SetData(offsets, connectivity);
+  output->SetPoints(points);
+  output->SetCells(VTK_TETRA, cells);
+  output->GetPointData()->AddArray(rest);
+}
+
+/// The nodes with a weight for some input point (`points`) in its tetrahedron, as `binding` bound it (1, else
+/// 0). A point on a face has a weight of (nearly) zero for the opposite node, which it does not move.
+vtkSmartPointer<vtkUnsignedCharArray> ActiveNodes(
+  const vtkFFDTetrahedralDeformer& binding, vtkPoints* points, const TetrahedralMesh& mesh, vtkIdType numberOfNodes)
+{
+  vtkNew<vtkUnsignedCharArray> active;
+  active->SetName(vtkFFDDataContract::ActiveArrayName());
+  active->SetNumberOfValues(numberOfNodes);
+  active->FillValue(0);
+  const std::vector<int>& bound = binding.GetCellOfPoint();
+  for (vtkIdType id = 0; id < points->GetNumberOfPoints(); ++id)
+  {
+    if (bound[id] < 0)
+    {
+      continue;
+    }
+    const vtkIdType* nodes = mesh.Tetrahedra.data() + 4 * bound[id];
+    double x[3];
+    points->GetPoint(id, x);
+    const ffd::Vec3<double> stu = binding.GetFrames()[bound[id]].ToParametric(ffd::Vec3<double>::From(x));
+    const double weights[4] = { 1.0 - stu.x - stu.y - stu.z, stu.x, stu.y, stu.z };
+    for (int i = 0; i < 4; ++i)
+    {
+      if (weights[i] > ActiveWeight)
+      {
+        active->SetValue(nodes[i], 1);
+      }
+    }
+  }
+  return active.Get();
+}
+
+/// Hides the nodes that are not `active`: the ghost array exists only where some are not.
+void HideCulledNodes(vtkUnstructuredGrid* output, vtkUnsignedCharArray* active)
+{
+  const vtkIdType numberOfNodes = active->GetNumberOfValues();
+  vtkNew<vtkUnsignedCharArray> ghosts;
+  ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
+  ghosts->SetNumberOfValues(numberOfNodes);
+  for (vtkIdType id = 0; id < numberOfNodes; ++id)
+  {
+    ghosts->SetValue(id, active->GetValue(id) ? 0 : vtkDataSetAttributes::HIDDENPOINT);
+  }
+  output->GetPointData()->AddArray(ghosts);
+}
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -276,96 +465,19 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
                   << "such as 0.05.");
     return 0;
   }
-
-  // The finite points and their centroid, an exact sum over every process rounded once; a distributed mesh's
-  // points shared by pieces (marked as copies in its ghost array) count once.
-  const vtkSmartPointer<vtkDataArray> owned = vtkFFDOwnedPoints(input);
-  const vtkIdType numberOfOwned = owned->GetNumberOfTuples();
   std::vector<double> coordinates;
-  coordinates.reserve(3 * numberOfOwned);
-  std::vector<ffd::ExactSum> sums(4); // x, y, z, count
-  for (vtkIdType id = 0; id < numberOfOwned; ++id)
-  {
-    double x[3];
-    owned->GetTuple(id, x);
-    if (std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))
-    {
-      coordinates.insert(coordinates.end(), x, x + 3);
-      for (int c = 0; c < 3; ++c)
-      {
-        sums[c].Add(x[c]);
-      }
-      sums[3].Add(1.0);
-    }
-  }
-  vtkFFDSumOverProcesses(controller, sums);
-  const double finite = sums[3].Value();
-  if (finite < 4)
-  {
-    vtkErrorMacro("The input has " << finite << " finite points; a tetrahedral lattice needs at least 4 that "
-                                   << "are not coplanar.");
-    return 0;
-  }
-  const double centroid[3] = { sums[0].Value() / finite, sums[1].Value() / finite, sums[2].Value() / finite };
-
-  // The hull of every process's points in lexicographic order: the same however the points are ordered and
-  // split (Qhull's handling of nearly coplanar points depends on the points it is given and their order, so
-  // each process takes all of them, 24 bytes a point).
-  coordinates = vtkFFDGatherOverProcesses(controller, coordinates);
-  SortPoints(coordinates);
+  double centroid[3];
   std::vector<std::array<int, 3>> triangles;
-  const std::string qhullMessage = ConvexHull(coordinates, triangles);
-  if (!qhullMessage.empty() || triangles.empty())
+  if (!FinitePointsAndCentroid(this, input, controller, coordinates, centroid) ||
+    !HullOverProcesses(this, controller, coordinates, triangles))
   {
-    vtkErrorMacro(
-      "The convex hull of the input's points cannot be computed (are they coplanar?). Qhull says: " << qhullMessage);
     return 0;
   }
   this->UpdateProgress(0.3);
 
-  // One tetrahedron per hull triangle and the centroid (node 0); the hull's nodes moved out by Padding.
-  TetrahedralMesh mesh;
-  mesh.Nodes.assign(centroid, centroid + 3);
-  std::unordered_map<int, vtkIdType> nodeOfPoint;
-  auto node = [&](int point)
-  {
-    const auto found = nodeOfPoint.find(point);
-    if (found != nodeOfPoint.end())
-    {
-      return found->second;
-    }
-    const vtkIdType id = static_cast<vtkIdType>(mesh.Nodes.size() / 3);
-    for (int c = 0; c < 3; ++c)
-    {
-      mesh.Nodes.push_back(centroid[c] + (1.0 + this->Padding) * (coordinates[3 * point + c] - centroid[c]));
-    }
-    nodeOfPoint.emplace(point, id);
-    return id;
-  };
-  for (const auto& triangle : triangles)
-  {
-    const vtkIdType a = node(triangle[0]), b = node(triangle[1]), c = node(triangle[2]);
-    // Qhull's triangulation of a facet with coplanar points may add triangles of no area: no volume either.
-    if (ffd::CheckTetrahedron(mesh.Node(0), mesh.Node(a), mesh.Node(b), mesh.Node(c)) == ffd::FrameStatus::Valid)
-    {
-      mesh.Add(0, a, b, c);
-    }
-  }
+  TetrahedralMesh mesh = HullFan(centroid, coordinates, triangles, this->Padding);
   this->NumberOfHullFaces = static_cast<vtkIdType>(mesh.Tetrahedra.size() / 4);
-  // A tetrahedron of the result costs about 300 bytes in all: its ids while subdividing (twice 32), the output's
-  // cell arrays (41), the binding of the input's points and the maps of the deformation (about 130), and its
-  // share of the nodes (at most one node per tetrahedron, 3 copies of 24 bytes and the midpoints' index).
-  const double finalTetrahedra = double(this->NumberOfHullFaces) * std::pow(8.0, this->SubdivisionLevels);
-  std::ostringstream request;
-  request << "SubdivisionLevels " << this->SubdivisionLevels << " (" << this->NumberOfHullFaces << " hull faces, so "
-          << finalTetrahedra << " tetrahedra)";
-  if (finalTetrahedra > double(vtkFFDTetrahedralDeformer::MaxTetrahedra))
-  {
-    vtkErrorMacro(<< request.str() << " exceeds the " << vtkFFDTetrahedralDeformer::MaxTetrahedra
-                  << " tetrahedra a lattice may have: choose fewer levels.");
-    return 0;
-  }
-  if (!vtkFFDCheckMemory(this, request.str(), 300.0 * finalTetrahedra))
+  if (!CheckSubdivisions(this, this->NumberOfHullFaces, this->SubdivisionLevels))
   {
     return 0;
   }
@@ -374,36 +486,9 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
     mesh = Subdivide(mesh);
   }
   this->UpdateProgress(0.5);
+  FillLattice(mesh, output);
 
-  // The output: nodes at rest, tetrahedra, RestPosition.
-  const vtkIdType numberOfNodes = static_cast<vtkIdType>(mesh.Nodes.size() / 3);
-  const vtkIdType numberOfTetrahedra = static_cast<vtkIdType>(mesh.Tetrahedra.size() / 4);
-  vtkNew<vtkDoubleArray> nodes;
-  nodes->SetNumberOfComponents(3);
-  nodes->SetNumberOfTuples(numberOfNodes);
-  std::copy(mesh.Nodes.begin(), mesh.Nodes.end(), nodes->GetPointer(0));
-  vtkNew<vtkPoints> points;
-  points->SetData(nodes);
-  vtkNew<vtkDoubleArray> rest;
-  rest->DeepCopy(nodes);
-  rest->SetName(vtkFFDDataContract::RestPositionArrayName());
-  vtkNew<vtkIdTypeArray> offsets;
-  offsets->SetNumberOfValues(numberOfTetrahedra + 1);
-  for (vtkIdType t = 0; t <= numberOfTetrahedra; ++t)
-  {
-    offsets->SetValue(t, 4 * t);
-  }
-  vtkNew<vtkIdTypeArray> connectivity;
-  connectivity->SetNumberOfValues(4 * numberOfTetrahedra);
-  std::copy(mesh.Tetrahedra.begin(), mesh.Tetrahedra.end(), connectivity->GetPointer(0));
-  vtkNew<vtkCellArray> cells;
-  cells->SetData(offsets, connectivity);
-  output->SetPoints(points);
-  output->SetCells(VTK_TETRA, cells);
-  output->GetPointData()->AddArray(rest);
-
-  // Active nodes: those with a weight for some input point in its tetrahedron, as vtkFFDDeform binds it. A
-  // point on a face has a weight of (nearly) zero for the opposite node, which it does not move.
+  // Active nodes: those with a weight for some input point in its tetrahedron, as vtkFFDDeform binds it.
   vtkFFDTetrahedralDeformer binding;
   const std::string problem = binding.SetLattice(output);
   bool rebound = false;
@@ -418,44 +503,14 @@ int vtkFFDBuildTetrahedralLattice::RequestData(
     output->Initialize();
     return problem.empty() ? 1 : 0; // aborted, or an internal inconsistency
   }
-  vtkNew<vtkUnsignedCharArray> active;
-  active->SetName(vtkFFDDataContract::ActiveArrayName());
-  active->SetNumberOfValues(numberOfNodes);
-  active->FillValue(0);
-  const std::vector<int>& bound = binding.GetCellOfPoint();
-  for (vtkIdType id = 0; id < inputPoints->GetNumberOfPoints(); ++id)
-  {
-    if (bound[id] < 0)
-    {
-      continue;
-    }
-    const vtkIdType* nodes = mesh.Tetrahedra.data() + 4 * bound[id];
-    double x[3];
-    input->GetPoint(id, x);
-    const ffd::Vec3<double> stu = binding.GetFrames()[bound[id]].ToParametric(ffd::Vec3<double>::From(x));
-    const double weights[4] = { 1.0 - stu.x - stu.y - stu.z, stu.x, stu.y, stu.z };
-    for (int i = 0; i < 4; ++i)
-    {
-      if (weights[i] > ActiveWeight)
-      {
-        active->SetValue(nodes[i], 1);
-      }
-    }
-  }
+  const vtkIdType numberOfNodes = static_cast<vtkIdType>(mesh.Nodes.size() / 3);
+  const vtkSmartPointer<vtkUnsignedCharArray> active = ActiveNodes(binding, inputPoints, mesh, numberOfNodes);
   vtkFFDAnyOverProcesses(controller, active->GetPointer(0), numberOfNodes);
   output->GetPointData()->AddArray(active);
   this->NumberOfActiveNodes = std::count(active->GetPointer(0), active->GetPointer(0) + numberOfNodes, 1);
   if (this->NumberOfActiveNodes < numberOfNodes)
   {
-    // Culled nodes are hidden; the ghost array exists only when some are.
-    vtkNew<vtkUnsignedCharArray> ghosts;
-    ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
-    ghosts->SetNumberOfValues(numberOfNodes);
-    for (vtkIdType id = 0; id < numberOfNodes; ++id)
-    {
-      ghosts->SetValue(id, active->GetValue(id) ? 0 : vtkDataSetAttributes::HIDDENPOINT);
-    }
-    output->GetPointData()->AddArray(ghosts);
+    HideCulledNodes(output, active);
   }
   this->UpdateProgress(1.0);
   return 1;
