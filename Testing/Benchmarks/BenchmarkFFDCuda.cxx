@@ -8,6 +8,7 @@
 // 100 k tetrahedra, float32 and float64, beside the trilinear grid's in the same run, with what an update would
 // cost if it uploaded the tetrahedra's maps instead of the nodes' displacements.
 // It prints tables and asserts nothing. Options: --quick (1 M points only), --tetrahedra (that section alone).
+#include "FFDBenchmarkUtilities.h"
 #include "FFDCudaGridDeformer.h"
 #include "FFDCudaTestSupport.h"
 #include "FFDCudaTetrahedralDeformer.h"
@@ -16,37 +17,14 @@
 #include <cuda_runtime.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <random>
 #include <string>
 #include <vector>
 
 namespace
 {
-using Clock = std::chrono::steady_clock;
-
-double Median(std::vector<double> v)
-{
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-template <typename F>
-double MedianSeconds(int repeats, F&& f)
-{
-  std::vector<double> times;
-  for (int r = 0; r < repeats; ++r)
-  {
-    const auto start = Clock::now();
-    f();
-    times.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-  }
-  return Median(times);
-}
-
 void Require(bool ok, const ffd::cuda::ResidentPoints& gpu, const char* what)
 {
   if (!ok)
@@ -160,6 +138,22 @@ Times TimeEvaluations(const ffd::cuda::ResidentPoints& gpu, Evaluate&& evaluate)
       points.push_back(gpu.GetCounters().LastKernelMilliseconds * 1e-3);
     });
   return { call, Median(lattice), Median(points) };
+}
+
+// TimeEvaluations() of the grid's evaluation of `displacements` into its resident points.
+Times TimeGridEvaluation(ffd::cuda::GridDeformer& gpu, const std::vector<double>& displacements)
+{
+  const std::int64_t controlPoints = std::int64_t(displacements.size() / 3);
+  return TimeEvaluations(
+    gpu, [&] { Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate"); });
+}
+
+// One row of the grid table (float32 points). Bytes a point must move: the point and its binding in, the point out.
+void PrintGridRow(const char* basis, const char* order, std::int64_t n, const Times& t, double bandwidth)
+{
+  const double bytes = double(n) * (12 + 4 + 12);
+  std::printf("| %s%s | %lld | %.3f | %.3f | %.2f | %.0f | %.0f %% |\n", basis, order, static_cast<long long>(n),
+    t.Call * 1e3, t.Points * 1e3, n / t.Points * 1e-9, bytes / t.Points * 1e-9, 100.0 * bytes / t.Points / bandwidth);
 }
 
 template <typename Real>
@@ -341,8 +335,13 @@ void Tetrahedra(const std::vector<std::int64_t>& sizes, double bandwidth, std::m
 
 int main(int argc, char* argv[])
 {
-  const bool quick = argc > 1 && std::string(argv[1]) == "--quick";
-  const bool tetrahedraOnly = argc > 1 && std::string(argv[1]) == "--tetrahedra";
+  bool quick = false, tetrahedraOnly = false;
+  int status = 0;
+  if (!ParseArguments(
+        argc, argv, { { "--quick", &quick }, { "--tetrahedra", &tetrahedraOnly } }, "[--quick] [--tetrahedra]", status))
+  {
+    return status;
+  }
   std::string why;
   if (!ffd::cuda::DeviceAvailable(&why))
   {
@@ -394,18 +393,7 @@ int main(int argc, char* argv[])
       ffd::cuda::GridDeformer gpu;
       Require(gpu.SetPoints(points.data(), n), gpu, "SetPoints");
       Require(gpu.Bind(Frame, int(c.Basis), divisions, false), gpu, "Bind");
-      Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate"); // warm-up
-      std::vector<double> kernelSeconds;
-      const double seconds = MedianSeconds(20,
-        [&]
-        {
-          Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate");
-          kernelSeconds.push_back(gpu.GetCounters().LastKernelMilliseconds * 1e-3);
-        });
-      const double kernel = Median(kernelSeconds);
-      const double bytes = double(n) * (12 + 4 + 12);
-      std::printf("| %s | %lld | %.3f | %.3f | %.2f | %.0f | %.0f %% |\n", c.Name, static_cast<long long>(n),
-        seconds * 1e3, kernel * 1e3, n / kernel * 1e-9, bytes / kernel * 1e-9, 100.0 * bytes / kernel / bandwidth);
+      PrintGridRow(c.Name, "", n, TimeGridEvaluation(gpu, displacements), bandwidth);
 
       if (n == sizes.front() && c.Basis == ffd::GridBasis::Trilinear)
       {
@@ -437,20 +425,7 @@ int main(int argc, char* argv[])
     const int divisions[3] = { c.Divisions, c.Divisions, c.Divisions };
     ffd::cuda::GridDeformer gpu;
     Require(gpu.SetPoints(points.data(), n) && gpu.Bind(Frame, int(c.Basis), divisions, false), gpu, "Bind");
-    const std::int64_t controlPoints = std::int64_t(displacements.size() / 3);
-    Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate");
-    std::vector<double> kernelSeconds;
-    const double seconds = MedianSeconds(20,
-      [&]
-      {
-        Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate");
-        kernelSeconds.push_back(gpu.GetCounters().LastKernelMilliseconds * 1e-3);
-      });
-    const double kernel = Median(kernelSeconds);
-    const double bytes = double(n) * (12 + 4 + 12);
-    std::printf("| %s, random point order | %lld | %.3f | %.3f | %.2f | %.0f | %.0f %% |\n", c.Name,
-      static_cast<long long>(n), seconds * 1e3, kernel * 1e3, n / kernel * 1e-9, bytes / kernel * 1e-9,
-      100.0 * bytes / kernel / bandwidth);
+    PrintGridRow(c.Name, ", random point order", n, TimeGridEvaluation(gpu, displacements), bandwidth);
   }
 
   std::printf("\nEnd-to-end update of %lld points (TRILINEAR; lattice upload + evaluation + download into pageable "

@@ -26,6 +26,8 @@
  *   --mesh     the mesh to subdivide (VTK XML PolyData); default: the armadillo of the test data
  */
 
+#include "FFDBenchmarkUtilities.h"
+
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDDeform.h"
@@ -50,7 +52,6 @@
 #include <immintrin.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -62,13 +63,6 @@
 
 namespace
 {
-using Clock = std::chrono::steady_clock;
-
-double Seconds(Clock::time_point begin)
-{
-  return std::chrono::duration<double>(Clock::now() - begin).count();
-}
-
 //------------------------------------------------------------------------------------------------------------
 // FMA throughput. Chains independent accumulators acc = acc * a + b hide the FMA latency (4-5 cycles on
 // current x86) times the number of FMA pipes (2); 12 chains plus the two constants fit the 16 registers of
@@ -231,11 +225,6 @@ vtkSmartPointer<vtkPolyData> WithPrecision(vtkPolyData* mesh, bool useDouble)
   return copy;
 }
 
-struct Timing
-{
-  double Best = 0.0, Median = 0.0;
-};
-
 /// Moves every lattice point by up to 2 % of the lattice's diagonal, a new random displacement each call.
 void MoveLattice(vtkStructuredGrid* lattice, const std::vector<double>& rest, std::mt19937& rng)
 {
@@ -321,34 +310,6 @@ double BindOnce(vtkFFDDeform* deform, vtkPolyData* mesh, BenchmarkLattice& latti
   return seconds;
 }
 
-/// Best and median of `times` (not empty).
-Timing BestAndMedian(std::vector<double> times)
-{
-  std::sort(times.begin(), times.end());
-  return { times.front(), times[times.size() / 2] };
-}
-
-/// Runs `step` (which returns the seconds of its timed part) at least `minRepeats` times and until
-/// `minSeconds` have been spent; appends the timed parts to `times`.
-template <typename Step>
-void RepeatInto(Step&& step, int minRepeats, double minSeconds, std::vector<double>& times)
-{
-  const Clock::time_point begin = Clock::now();
-  for (int repeats = 0; repeats < minRepeats || Seconds(begin) < minSeconds; ++repeats)
-  {
-    times.push_back(step());
-  }
-}
-
-/// RepeatInto(); best and median of the timed parts.
-template <typename Step>
-Timing Repeat(Step&& step, int minRepeats, double minSeconds)
-{
-  std::vector<double> times;
-  RepeatInto(step, minRepeats, minSeconds, times);
-  return BestAndMedian(times);
-}
-
 /// Times vtkFFDDeform::Update() after moving the lattice's points (the binding cached), on the threads
 /// vtkSMPTools was initialized to; appends the times to `times`.
 void TimeUpdates(vtkFFDDeform* deform, BenchmarkLattice& lattice, std::mt19937& rng, int minRepeats, double minSeconds,
@@ -377,7 +338,7 @@ Timing TimeEvaluation(
   vtkSMPTools::Initialize(threads);
   std::vector<double> times;
   TimeUpdates(deform, lattice, rng, minRepeats, minSeconds, times);
-  return BestAndMedian(times);
+  return Summarize(times);
 }
 
 /**
@@ -542,7 +503,7 @@ SideBySide MeasureSideBySide(CopyBuffers& copy, vtkFFDDeform* deform, BenchmarkL
     deform->Update();
     TimeUpdates(deform, lattice, rng, (minRepeats + rounds - 1) / rounds, minSeconds / rounds, times);
   }
-  measured.Evaluation = BestAndMedian(times);
+  measured.Evaluation = Summarize(times);
   return measured;
 }
 
@@ -893,10 +854,10 @@ bool RunInverseSection(vtkPolyData* mesh, bool quick)
               "max |F(x) - y| / d | vs ours |\n");
   std::printf("|--------------------------------------------|-----------:|---------:|----------------:|"
               "------------------:|--------:|\n");
-  const double ourMedian = BestAndMedian(rows[0].Times).Median;
+  const double ourMedian = Summarize(rows[0].Times).Median;
   for (const InverseRow& r : rows)
   {
-    const Timing t = BestAndMedian(r.Times);
+    const Timing t = Summarize(r.Times);
     std::printf("| %-42s | %10.4f | %8.4f | %15.1e | %18.1e | %6.1fx |\n", r.Name, t.Median, t.Best, r.RestError,
       r.ResidualError, t.Median / ourMedian);
   }
@@ -910,28 +871,12 @@ int main(int argc, char* argv[])
   bool quick = false;
   std::string section = "all";
   std::string meshPath = std::string(VOXELFFD_MESH_DIR) + "/armadillo.vtp";
-  for (int a = 1; a < argc; ++a)
+  int status = 0;
+  if (!ParseArguments(argc, argv,
+        { { "--quick", &quick }, { "--section", &section, "global|bases|inverse|all" }, { "--mesh", &meshPath } },
+        "[--quick] [--section global|bases|inverse|all] [--mesh path.vtp]", status))
   {
-    const std::string arg = argv[a];
-    if (arg == "--quick")
-    {
-      quick = true;
-    }
-    else if (arg == "--mesh" && a + 1 < argc)
-    {
-      meshPath = argv[++a];
-    }
-    else if (arg == "--section" && a + 1 < argc &&
-      (std::string(argv[a + 1]) == "global" || std::string(argv[a + 1]) == "bases" ||
-        std::string(argv[a + 1]) == "inverse" || std::string(argv[a + 1]) == "all"))
-    {
-      section = argv[++a];
-    }
-    else
-    {
-      std::fprintf(stderr, "usage: %s [--quick] [--section global|bases|inverse|all] [--mesh path.vtp]\n", argv[0]);
-      return arg == "--help" || arg == "-h" ? 0 : 1;
-    }
+    return status;
   }
 
   // Thread counts: one, and every thread the SMP backend would use by default.

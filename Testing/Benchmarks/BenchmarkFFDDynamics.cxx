@@ -5,6 +5,7 @@
 // nothing.
 
 #include "FFDBenchmarkMeshes.h"
+#include "FFDBenchmarkUtilities.h"
 
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDeform.h"
@@ -14,28 +15,13 @@
 #include "vtkSMPTools.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <string>
 #include <vector>
 
 namespace
 {
-using Clock = std::chrono::steady_clock;
-
-double Seconds(Clock::time_point since)
-{
-  return std::chrono::duration<double>(Clock::now() - since).count();
-}
-
-double Median(std::vector<double> values)
-{
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
-
 /// The mesh's sparse lattice of `basis` over `divisions` voxels per axis.
 vtkSmartPointer<vtkPointSet> Lattice(vtkPolyData* mesh, int divisions, int basis)
 {
@@ -95,22 +81,11 @@ int main(int argc, char* argv[])
 {
   bool quick = false;
   std::string meshDir = VOXELFFD_MESH_DIR;
-  for (int a = 1; a < argc; ++a)
+  int status = 0;
+  if (!ParseArguments(
+        argc, argv, { { "--quick", &quick }, { "--mesh-dir", &meshDir } }, "[--quick] [--mesh-dir dir]", status))
   {
-    const std::string arg = argv[a];
-    if (arg == "--quick")
-    {
-      quick = true;
-    }
-    else if (arg == "--mesh-dir" && a + 1 < argc)
-    {
-      meshDir = argv[++a];
-    }
-    else
-    {
-      std::printf("usage: %s [--quick] [--mesh-dir dir]\n", argv[0]);
-      return arg == "--help" ? 0 : 1;
-    }
+    return status;
   }
   const vtkSmartPointer<vtkPolyData> armadillo = ShadedSubdividedMesh(meshDir + "/armadillo.vtp", 0);
   if (armadillo->GetNumberOfPoints() == 0)

@@ -20,6 +20,7 @@
  * Utilities/with-display.sh build/bin/BenchmarkFFDInteraction)
  */
 #include "FFDBenchmarkMeshes.h"
+#include "FFDBenchmarkUtilities.h"
 #include "vtkActor.h"
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDeform.h"
@@ -38,55 +39,23 @@
 #include "vtkStructuredGrid.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <string>
 #include <vector>
-
-namespace
-{
-using Clock = std::chrono::steady_clock;
-
-double Milliseconds(Clock::time_point a, Clock::time_point b)
-{
-  return std::chrono::duration<double, std::milli>(b - a).count();
-}
-
-struct Stats
-{
-  double Median, Min, Max;
-};
-
-Stats Summarize(std::vector<double> values)
-{
-  std::sort(values.begin(), values.end());
-  return { values[values.size() / 2], values.front(), values.back() };
-}
-}
 
 int main(int argc, char* argv[])
 {
   std::string meshPath = std::string(VOXELFFD_MESH_DIR) + "/armadillo.vtp";
   int levels = 2;
   int moves = 30;
-  for (int a = 1; a + 1 < argc; a += 2)
+  int status = 0;
+  if (!ParseArguments(argc, argv, { { "--mesh", &meshPath }, { "--levels", &levels }, { "--moves", &moves } },
+        "[--mesh FILE.vtp] [--levels N] [--moves N]", status))
   {
-    if (!std::strcmp(argv[a], "--mesh"))
-    {
-      meshPath = argv[a + 1];
-    }
-    else if (!std::strcmp(argv[a], "--levels"))
-    {
-      levels = std::atoi(argv[a + 1]);
-    }
-    else if (!std::strcmp(argv[a], "--moves"))
-    {
-      moves = std::max(1, std::atoi(argv[a + 1]));
-    }
+    return status;
   }
-
+  moves = std::max(1, moves);
   const vtkSmartPointer<vtkPolyData> mesh = ShadedSubdividedMesh(meshPath, levels);
   if (mesh->GetNumberOfPoints() == 0)
   {
@@ -159,7 +128,7 @@ int main(int argc, char* argv[])
       const Clock::time_point t0 = Clock::now();
       window->Render();
       window->WaitForCompletion();
-      still.push_back(Milliseconds(t0, Clock::now()));
+      still.push_back(1e3 * Seconds(t0));
     }
 
     const double step = 0.01 * lattice->GetLength();
@@ -175,16 +144,16 @@ int main(int argc, char* argv[])
       window->Render();
       window->WaitForCompletion();
       const Clock::time_point t2 = Clock::now();
-      pipeline.push_back(Milliseconds(t0, t1));
-      render.push_back(Milliseconds(t1, t2));
-      total.push_back(Milliseconds(t0, t2));
+      pipeline.push_back(1e3 * Seconds(t0, t1));
+      render.push_back(1e3 * Seconds(t1, t2));
+      total.push_back(1e3 * Seconds(t0, t2));
     }
-    const Stats p = Summarize(pipeline), r = Summarize(render), t = Summarize(total), u = Summarize(still);
+    const Timing p = Summarize(pipeline), r = Summarize(render), t = Summarize(total), u = Summarize(still);
     std::printf("| %s | %lld (%lld) | %lld | %.1f (%.1f-%.1f) | %.1f (%.1f-%.1f) | %.1f | %.1f |\n",
       vtkFFDBuildLattice::GetBasisAsString(basis), static_cast<long long>(lattice->GetNumberOfPoints()),
       static_cast<long long>(build->GetNumberOfActiveControlPoints()),
-      static_cast<long long>(deform->GetNumberOfBindings()), p.Median, p.Min, p.Max, r.Median, r.Min, r.Max, t.Median,
-      u.Median);
+      static_cast<long long>(deform->GetNumberOfBindings()), p.Median, p.Best, p.Worst, r.Median, r.Best, r.Worst,
+      t.Median, u.Median);
   }
   return EXIT_SUCCESS;
 }

@@ -19,6 +19,8 @@
 #include "vtkFFDRefineLattice.h"
 #include "vtkFFDVoxelize.h"
 
+#include "FFDBenchmarkUtilities.h"
+
 #include "vtkDataArray.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
@@ -28,38 +30,14 @@
 #include "vtkSmartPointer.h"
 #include "vtkXMLPolyDataReader.h"
 
-#include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <functional>
 #include <random>
 #include <string>
 #include <vector>
 
 namespace
 {
-using Clock = std::chrono::steady_clock;
-
-/// The median time of `runs` runs of `work` in seconds, after the first when it takes more than 10 s.
-double MedianSeconds(const std::function<void()>& work, int runs = 3)
-{
-  std::vector<double> times;
-  for (int run = 0; run < runs; ++run)
-  {
-    const Clock::time_point start = Clock::now();
-    work();
-    times.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-    if (times.back() > 10.0)
-    {
-      break;
-    }
-  }
-  std::sort(times.begin(), times.end());
-  return times[times.size() / 2];
-}
-
 vtkSmartPointer<vtkPointSet> MovedLattice(vtkPolyData* mesh, int basis, int n, int form, double amplitude)
 {
   vtkNew<vtkFFDVoxelize> voxelize;
@@ -91,27 +69,16 @@ vtkSmartPointer<vtkPointSet> MovedLattice(vtkPolyData* mesh, int basis, int n, i
 int main(int argc, char* argv[])
 {
   bool quick = false;
-  std::string meshName = "armadillo", meshDir = VOXELFFD_MESH_DIR;
-  for (int i = 1; i < argc; ++i)
+  std::string meshName, meshDir = VOXELFFD_MESH_DIR;
+  int status = 0;
+  if (!ParseArguments(argc, argv, { { "--quick", &quick }, { "--mesh", &meshName }, { "--mesh-dir", &meshDir } },
+        "[--quick] [--mesh name] [--mesh-dir dir]", status))
   {
-    if (!std::strcmp(argv[i], "--quick"))
-    {
-      quick = true;
-      meshName = "bear";
-    }
-    else if (!std::strcmp(argv[i], "--mesh") && i + 1 < argc)
-    {
-      meshName = argv[++i];
-    }
-    else if (!std::strcmp(argv[i], "--mesh-dir") && i + 1 < argc)
-    {
-      meshDir = argv[++i];
-    }
-    else
-    {
-      std::fprintf(stderr, "usage: %s [--quick] [--mesh name] [--mesh-dir dir]\n", argv[0]);
-      return 2;
-    }
+    return status;
+  }
+  if (meshName.empty())
+  {
+    meshName = quick ? "bear" : "armadillo";
   }
   vtkNew<vtkXMLPolyDataReader> reader;
   reader->SetFileName((meshDir + "/" + meshName + ".vtp").c_str());
@@ -144,20 +111,24 @@ int main(int argc, char* argv[])
         vtkNew<vtkFFDRefineLattice> refine;
         refine->SetInputData(lattice);
         const double refineSeconds = MedianSeconds(
+          3,
           [&]
           {
             refine->Modified();
             refine->Update();
-          });
+          },
+          10.0);
         vtkNew<vtkFFDCoarsenLattice> coarsen;
         coarsen->SetInputData(lattice);
         coarsen->SetMeshData(mesh);
         const double coarsenSeconds = MedianSeconds(
+          3,
           [&]
           {
             coarsen->Modified();
             coarsen->Update();
-          });
+          },
+          10.0);
         std::printf("| %s | %s | %d^3 | %lld | %.1f | %lld | %.0f | %lld | %.2e |\n",
           vtkFFDBuildLattice::GetBasisAsString(basis), form == vtkFFDBuildLattice::SPARSE ? "sparse" : "dense", n,
           static_cast<long long>(lattice->GetNumberOfPoints()), 1e3 * refineSeconds,

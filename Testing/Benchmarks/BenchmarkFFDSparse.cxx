@@ -30,6 +30,7 @@
 #include "vtkFFDVoxelize.h"
 
 #include "FFDBenchmarkMeshes.h"
+#include "FFDBenchmarkUtilities.h"
 
 #include "vtkDataSet.h"
 #include "vtkNew.h"
@@ -39,46 +40,15 @@
 #include "vtkSmartPointer.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <random>
 #include <string>
 #include <vector>
 
 namespace
 {
-using Clock = std::chrono::steady_clock;
-
-double Seconds(Clock::time_point since)
-{
-  return std::chrono::duration<double>(Clock::now() - since).count();
-}
-
-/// The process's resident memory now ("VmRSS") or at its peak since the last ResetPeak() ("VmHWM"), in MB.
-double ResidentMegabytes(const char* field)
-{
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line))
-  {
-    if (line.compare(0, std::strlen(field), field) == 0)
-    {
-      return std::atof(line.c_str() + std::strlen(field) + 1) / 1024.0; // in kB
-    }
-  }
-  return -1.0;
-}
-
-/// Starts a new peak at the current resident memory (Linux: clear_refs 5), so that the peak of the pipeline
-/// is not the mesh's subdivision's.
-void ResetPeak()
-{
-  std::ofstream("/proc/self/clear_refs") << "5";
-}
-
 /// One row, measured in this process: the line the parent prints, or an error.
 int RunRow(const std::string& meshPath, int levels, int divisions, int basis, bool sparse, int backend)
 {
@@ -89,7 +59,7 @@ int RunRow(const std::string& meshPath, int levels, int divisions, int basis, bo
     return 1;
   }
   const double meshMegabytes = ResidentMegabytes("VmRSS");
-  ResetPeak();
+  ResetPeakResidentMemory();
 
   auto start = Clock::now();
   vtkNew<vtkFFDVoxelize> voxelize;
@@ -149,8 +119,7 @@ int RunRow(const std::string& meshPath, int levels, int divisions, int basis, bo
     deform->Update();
     updates.push_back(Seconds(start));
   }
-  std::sort(updates.begin(), updates.end());
-  const double update = updates[updates.size() / 2];
+  const double update = Median(updates);
   if (deform->GetNumberOfBindings() != 1 || deform->GetOutputDataObject(0)->GetMTime() < points->GetMTime())
   {
     std::printf("error: the binding was recomputed, or the update did not run\n");
@@ -237,31 +206,13 @@ int main(int argc, char* argv[])
   }
   bool quick = false;
   std::string table = "all", meshDir = VOXELFFD_MESH_DIR, backend = "cpu";
-  for (int a = 1; a < argc; ++a)
+  int status = 0;
+  if (!ParseArguments(argc, argv,
+        { { "--quick", &quick }, { "--table", &table, "scaling|throughput|all" }, { "--mesh-dir", &meshDir },
+          { "--backend", &backend, "cpu|auto" } },
+        "[--quick] [--table scaling|throughput|all] [--mesh-dir dir] [--backend cpu|auto]", status))
   {
-    const std::string arg = argv[a];
-    if (arg == "--quick")
-    {
-      quick = true;
-    }
-    else if (arg == "--table" && a + 1 < argc)
-    {
-      table = argv[++a];
-    }
-    else if (arg == "--mesh-dir" && a + 1 < argc)
-    {
-      meshDir = argv[++a];
-    }
-    else if (arg == "--backend" && a + 1 < argc)
-    {
-      backend = argv[++a];
-    }
-    else
-    {
-      std::printf(
-        "usage: %s [--quick] [--table scaling|throughput|all] [--mesh-dir dir] [--backend cpu|auto]\n", argv[0]);
-      return arg == "--help" ? 0 : 1;
-    }
+    return status;
   }
   const std::string self = argv[0];
   const MeshChoice bear = { "bear", "bear.vtp", 0 };

@@ -4,6 +4,7 @@
 // grid evaluation of the same mesh and to VTK's vtkDeformPointSet (mean value coordinates over a control
 // mesh's surface) as the peer, all in one run. Prints tables; asserts nothing (not a test). BENCHMARKS.md says
 // how to run it and records the results.
+#include "FFDBenchmarkUtilities.h"
 #include "FFDTestTetrahedra.h"
 
 #include "vtkFFDBuildLattice.h"
@@ -19,36 +20,13 @@
 #include "vtkStructuredGrid.h"
 #include "vtkXMLPolyDataReader.h"
 
-#include <algorithm>
-#include <chrono>
 #include <cstdio>
-#include <cstring>
-#include <functional>
 #include <random>
 #include <string>
 #include <vector>
 
 namespace
 {
-using Clock = std::chrono::steady_clock;
-
-double Seconds(Clock::time_point begin)
-{
-  return std::chrono::duration<double>(Clock::now() - begin).count();
-}
-
-/// The median of `repeats` runs of step() (which returns its own time).
-double Median(const std::function<double()>& step, int repeats)
-{
-  std::vector<double> times;
-  for (int r = 0; r < repeats; ++r)
-  {
-    times.push_back(step());
-  }
-  std::sort(times.begin(), times.end());
-  return times[times.size() / 2];
-}
-
 /// Moves every point of a lattice by up to `amplitude`, a new random displacement each call.
 void Move(vtkPointSet* lattice, vtkDataArray* rest, double amplitude, std::mt19937& rng)
 {
@@ -88,15 +66,14 @@ Row Measure(const std::string& name, vtkPolyData* mesh, vtkPointSet* lattice, in
   const Clock::time_point begin = Clock::now();
   deform->Update();
   const double first = Seconds(begin);
-  row.Evaluate = Median(
-    [&]()
-    {
-      Move(lattice, rest, amplitude, rng);
-      const Clock::time_point start = Clock::now();
-      deform->Update();
-      return Seconds(start);
-    },
-    9);
+  const auto moveAndUpdate = [&]()
+  {
+    Move(lattice, rest, amplitude, rng);
+    const Clock::time_point start = Clock::now();
+    deform->Update();
+    return Seconds(start);
+  };
+  row.Evaluate = Repeat(moveAndUpdate, 9).Median;
   row.Bind = first - row.Evaluate;
   if (deform->GetNumberOfBindings() != 1)
   {
@@ -109,28 +86,15 @@ Row Measure(const std::string& name, vtkPolyData* mesh, vtkPointSet* lattice, in
 int main(int argc, char* argv[])
 {
   std::string meshPath = std::string(VOXELFFD_MESH_DIR) + "/armadillo.vtp";
-  int levels = 2; // armadillo: 26 k points, 416 k after two subdivisions
-  bool peer = true;
-  for (int a = 1; a < argc; ++a)
+  bool quick = false, noPeer = false;
+  int status = 0;
+  if (!ParseArguments(argc, argv, { { "--mesh", &meshPath }, { "--quick", &quick }, { "--no-peer", &noPeer } },
+        "[--mesh file.vtp] [--quick] [--no-peer]", status))
   {
-    if (!std::strcmp(argv[a], "--mesh") && a + 1 < argc)
-    {
-      meshPath = argv[++a];
-    }
-    else if (!std::strcmp(argv[a], "--quick"))
-    {
-      levels = 0;
-    }
-    else if (!std::strcmp(argv[a], "--no-peer"))
-    {
-      peer = false;
-    }
-    else
-    {
-      std::fprintf(stderr, "usage: %s [--mesh file.vtp] [--quick] [--no-peer]\n", argv[0]);
-      return 2;
-    }
+    return status;
   }
+  const int levels = quick ? 0 : 2; // armadillo: 26 k points, 416 k after two subdivisions
+  const bool peer = !noPeer;
   vtkNew<vtkXMLPolyDataReader> reader;
   reader->SetFileName(meshPath.c_str());
   vtkNew<vtkLinearSubdivisionFilter> subdivide;
@@ -254,16 +218,15 @@ int main(int argc, char* argv[])
       const Clock::time_point begin = Clock::now();
       deform->Update();
       const double first = Seconds(begin);
-      const double evaluate = Median(
-        [&]()
-        {
-          Move(moving, control->GetPointData()->GetArray("RestPosition"), amplitude, rng);
-          moving->Modified();
-          const Clock::time_point start = Clock::now();
-          deform->Update();
-          return Seconds(start);
-        },
-        5);
+      const auto moveAndUpdate = [&]()
+      {
+        Move(moving, control->GetPointData()->GetArray("RestPosition"), amplitude, rng);
+        moving->Modified();
+        const Clock::time_point start = Clock::now();
+        deform->Update();
+        return Seconds(start);
+      };
+      const double evaluate = Repeat(moveAndUpdate, 5).Median;
       const Row ours = Measure(lattice.Name, mesh, lattice.Grid, vtkSMPTools::GetEstimatedNumberOfThreads(), amplitude);
       std::printf("| %-20s | %9lld | %8.3f | %11.3f | %8.4f | %11.2f | %13.4f |\n", lattice.Name.c_str(),
         (long long)control->GetNumberOfCells(), first - evaluate, n / (first - evaluate) * 1e-6, evaluate,

@@ -9,12 +9,13 @@
  * lattice as the widget's drag does (vtkFFDLatticeRepresentation::MoveSelectedControlPoints on a selected
  * control point, back and forth), and every 10th moves all of its points a little, as a script would; a view
  * of each output's points is held until the next update, as a numpy user holds one. The resident set size
- * (/proc/self/statm) is read after update 1,000 and after the last: the table gives both and their
+ * (/proc/self/status VmRSS) is read after update 1,000 and after the last: the table gives both and their
  * difference. Results: BENCHMARKS.md.
  *
  * Usage: SoakFFD [--mesh FILE.vtp] [--updates N]   (default 10000)
  */
 #include "FFDBenchmarkMeshes.h"
+#include "FFDBenchmarkUtilities.h"
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDBuildTetrahedralLattice.h"
 #include "vtkFFDDeform.h"
@@ -30,33 +31,14 @@
 #include "vtkStructuredGrid.h"
 #include "vtkUnstructuredGrid.h"
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <random>
 #include <string>
 
 namespace
 {
-/// The resident set size in MB.
-double ResidentMB()
-{
-  long pages = 0, resident = 0;
-  if (FILE* statm = std::fopen("/proc/self/statm", "r"))
-  {
-    if (std::fscanf(statm, "%ld %ld", &pages, &resident) != 2)
-    {
-      resident = 0;
-    }
-    std::fclose(statm);
-  }
-  return double(resident) * double(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
-}
-
 /// A lattice to deform: built over the mesh by `build` (a vtkFFDBuildLattice or vtkFFDBuildTetrahedralLattice).
 template <typename Lattice>
 vtkSmartPointer<Lattice> CopyOf(vtkAlgorithm* build)
@@ -72,17 +54,13 @@ int main(int argc, char* argv[])
 {
   std::string meshPath = std::string(VOXELFFD_MESH_DIR) + "/armadillo.vtp";
   int updates = 10000;
-  for (int a = 1; a + 1 < argc; a += 2)
+  int status = 0;
+  if (!ParseArguments(
+        argc, argv, { { "--mesh", &meshPath }, { "--updates", &updates } }, "[--mesh FILE.vtp] [--updates N]", status))
   {
-    if (!std::strcmp(argv[a], "--mesh"))
-    {
-      meshPath = argv[a + 1];
-    }
-    else if (!std::strcmp(argv[a], "--updates"))
-    {
-      updates = std::max(1001, std::atoi(argv[a + 1]));
-    }
+    return status;
   }
+  updates = std::max(1001, updates);
   const vtkSmartPointer<vtkPolyData> mesh = ShadedSubdividedMesh(meshPath, 2);
   if (mesh->GetNumberOfPoints() == 0)
   {
@@ -142,7 +120,7 @@ int main(int argc, char* argv[])
     std::normal_distribution<double> jitter(0.0, 0.0002 * lattice->GetLength());
     vtkSmartPointer<vtkDataArray> view; // the caller's view of the last output's points
     double at1000 = 0.0;
-    const auto start = std::chrono::steady_clock::now();
+    const Clock::time_point start = Clock::now();
     for (int u = 1; u <= updates; ++u)
     {
       const double sign = (u % 2) ? 1.0 : -1.0;
@@ -163,11 +141,11 @@ int main(int argc, char* argv[])
       view = deform->GetOutput()->GetPoints()->GetData();
       if (u == 1000)
       {
-        at1000 = ResidentMB();
+        at1000 = ResidentMegabytes("VmRSS");
       }
     }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const double atEnd = ResidentMB();
+    const double seconds = Seconds(start);
+    const double atEnd = ResidentMegabytes("VmRSS");
     std::printf("| %s | %lld | %lld | %.2f | %.1f | %.1f | %+.2f %% |\n", name.c_str(),
       static_cast<long long>(lattice->GetNumberOfPoints()), static_cast<long long>(deform->GetNumberOfBindings()),
       1000.0 * seconds / updates, at1000, atEnd, 100.0 * (atEnd - at1000) / at1000);
