@@ -262,6 +262,24 @@ vtkSmartPointer<vtkPoints> MovedPoints(
   }
   return points.Get();
 }
+
+/// The largest distance from a target to where its point goes: the fit's miss `missed` (T - F - W dP) for a
+/// target inside the lattice, else the distance to where the lattice takes its point now (for every target where
+/// `missed` is null).
+double MaximumDistance(
+  vtkPoints* positions, vtkPointSet* now, const std::vector<int>& cellOf, const Eigen::MatrixXd* missed)
+{
+  double maximum = 0;
+  for (vtkIdType t = 0; t < now->GetNumberOfPoints(); ++t)
+  {
+    double target[3], at[3];
+    positions->GetPoint(t, target);
+    now->GetPoint(t, at);
+    maximum = std::max(maximum,
+      missed && cellOf[t] >= 0 ? missed->row(t).norm() : std::sqrt(vtkMath::Distance2BetweenPoints(target, at)));
+  }
+  return maximum;
+}
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -403,23 +421,12 @@ int vtkFFDDirectManipulation::RequestData(
   {
     return fail();
   }
-  // The distance from target t to where the lattice takes its point now.
-  auto apart = [&](vtkIdType t)
-  {
-    double target[3], at[3];
-    this->TargetPositions->GetPoint(t, target);
-    now->GetPoint(t, at);
-    return std::sqrt(vtkMath::Distance2BetweenPoints(target, at));
-  };
   std::map<vtkIdType, Eigen::Index> column;
   const std::vector<vtkIdType> controlPoints = MovingControlPoints(entries, column);
   if (controlPoints.empty())
   {
     // No target inside: no control point can move them (and W would have no column to decompose).
-    for (vtkIdType t = 0; t < count; ++t)
-    {
-      this->MaximumTargetDistance = std::max(this->MaximumTargetDistance, apart(t));
-    }
+    this->MaximumTargetDistance = MaximumDistance(this->TargetPositions, now, cellOf, nullptr);
     return 1;
   }
   std::ostringstream request;
@@ -441,11 +448,7 @@ int vtkFFDDirectManipulation::RequestData(
   }
   output->SetPoints(MovedPoints(lattice, controlPoints, move, this->NumberOfMovedControlPoints));
   const Eigen::MatrixXd missed = change - w * move;
-  for (vtkIdType t = 0; t < count; ++t)
-  {
-    this->MaximumTargetDistance =
-      std::max(this->MaximumTargetDistance, cellOf[t] < 0 ? apart(t) : missed.row(t).norm());
-  }
+  this->MaximumTargetDistance = MaximumDistance(this->TargetPositions, now, cellOf, &missed);
   return 1;
 }
 
