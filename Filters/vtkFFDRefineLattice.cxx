@@ -21,6 +21,7 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkSMPTools.h"
+#include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStructuredGrid.h"
 #include "vtkUnsignedCharArray.h"
@@ -31,6 +32,8 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
+#include <vector>
 
 vtkStandardNewMacro(vtkFFDRefineLattice);
 
@@ -82,6 +85,171 @@ double LastLevelBytes(const vtkFFDGridLattice& lattice, bool sparse, double voxe
   const double support = ffd::SupportSize(basis, lattice.Divisions[0]);
   const double cells = sparse ? 4.0 * fineVoxels * (support * support * support + 1) : 0.0;
   return 20.0 * fineVoxels + 74.0 * points + cells;
+}
+
+/// The fine voxels of a refinement to `fine` divisions: the halves of the coarse active region's voxels, in
+/// increasing order; `what` names the refinement. Null, said why, where they cannot be held.
+vtkSmartPointer<vtkIntArray> FineVoxels(vtkFFDRefineLattice* self, const vtkFFDGridDeformer& reader,
+  vtkPointSet* coarse, const int fine[3], std::string& what)
+{
+  std::vector<int> parents = vtkFFDCoveredVoxels(reader, coarse);
+  std::ostringstream request;
+  request << "The " << vtkFFDBuildLattice::GetBasisAsString(int(reader.GetLattice().Basis)) << " lattice refined to "
+          << fine[0] << "x" << fine[1] << "x" << fine[2] << " divisions (" << 8 * (parents.size() / 3) << " voxels)";
+  what = request.str();
+  if (!vtkFFDCheckMemory(self, what, 8.0 * 8.0 * double(parents.size() / 3)))
+  {
+    return nullptr;
+  }
+  std::vector<vtkTypeInt64> keys;
+  keys.reserve(8 * (parents.size() / 3));
+  for (std::size_t v = 0; v < parents.size(); v += 3)
+  {
+    for (int child = 0; child < 8; ++child)
+    {
+      keys.push_back(vtkFFDFlatIndex(
+        2 * parents[v] + (child & 1), 2 * parents[v + 1] + (child >> 1 & 1), 2 * parents[v + 2] + (child >> 2), fine));
+    }
+  }
+  parents = std::vector<int>();
+  std::sort(keys.begin(), keys.end());
+  return vtkFFDMakeVoxelIndex(keys, fine);
+}
+
+/// The refined lattice at rest over `voxelIndex`, as vtkFFDBuildLattice makes it (`sparse`, or dense); null,
+/// said why, where it cannot be built.
+vtkSmartPointer<vtkPointSet> RefinedAtRest(vtkFFDRefineLattice* self, const vtkFFDGridLattice& lattice, bool sparse,
+  const int fine[3], vtkIntArray* voxelIndex, const std::string& what)
+{
+  if (sparse)
+  {
+    auto refined = vtkSmartPointer<vtkUnstructuredGrid>::New();
+    if (!vtkFFDMakeSparseLattice(self, lattice.Frame, lattice.Basis, fine, voxelIndex, what, refined))
+    {
+      return nullptr;
+    }
+    return refined;
+  }
+  vtkNew<vtkUnstructuredGrid> voxelGrid;
+  if (!vtkFFDMakeVoxelGrid(self, lattice.Frame, fine, voxelIndex, what, voxelGrid))
+  {
+    return nullptr;
+  }
+  vtkNew<vtkFFDBuildLattice> build;
+  build->SetBasis(int(lattice.Basis));
+  build->SetLatticeFormToDense();
+  build->SetInputData(voxelGrid);
+  build->Update();
+  vtkSmartPointer<vtkPointSet> refined = build->GetOutput();
+  if (refined->GetNumberOfPoints() == 0)
+  {
+    vtkErrorWithObjectMacro(self, << "Could not build the refined lattice (see the error above).");
+    return nullptr;
+  }
+  return refined;
+}
+
+/// Adds to the control points `x` of the sparse `refined` lattice (`fine` divisions) their displacements from
+/// the coarse `lattice`'s (ffd::LocalRefinementRow): each fine point from the first fine cell that holds it,
+/// through that cell's parent's support. False, said why, where the refined lattice cannot be read.
+bool DisplaceSparse(vtkFFDRefineLattice* self, const vtkFFDGridLattice& lattice, const vtkFFDSparseCells* cells,
+  vtkPointSet* refined, const int fine[3], double* x)
+{
+  const ffd::GridBasis basis = lattice.Basis;
+  const int* n = lattice.Divisions;
+  const double* d = lattice.Displacements.data();
+  vtkFFDSparseCells fineCells;
+  const std::string unread = fineCells.Read(vtkUnstructuredGrid::SafeDownCast(refined), basis, fine);
+  if (!unread.empty())
+  {
+    vtkErrorWithObjectMacro(self, << "Internal error reading the refined lattice: " << unread);
+    return false;
+  }
+  const int m = ffd::SupportSize(basis, n[0]), m3 = m * m * m; // a local basis: the same along every axis
+  std::vector<int> owner(std::size_t(refined->GetNumberOfPoints()), -1);
+  for (int c = fineCells.GetNumberOfCells() - 1; c >= 0; --c)
+  {
+    for (int s = 0; s < m3; ++s)
+    {
+      owner[fineCells.GetSupports()[std::size_t(c) * m3 + s]] = c;
+    }
+  }
+  const int* coarseSupports = cells->GetSupports();
+  vtkSMPTools::For(0, fineCells.GetNumberOfCells(),
+    [&](int begin, int end)
+    {
+      for (int c = begin; c < end; ++c)
+      {
+        const int* voxel = fineCells.GetVoxels().data() + 3 * std::size_t(c);
+        const int* support =
+          coarseSupports + std::size_t(cells->Find(vtkFFDFlatIndex(voxel[0] / 2, voxel[1] / 2, voxel[2] / 2, n))) * m3;
+        int first[3], unused;
+        for (int a = 0; a < 3; ++a)
+        {
+          ffd::VoxelSupport(basis, fine[a], voxel[a], first[a], unused);
+        }
+        for (int s = 0; s < m3; ++s)
+        {
+          const int p = fineCells.GetSupports()[std::size_t(c) * m3 + s];
+          if (owner[p] != c)
+          {
+            continue;
+          }
+          const int local[3] = { s % m, s / m % m, s / (m * m) };
+          ffd::RefinementRow rows[3];
+          for (int a = 0; a < 3; ++a)
+          {
+            ffd::LocalRefinementRow(basis, n[a], voxel[a], first[a] + local[a], rows[a]);
+          }
+          double delta[3];
+          Combine(
+            rows, d, [&](int i, int j, int k) { return support[i + m * (j + m * k)]; }, delta);
+          for (int a = 0; a < 3; ++a)
+          {
+            x[3 * p + a] += delta[a];
+          }
+        }
+      }
+    });
+  return true;
+}
+
+/// Adds to the active control points `x` of the dense `refined` lattice (`finePoints` per axis) their
+/// displacements from the coarse `lattice`'s (ffd::RefineRow).
+void DisplaceDense(const vtkFFDGridLattice& lattice, vtkPointSet* refined, const int finePoints[3], double* x)
+{
+  const ffd::GridBasis basis = lattice.Basis;
+  const int* n = lattice.Divisions;
+  const double* d = lattice.Displacements.data();
+  vtkDataArray* active = refined->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName());
+  const int* coarseDims = lattice.ControlPointsPerAxis;
+  vtkSMPTools::For(0, refined->GetNumberOfPoints(),
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType p = begin; p < end; ++p)
+      {
+        if (active->GetComponent(p, 0) == 0)
+        {
+          continue;
+        }
+        const int index[3] = { int(p % finePoints[0]), int(p / finePoints[0] % finePoints[1]),
+          int(p / finePoints[0] / finePoints[1]) };
+        ffd::RefinementRow rows[3];
+        for (int a = 0; a < 3; ++a)
+        {
+          rows[a] = ffd::RefineRow(basis, n[a], index[a]);
+        }
+        double delta[3];
+        Combine(
+          rows, d,
+          [&](int i, int j, int k) { return i + vtkIdType(coarseDims[0]) * (j + vtkIdType(coarseDims[1]) * k); },
+          delta);
+        for (int a = 0; a < 3; ++a)
+        {
+          x[3 * p + a] += delta[a];
+        }
+      }
+    });
 }
 } // namespace
 
@@ -237,172 +405,38 @@ vtkSmartPointer<vtkPointSet> vtkFFDRefineLattice::RefineOnce(vtkPointSet* coarse
   }
   const vtkFFDGridLattice& lattice = reader.GetLattice();
   const vtkFFDSparseCells* cells = reader.GetSparseCells();
-  const ffd::GridBasis basis = lattice.Basis;
-  const int* n = lattice.Divisions;
   int fine[3], finePoints[3];
-  const std::string tooLarge =
-    vtkFFDDoubledDivisions(basis, n, cells ? vtkFFDBuildLattice::SPARSE : vtkFFDBuildLattice::DENSE, fine, finePoints);
+  const std::string tooLarge = vtkFFDDoubledDivisions(
+    lattice.Basis, lattice.Divisions, cells ? vtkFFDBuildLattice::SPARSE : vtkFFDBuildLattice::DENSE, fine, finePoints);
   if (!tooLarge.empty())
   {
     vtkErrorMacro(<< "Cannot refine the lattice: " << tooLarge);
     return nullptr;
   }
 
-  // The fine voxels: the halves of the coarse active region's voxels, in increasing order.
-  std::vector<int> parents = vtkFFDCoveredVoxels(reader, coarse);
-  std::ostringstream what;
-  what << "The " << vtkFFDBuildLattice::GetBasisAsString(int(basis)) << " lattice refined to " << fine[0] << "x"
-       << fine[1] << "x" << fine[2] << " divisions (" << 8 * (parents.size() / 3) << " voxels)";
-  if (!vtkFFDCheckMemory(this, what.str(), 8.0 * 8.0 * double(parents.size() / 3)))
-  {
-    return nullptr;
-  }
-  std::vector<vtkTypeInt64> keys;
-  keys.reserve(8 * (parents.size() / 3));
-  for (std::size_t v = 0; v < parents.size(); v += 3)
-  {
-    for (int child = 0; child < 8; ++child)
-    {
-      keys.push_back(vtkFFDFlatIndex(
-        2 * parents[v] + (child & 1), 2 * parents[v + 1] + (child >> 1 & 1), 2 * parents[v + 2] + (child >> 2), fine));
-    }
-  }
-  parents = std::vector<int>();
-  std::sort(keys.begin(), keys.end());
-  vtkSmartPointer<vtkIntArray> voxelIndex = vtkFFDMakeVoxelIndex(keys, fine);
-  keys = std::vector<vtkTypeInt64>();
-
-  // The refined lattice at rest, as vtkFFDBuildLattice makes it over those voxels.
-  vtkSmartPointer<vtkPointSet> refined;
-  if (cells)
-  {
-    auto sparse = vtkSmartPointer<vtkUnstructuredGrid>::New();
-    if (!vtkFFDMakeSparseLattice(this, lattice.Frame, basis, fine, voxelIndex, what.str(), sparse))
-    {
-      return nullptr;
-    }
-    refined = sparse;
-  }
-  else
-  {
-    vtkNew<vtkUnstructuredGrid> voxelGrid;
-    if (!vtkFFDMakeVoxelGrid(this, lattice.Frame, fine, voxelIndex, what.str(), voxelGrid))
-    {
-      return nullptr;
-    }
-    vtkNew<vtkFFDBuildLattice> build;
-    build->SetBasis(int(basis));
-    build->SetLatticeFormToDense();
-    build->SetInputData(voxelGrid);
-    build->Update();
-    refined = build->GetOutput();
-    if (refined->GetNumberOfPoints() == 0)
-    {
-      vtkErrorMacro(<< "Could not build the refined lattice (see the error above).");
-      return nullptr;
-    }
-  }
-  if (this->GetAbortExecute())
+  // The fine voxels, and the refined lattice at rest over them.
+  std::string what;
+  const vtkSmartPointer<vtkIntArray> voxelIndex = FineVoxels(this, reader, coarse, fine, what);
+  const vtkSmartPointer<vtkPointSet> refined =
+    voxelIndex ? RefinedAtRest(this, lattice, cells != nullptr, fine, voxelIndex, what) : nullptr;
+  if (!refined || this->GetAbortExecute())
   {
     return refined;
   }
 
   // Each fine control point's displacement from the coarse ones (ffd::RefineRow); points stay at rest where
   // they are not active.
-  const vtkIdType count = refined->GetNumberOfPoints();
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->DeepCopy(refined->GetPoints());
   double* x = vtkDoubleArray::SafeDownCast(points->GetData())->GetPointer(0);
-  const double* d = lattice.Displacements.data();
-  if (cells)
+  if (cells && !DisplaceSparse(this, lattice, cells, refined, fine, x))
   {
-    // Each fine point from the first fine cell that holds it, through that cell's parent's support.
-    vtkFFDSparseCells fineCells;
-    const std::string unread = fineCells.Read(vtkUnstructuredGrid::SafeDownCast(refined), basis, fine);
-    if (!unread.empty())
-    {
-      vtkErrorMacro(<< "Internal error reading the refined lattice: " << unread);
-      return nullptr;
-    }
-    const int m = ffd::SupportSize(basis, n[0]), m3 = m * m * m; // a local basis: the same along every axis
-    std::vector<int> owner(std::size_t(count), -1);
-    for (int c = fineCells.GetNumberOfCells() - 1; c >= 0; --c)
-    {
-      for (int s = 0; s < m3; ++s)
-      {
-        owner[fineCells.GetSupports()[std::size_t(c) * m3 + s]] = c;
-      }
-    }
-    const int* coarseSupports = cells->GetSupports();
-    vtkSMPTools::For(0, fineCells.GetNumberOfCells(),
-      [&](int begin, int end)
-      {
-        for (int c = begin; c < end; ++c)
-        {
-          const int* voxel = fineCells.GetVoxels().data() + 3 * std::size_t(c);
-          const int* support = coarseSupports +
-            std::size_t(cells->Find(vtkFFDFlatIndex(voxel[0] / 2, voxel[1] / 2, voxel[2] / 2, n))) * m3;
-          int first[3], unused;
-          for (int a = 0; a < 3; ++a)
-          {
-            ffd::VoxelSupport(basis, fine[a], voxel[a], first[a], unused);
-          }
-          for (int s = 0; s < m3; ++s)
-          {
-            const int p = fineCells.GetSupports()[std::size_t(c) * m3 + s];
-            if (owner[p] != c)
-            {
-              continue;
-            }
-            const int local[3] = { s % m, s / m % m, s / (m * m) };
-            ffd::RefinementRow rows[3];
-            for (int a = 0; a < 3; ++a)
-            {
-              ffd::LocalRefinementRow(basis, n[a], voxel[a], first[a] + local[a], rows[a]);
-            }
-            double delta[3];
-            Combine(
-              rows, d, [&](int i, int j, int k) { return support[i + m * (j + m * k)]; }, delta);
-            for (int a = 0; a < 3; ++a)
-            {
-              x[3 * p + a] += delta[a];
-            }
-          }
-        }
-      });
+    return nullptr;
   }
-  else
+  if (!cells)
   {
-    vtkDataArray* active = refined->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName());
-    const int* coarseDims = lattice.ControlPointsPerAxis;
-    vtkSMPTools::For(0, count,
-      [&](vtkIdType begin, vtkIdType end)
-      {
-        for (vtkIdType p = begin; p < end; ++p)
-        {
-          if (active->GetComponent(p, 0) == 0)
-          {
-            continue;
-          }
-          const int index[3] = { int(p % finePoints[0]), int(p / finePoints[0] % finePoints[1]),
-            int(p / finePoints[0] / finePoints[1]) };
-          ffd::RefinementRow rows[3];
-          for (int a = 0; a < 3; ++a)
-          {
-            rows[a] = ffd::RefineRow(basis, n[a], index[a]);
-          }
-          double delta[3];
-          Combine(
-            rows, d,
-            [&](int i, int j, int k) { return i + vtkIdType(coarseDims[0]) * (j + vtkIdType(coarseDims[1]) * k); },
-            delta);
-          for (int a = 0; a < 3; ++a)
-          {
-            x[3 * p + a] += delta[a];
-          }
-        }
-      });
+    DisplaceDense(lattice, refined, finePoints, x);
   }
   refined->SetPoints(points);
   return refined;
