@@ -13,15 +13,19 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
+#include "vtkSmartPointer.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
+#include <vector>
 
 vtkStandardNewMacro(vtkFFDBuildDetailLattice);
 
@@ -105,6 +109,169 @@ double SecondDifference(
   }
   return worst;
 }
+
+/// The grid lattice `input` in `reader`, and its doubled divisions (`fine`, `finePoints` control points); false,
+/// said why, where the threshold or the input cannot be refined locally.
+bool ReadLattice(vtkFFDBuildDetailLattice* self, vtkPointSet* input, double threshold, vtkFFDGridDeformer& reader,
+  int fine[3], int finePoints[3])
+{
+  if (!(threshold >= 0))
+  {
+    vtkErrorWithObjectMacro(self, << "SecondDerivativeThreshold is " << threshold
+                                  << ": give SetSecondDerivativeThreshold() a number >= 0 (0, the default: off).");
+    return false;
+  }
+  if (vtkFFDTetrahedralDeformer::IsTetrahedralLattice(input))
+  {
+    vtkErrorWithObjectMacro(self, << "The input is a tetrahedral lattice: refine it with "
+                                     "vtkFFDBuildTetrahedralLattice's SubdivisionLevels. This filter refines the "
+                                     "grid lattices of vtkFFDBuildLattice.");
+    return false;
+  }
+  const std::string why = reader.SetLattice(input);
+  if (!why.empty())
+  {
+    vtkErrorWithObjectMacro(self, << "Cannot refine the input: " << why);
+    return false;
+  }
+  const vtkFFDGridLattice& lattice = reader.GetLattice();
+  if (lattice.Basis == ffd::GridBasis::Bernstein)
+  {
+    vtkErrorWithObjectMacro(self, << "The global BERNSTEIN basis has no local refinement (each control point moves "
+                                     "every voxel): refine the whole lattice with vtkFFDRefineLattice, or use a "
+                                     "local basis.");
+    return false;
+  }
+  const std::string tooLarge =
+    vtkFFDDoubledDivisions(lattice.Basis, lattice.Divisions, vtkFFDBuildLattice::SPARSE, fine, finePoints);
+  if (!tooLarge.empty())
+  {
+    vtkErrorWithObjectMacro(self, << "Cannot refine the lattice: " << tooLarge);
+    return false;
+  }
+  return true;
+}
+
+/// Appends the flat indices of the `voxels` (3 ints a voxel) of a lattice of `n` divisions to `selected`;
+/// false, said why, where they are not voxels of it.
+bool AddSelectedVoxels(
+  vtkFFDBuildDetailLattice* self, vtkIntArray* voxels, const int n[3], std::vector<vtkTypeInt64>& selected)
+{
+  if (voxels->GetNumberOfComponents() != 3)
+  {
+    vtkErrorWithObjectMacro(self, << "SelectedVoxels has " << voxels->GetNumberOfComponents()
+                                  << " components: give 3 ints (i, j, k) a voxel.");
+    return false;
+  }
+  for (vtkIdType v = 0; v < voxels->GetNumberOfTuples(); ++v)
+  {
+    const int* ijk = voxels->GetPointer(3 * v);
+    if (ijk[0] < 0 || ijk[1] < 0 || ijk[2] < 0 || ijk[0] >= n[0] || ijk[1] >= n[1] || ijk[2] >= n[2])
+    {
+      vtkErrorWithObjectMacro(self, << "Selected voxel " << v << ", (" << ijk[0] << ", " << ijk[1] << ", " << ijk[2]
+                                    << "), lies outside the lattice's " << n[0] << "x" << n[1] << "x" << n[2]
+                                    << " divisions.");
+      return false;
+    }
+    selected.push_back(vtkFFDFlatIndex(ijk[0], ijk[1], ijk[2], n));
+  }
+  return true;
+}
+
+/// Appends the flat indices of the voxels of `input` (read by `reader`) that bend more than `threshold`
+/// (SecondDifference()) to `selected`.
+void AddBendingVoxels(
+  const vtkFFDGridDeformer& reader, vtkPointSet* input, double threshold, std::vector<vtkTypeInt64>& selected)
+{
+  const vtkFFDGridLattice& lattice = reader.GetLattice();
+  const int* n = lattice.Divisions;
+  const vtkFFDControlPointIndex index(reader, input);
+  double h[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    const double* axis = lattice.Frame + 3 * (a + 1);
+    h[a] = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]) *
+      (ffd::RestParameter(lattice.Basis, n[a], 1) - ffd::RestParameter(lattice.Basis, n[a], 0));
+  }
+  const std::vector<int> covered = vtkFFDCoveredVoxels(reader, input);
+  for (std::size_t v = 0; v < covered.size(); v += 3)
+  {
+    if (SecondDifference(lattice, index, h, &covered[v]) > threshold)
+    {
+      selected.push_back(vtkFFDFlatIndex(covered[v], covered[v + 1], covered[v + 2], n));
+    }
+  }
+}
+
+/// M: the fine control points (flat indices, sorted) of the halves of the `selected` voxels of a lattice of `n`
+/// divisions, refined to `fine` (`finePoints` control points).
+std::vector<vtkTypeInt64> MovablePoints(const std::vector<vtkTypeInt64>& selected, ffd::GridBasis basis, const int n[3],
+  const int fine[3], const int finePoints[3])
+{
+  std::vector<int> halves;
+  halves.reserve(24 * selected.size());
+  for (vtkTypeInt64 key : selected)
+  {
+    const int v[3] = { int(key % n[0]), int(key / n[0] % n[1]), int(key / n[0] / n[1]) };
+    for (int child = 0; child < 8; ++child)
+    {
+      halves.push_back(2 * v[0] + (child & 1));
+      halves.push_back(2 * v[1] + (child >> 1 & 1));
+      halves.push_back(2 * v[2] + (child >> 2));
+    }
+  }
+  vtkFFDActiveSet movableSet;
+  vtkFFDSparseLattice::MarkSupports(movableSet, basis, fine, halves.data(), vtkIdType(halves.size() / 3));
+  const vtkTypeInt64 pointDims[3] = { finePoints[0], finePoints[1], finePoints[2] };
+  return movableSet.TakeSortedIndices(pointDims);
+}
+
+/// C: the voxel index of every fine voxel that the `movable` points influence.
+vtkSmartPointer<vtkIntArray> InfluencedVoxels(
+  const std::vector<vtkTypeInt64>& movable, ffd::GridBasis basis, const int fine[3], const int finePoints[3])
+{
+  const vtkTypeInt64 pointDims[3] = { finePoints[0], finePoints[1], finePoints[2] };
+  vtkFFDActiveSet cellSet;
+  cellSet.Mark(vtkIdType(movable.size()),
+    [&](vtkIdType begin, vtkIdType end, vtkFFDBoxMarker& marker)
+    {
+      for (vtkIdType m = begin; m < end; ++m)
+      {
+        const vtkTypeInt64 key = movable[m];
+        const int p[3] = { int(key % pointDims[0]), int(key / pointDims[0] % pointDims[1]),
+          int(key / pointDims[0] / pointDims[1]) };
+        int first[3], count[3];
+        for (int a = 0; a < 3; ++a)
+        {
+          Influence(basis, fine[a], p[a], first[a], count[a]);
+        }
+        marker.Mark(first, count);
+      }
+    });
+  const vtkTypeInt64 voxelDims[3] = { fine[0], fine[1], fine[2] };
+  return vtkFFDMakeVoxelIndex(cellSet.TakeSortedIndices(voxelDims), fine);
+}
+
+/// Active: the `movable` points of `output`; the ring that closes the region is hidden.
+void MarkMovable(vtkUnstructuredGrid* output, const std::vector<vtkTypeInt64>& movable, const int finePoints[3])
+{
+  vtkIntArray* latticeIndex =
+    vtkIntArray::SafeDownCast(output->GetPointData()->GetArray(vtkFFDDataContract::LatticeIndexArrayName()));
+  vtkUnsignedCharArray* active =
+    vtkUnsignedCharArray::SafeDownCast(output->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName()));
+  vtkNew<vtkUnsignedCharArray> ghosts;
+  ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
+  ghosts->SetNumberOfValues(output->GetNumberOfPoints());
+  for (vtkIdType p = 0; p < output->GetNumberOfPoints(); ++p)
+  {
+    const int* ijk = latticeIndex->GetPointer(3 * p);
+    const bool isMovable =
+      std::binary_search(movable.begin(), movable.end(), vtkFFDFlatIndex(ijk[0], ijk[1], ijk[2], finePoints));
+    active->SetValue(p, isMovable ? 1 : 0);
+    ghosts->SetValue(p, isMovable ? 0 : vtkDataSetAttributes::HIDDENPOINT);
+  }
+  output->GetPointData()->AddArray(ghosts);
+}
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -172,83 +339,23 @@ int vtkFFDBuildDetailLattice::RequestData(
   {
     return 1;
   }
-  if (!(this->SecondDerivativeThreshold >= 0))
-  {
-    vtkErrorMacro(<< "SecondDerivativeThreshold is " << this->SecondDerivativeThreshold
-                  << ": give SetSecondDerivativeThreshold() a number >= 0 (0, the default: off).");
-    return 0;
-  }
-  if (vtkFFDTetrahedralDeformer::IsTetrahedralLattice(input))
-  {
-    vtkErrorMacro(<< "The input is a tetrahedral lattice: refine it with vtkFFDBuildTetrahedralLattice's "
-                     "SubdivisionLevels. This filter refines the grid lattices of vtkFFDBuildLattice.");
-    return 0;
-  }
   vtkFFDGridDeformer reader;
-  const std::string why = reader.SetLattice(input);
-  if (!why.empty())
+  int fine[3], finePoints[3];
+  if (!ReadLattice(this, input, this->SecondDerivativeThreshold, reader, fine, finePoints))
   {
-    vtkErrorMacro(<< "Cannot refine the input: " << why);
     return 0;
   }
   const vtkFFDGridLattice& lattice = reader.GetLattice();
-  const ffd::GridBasis basis = lattice.Basis;
-  if (basis == ffd::GridBasis::Bernstein)
-  {
-    vtkErrorMacro(<< "The global BERNSTEIN basis has no local refinement (each control point moves every voxel): "
-                     "refine the whole lattice with vtkFFDRefineLattice, or use a local basis.");
-    return 0;
-  }
-  const int* n = lattice.Divisions;
-  int fine[3], finePoints[3];
-  const std::string tooLarge = vtkFFDDoubledDivisions(basis, n, vtkFFDBuildLattice::SPARSE, fine, finePoints);
-  if (!tooLarge.empty())
-  {
-    vtkErrorMacro(<< "Cannot refine the lattice: " << tooLarge);
-    return 0;
-  }
 
   // The input voxels to refine: the selected ones, and those that bend more than the threshold.
   std::vector<vtkTypeInt64> selected;
-  if (this->SelectedVoxels)
+  if (this->SelectedVoxels && !AddSelectedVoxels(this, this->SelectedVoxels, lattice.Divisions, selected))
   {
-    vtkIntArray* voxels = this->SelectedVoxels;
-    if (voxels->GetNumberOfComponents() != 3)
-    {
-      vtkErrorMacro(<< "SelectedVoxels has " << voxels->GetNumberOfComponents()
-                    << " components: give 3 ints (i, j, k) a voxel.");
-      return 0;
-    }
-    for (vtkIdType v = 0; v < voxels->GetNumberOfTuples(); ++v)
-    {
-      const int* ijk = voxels->GetPointer(3 * v);
-      if (ijk[0] < 0 || ijk[1] < 0 || ijk[2] < 0 || ijk[0] >= n[0] || ijk[1] >= n[1] || ijk[2] >= n[2])
-      {
-        vtkErrorMacro(<< "Selected voxel " << v << ", (" << ijk[0] << ", " << ijk[1] << ", " << ijk[2]
-                      << "), lies outside the lattice's " << n[0] << "x" << n[1] << "x" << n[2] << " divisions.");
-        return 0;
-      }
-      selected.push_back(vtkFFDFlatIndex(ijk[0], ijk[1], ijk[2], n));
-    }
+    return 0;
   }
   if (this->SecondDerivativeThreshold > 0)
   {
-    const vtkFFDControlPointIndex index(reader, input);
-    double h[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      const double* axis = lattice.Frame + 3 * (a + 1);
-      h[a] = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]) *
-        (ffd::RestParameter(basis, n[a], 1) - ffd::RestParameter(basis, n[a], 0));
-    }
-    const std::vector<int> covered = vtkFFDCoveredVoxels(reader, input);
-    for (std::size_t v = 0; v < covered.size(); v += 3)
-    {
-      if (SecondDifference(lattice, index, h, &covered[v]) > this->SecondDerivativeThreshold)
-      {
-        selected.push_back(vtkFFDFlatIndex(covered[v], covered[v + 1], covered[v + 2], n));
-      }
-    }
+    AddBendingVoxels(reader, input, this->SecondDerivativeThreshold, selected);
   }
   std::sort(selected.begin(), selected.end());
   selected.erase(std::unique(selected.begin(), selected.end()), selected.end());
@@ -260,66 +367,16 @@ int vtkFFDBuildDetailLattice::RequestData(
   this->UpdateProgress(0.2);
 
   // M: the fine control points of the selected voxels' halves (movable); C: every fine voxel they influence.
-  std::vector<int> halves;
-  halves.reserve(24 * selected.size());
-  for (vtkTypeInt64 key : selected)
-  {
-    const int v[3] = { int(key % n[0]), int(key / n[0] % n[1]), int(key / n[0] / n[1]) };
-    for (int child = 0; child < 8; ++child)
-    {
-      halves.push_back(2 * v[0] + (child & 1));
-      halves.push_back(2 * v[1] + (child >> 1 & 1));
-      halves.push_back(2 * v[2] + (child >> 2));
-    }
-  }
-  vtkFFDActiveSet movableSet;
-  vtkFFDSparseLattice::MarkSupports(movableSet, basis, fine, halves.data(), vtkIdType(halves.size() / 3));
-  const vtkTypeInt64 pointDims[3] = { finePoints[0], finePoints[1], finePoints[2] };
-  const std::vector<vtkTypeInt64> movable = movableSet.TakeSortedIndices(pointDims);
-  vtkFFDActiveSet cellSet;
-  cellSet.Mark(vtkIdType(movable.size()),
-    [&](vtkIdType begin, vtkIdType end, vtkFFDBoxMarker& marker)
-    {
-      for (vtkIdType m = begin; m < end; ++m)
-      {
-        const vtkTypeInt64 key = movable[m];
-        const int p[3] = { int(key % pointDims[0]), int(key / pointDims[0] % pointDims[1]),
-          int(key / pointDims[0] / pointDims[1]) };
-        int first[3], count[3];
-        for (int a = 0; a < 3; ++a)
-        {
-          Influence(basis, fine[a], p[a], first[a], count[a]);
-        }
-        marker.Mark(first, count);
-      }
-    });
-  const vtkTypeInt64 voxelDims[3] = { fine[0], fine[1], fine[2] };
-  vtkSmartPointer<vtkIntArray> voxelIndex = vtkFFDMakeVoxelIndex(cellSet.TakeSortedIndices(voxelDims), fine);
+  const std::vector<vtkTypeInt64> movable = MovablePoints(selected, lattice.Basis, lattice.Divisions, fine, finePoints);
+  const vtkSmartPointer<vtkIntArray> voxelIndex = InfluencedVoxels(movable, lattice.Basis, fine, finePoints);
   std::ostringstream what;
   what << "A detail lattice over " << voxelIndex->GetNumberOfTuples() << " voxels of " << fine[0] << "x" << fine[1]
        << "x" << fine[2];
-  if (!vtkFFDMakeSparseLattice(this, lattice.Frame, basis, fine, voxelIndex, what.str(), output))
+  if (!vtkFFDMakeSparseLattice(this, lattice.Frame, lattice.Basis, fine, voxelIndex, what.str(), output))
   {
     return 0;
   }
-
-  // Active: the movable points; the ring that closes the region is hidden.
-  vtkIntArray* latticeIndex =
-    vtkIntArray::SafeDownCast(output->GetPointData()->GetArray(vtkFFDDataContract::LatticeIndexArrayName()));
-  vtkUnsignedCharArray* active =
-    vtkUnsignedCharArray::SafeDownCast(output->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName()));
-  vtkNew<vtkUnsignedCharArray> ghosts;
-  ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
-  ghosts->SetNumberOfValues(output->GetNumberOfPoints());
-  for (vtkIdType p = 0; p < output->GetNumberOfPoints(); ++p)
-  {
-    const int* ijk = latticeIndex->GetPointer(3 * p);
-    const bool isMovable =
-      std::binary_search(movable.begin(), movable.end(), vtkFFDFlatIndex(ijk[0], ijk[1], ijk[2], finePoints));
-    active->SetValue(p, isMovable ? 1 : 0);
-    ghosts->SetValue(p, isMovable ? 0 : vtkDataSetAttributes::HIDDENPOINT);
-  }
-  output->GetPointData()->AddArray(ghosts);
+  MarkMovable(output, movable, finePoints);
   this->UpdateProgress(1.0);
   return 1;
 }
