@@ -319,12 +319,7 @@ TEST(vtkFFDDeformSparse, DeformsAsTheDenseLatticeBitForBit)
   for (const char* name : { "bear", "elephant" })
   {
     const vtkSmartPointer<vtkPolyData> mesh = ffdtest::WithPointNormals(ReadTestMesh(name));
-    vtkNew<vtkPolyData> floatMesh;
-    floatMesh->DeepCopy(mesh);
-    vtkNew<vtkPoints> floatPoints;
-    floatPoints->SetDataTypeToFloat();
-    floatPoints->DeepCopy(mesh->GetPoints());
-    floatMesh->SetPoints(floatPoints);
+    const vtkSmartPointer<vtkPolyData> floatMesh = WithFloatPoints(mesh);
     const ffdref::Frame f = FrameAround(mesh);
     const int n[3] = { 5, 6, 7 };
     const std::set<Voxel> voxels = VoxelsOf(mesh, f, n);
@@ -717,12 +712,7 @@ TEST(vtkFFDDeformSparse, BuiltBSplineLatticeDeformsAsItsOtherFormsBitForBit)
   // same displacements at the same LatticeIndex, for double and float points, both outside policies.
   std::mt19937 rng(1722);
   const vtkSmartPointer<vtkPolyData> mesh = ffdtest::WithPointNormals(ReadTestMesh("bear"));
-  vtkNew<vtkPolyData> floatMesh;
-  floatMesh->DeepCopy(mesh);
-  vtkNew<vtkPoints> floatPoints;
-  floatPoints->SetDataTypeToFloat();
-  floatPoints->DeepCopy(mesh->GetPoints());
-  floatMesh->SetPoints(floatPoints);
+  const vtkSmartPointer<vtkPolyData> floatMesh = WithFloatPoints(mesh);
   vtkNew<vtkFFDVoxelize> voxelize;
   voxelize->SetInputData(mesh);
   voxelize->SetDivisions(12, 13, 14);
@@ -817,12 +807,7 @@ TEST(vtkFFDDeformSparse, ReupdatesInEitherPrecisionGiveAFreshFiltersBytes)
   // filter, for a dense and a sparse lattice, with and without normals and det J.
   std::mt19937 rng(1723);
   const vtkSmartPointer<vtkPolyData> mesh = ffdtest::WithPointNormals(ReadTestMesh("bear"));
-  vtkNew<vtkPolyData> floatMesh;
-  floatMesh->DeepCopy(mesh);
-  vtkNew<vtkPoints> floatPoints;
-  floatPoints->SetDataTypeToFloat();
-  floatPoints->DeepCopy(mesh->GetPoints());
-  floatMesh->SetPoints(floatPoints);
+  const vtkSmartPointer<vtkPolyData> floatMesh = WithFloatPoints(mesh);
   const ffdref::Frame f = FrameAround(mesh);
   const int n[3] = { 5, 6, 7 };
   const vtkSmartPointer<vtkStructuredGrid> dense = ffdtest::MakeLattice(f, vtkFFDBuildLattice::CUBIC_BSPLINE, n);
