@@ -20,6 +20,7 @@
 #include "vtkUnstructuredGrid.h"
 
 #include "FFDFrame.h"
+#include "FFDGridDeformation.h"
 
 #include <Eigen/Eigenvalues>
 
@@ -379,9 +380,9 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
     return 1;
   }
 
-  // Phase 2: the active voxels, each thread marking the voxels of its points. Points outside the frame and
-  // non-finite ones mark none. Parameters are clamped to [0, 1], so s * nx >= 0 truncates to floor(s * nx);
-  // s = 1 (the upper face) belongs to the last voxel.
+  // Phase 2: the active voxels, each thread marking the voxels of its points: the voxel of a point is the cell
+  // that vtkFFDDeform binds it to (ffd::BindToCells, s = 1 in the last voxel). Points outside the frame and
+  // non-finite ones mark none.
   const ffd::Frame<double> bound = ffd::Frame<double>::FromArray(frame);
   vtkFFDActiveSet active;
   WithPointRange(points,
@@ -394,11 +395,10 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
           for (vtkIdType id = begin; id < end; ++id)
           {
             const auto p = range[id];
-            ffd::Vec3<double> stu;
-            if (bound.Bind({ static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2]) }, stu))
+            int v[3];
+            if (ffd::BindToCells(bound, this->Divisions,
+                  { static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2]) }, false, v))
             {
-              const int v[3] = { std::min(static_cast<int>(stu.x * nx), nx - 1),
-                std::min(static_cast<int>(stu.y * ny), ny - 1), std::min(static_cast<int>(stu.z * nz), nz - 1) };
               marker.Mark(v, one);
             }
           }
