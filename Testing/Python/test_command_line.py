@@ -132,6 +132,23 @@ class TestCommandLine(unittest.TestCase):
                                 timeout=120, preexec_fn=limit)
         return result.returncode, result.stdout, result.stderr
 
+    def expect_one_line_errors(self, cases, no_file_named=None):
+        """Runs each case (arguments, exit status, what its message names): exit status 1 and one line on stderr,
+        or 2 and argparse's usage above the line; no traceback; with `no_file_named`, no file of that prefix left."""
+        for arguments, status, problem in cases:
+            with self.subTest(arguments=" ".join(arguments)):
+                got, out, err = self.run_command(*arguments, "-q")
+                self.assertEqual(got, status, err)
+                self.assertNotIn("Traceback", err)
+                lines = err.splitlines()
+                if status == 2:  # a usage error shows the usage above its line, as argparse does
+                    self.assertTrue(lines[0].startswith("usage: "), err)
+                else:
+                    self.assertEqual(len(lines), 1, err)
+                self.assertIn(problem, lines[-1])
+                if no_file_named:
+                    self.assertFalse([name for name in os.listdir(self.folder.name) if name.startswith(no_file_named)])
+
     def succeed(self, *arguments):
         """Runs the command, which must succeed; returns its stdout."""
         status, out, err = self.run_command(*arguments)
@@ -309,17 +326,7 @@ class TestCommandLine(unittest.TestCase):
             (("build", "bear.off", "-o", "out.vtu", "--form", "sparse"), 1, "SPARSE lattice of the global BERNSTEIN"),
             (("build", "bear.off", "-o", "out.vts", "--divisions", "0"), 2, "--divisions"),
             (("build", "bear.off", "-o", "out.vts", "--divisions", "2", "3"), 2, "--divisions"))
-        for arguments, status, problem in cases:
-            with self.subTest(arguments=" ".join(arguments)):
-                got, out, err = self.run_command(*arguments, "-q")
-                self.assertEqual(got, status, err)
-                self.assertNotIn("Traceback", err)
-                lines = err.splitlines()
-                if status == 2:  # a usage error shows the usage above its line, as argparse does
-                    self.assertTrue(lines[0].startswith("usage: "), err)
-                else:
-                    self.assertEqual(len(lines), 1, err)
-                self.assertIn(problem, lines[-1])
+        self.expect_one_line_errors(cases)
 
     def test_files_cut_short_or_garbled_and_numbers_out_of_range(self):
         """One line and exit status 1 (2 for a usage error), no traceback, no output file: random bytes in a mesh's
@@ -370,18 +377,7 @@ class TestCommandLine(unittest.TestCase):
             (("build", "bear.off", "-o", "bad_out.vts", "--padding", "inf"), 2, "--padding: inf: a finite number"),
             (("build", "bear.off", "-o", "bad_out.vts", "--padding", "1e308"), 1, "--padding 1e+308"),
             (("build", "huge.off", "-o", "bad_out.vts"), 1, "huge.off: its points span"))
-        for arguments, status, problem in cases:
-            with self.subTest(arguments=" ".join(arguments)):
-                got, out, err = self.run_command(*arguments, "-q")
-                self.assertEqual(got, status, err)
-                self.assertNotIn("Traceback", err)
-                lines = err.splitlines()
-                if status == 2:  # a usage error shows the usage above its line, as argparse does
-                    self.assertTrue(lines[0].startswith("usage: "), err)
-                else:
-                    self.assertEqual(len(lines), 1, err)
-                self.assertIn(problem, lines[-1])
-                self.assertFalse([name for name in os.listdir(self.folder.name) if name.startswith("bad_out")])
+        self.expect_one_line_errors(cases, no_file_named="bad_out")
 
     def test_a_failed_write_leaves_the_file_that_was_there(self):
         """Every output format, written by a command whose writes of a file fail past 2,000 bytes (a disk that
