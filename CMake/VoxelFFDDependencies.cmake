@@ -1,5 +1,5 @@
-# What the Filters module needs besides VTK, found the same way by the VTK build (CMakeLists.txt) and by the
-# ParaView plugin's build (ParaView/CMakeLists.txt), which compiles the module again against ParaView's VTK.
+# What the VTK modules need besides VTK, found the same way by the VTK build (CMakeLists.txt) and by the
+# ParaView plugin's build (ParaView/CMakeLists.txt), which compiles the modules again against ParaView's VTK.
 
 # The CUDA backend is built when a CUDA compiler is found (this project's machines have CUDA 13 at
 # /usr/local/cuda but no GPU); without one everything else builds and passes as is.

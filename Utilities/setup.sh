@@ -109,26 +109,27 @@ else
 fi
 
 # --- 3. Configure and build -----------------------------------------------------------------------------------
-# The ParaView plugin (test only) has a build tree of its own in $build/paraview, against ParaView's VTK; it is
-# configured first, so that the main build finds the plugin's test settings there (Testing/ParaView).
+step "Build in ${build}"
+# Configure only when there is no build system yet (also after a configure that failed half-way); Ninja re-runs
+# CMake by itself when a CMakeLists.txt changed.
+if [[ ! -f $build/build.ninja ]]; then
+  cmake -G Ninja -S "$root" -B "$build" -DPython3_EXECUTABLE="$python" "${configure_options[@]}"
+fi
+# The ParaView plugin (test only) has a build tree of its own in $build/paraview, against ParaView's VTK, linking
+# the evaluation libraries of $build; the main build then learns the plugin's test settings from it
+# (Testing/ParaView), once.
 if [[ $action == test ]]; then
   step "ParaView plugin in ${build}/paraview"
   "$root/Utilities/paraview-prefix.sh" "$build/paraview-prefix"
   if [[ ! -f $build/paraview/build.ninja ]]; then
     cmake -G Ninja -S "$root/ParaView" -B "$build/paraview" -DCMAKE_BUILD_TYPE=Release \
-      "-DParaView_DIR=$build/paraview-prefix/usr/lib/$(gcc -print-multiarch)/cmake/paraview-5.11"
+      "-DParaView_DIR=$build/paraview-prefix/usr/lib/$(gcc -print-multiarch)/cmake/paraview-5.11" \
+      "-DVOXELFFD_EVALUATION_TREE=$build"
   fi
-  configure_options+=("-DVOXELFFD_PARAVIEW_PLUGIN_TREE=$build/paraview")
+  if ! grep -q "^VOXELFFD_PARAVIEW_PLUGIN_TREE:PATH=$build/paraview\$" "$build/CMakeCache.txt"; then
+    cmake "$build" "-DVOXELFFD_PARAVIEW_PLUGIN_TREE=$build/paraview"
+  fi
 fi
-
-step "Build in ${build}"
-# Configure only when there is no build system yet (also after a configure that failed half-way), or when the
-# ParaView plugin's tree is not known to it yet (a build made by `demo` before).
-if [[ ! -f $build/build.ninja ]] ||
-  { [[ $action == test ]] && ! grep -q "^VOXELFFD_PARAVIEW_PLUGIN_TREE:PATH=$build/paraview\$" "$build/CMakeCache.txt"; }; then
-  cmake -G Ninja -S "$root" -B "$build" -DPython3_EXECUTABLE="$python" "${configure_options[@]}"
-fi
-# Ninja re-runs CMake by itself when a CMakeLists.txt changed.
 cmake --build "$build"
 if [[ $action == test ]]; then
   cmake --build "$build/paraview"

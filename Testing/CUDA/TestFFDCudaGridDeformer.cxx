@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The CUDA backend against the CPU path (the same Filters/Kernels functions run on the host) for every grid
+// The CUDA backend against the CPU path (the same Evaluation/Kernels functions run on the host) for every grid
 // basis, on fresh random inputs with fixed seeds; device residency (what is uploaded on an update); failures.
 // Without a CUDA device every test skips.
 #include "FFDCudaGridDeformer.h"

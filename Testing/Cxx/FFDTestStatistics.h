@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
  * @file FFDTestStatistics.h
- * @brief Checks a statistic that a filter recorded in its output's field data (Filters/vtkFFDStatistics.h).
+ * @brief Checks a statistic that a filter recorded in its output's field data (Filters/Core/vtkFFDStatistics.h).
  */
 #ifndef FFDTestStatistics_h
 #define FFDTestStatistics_h

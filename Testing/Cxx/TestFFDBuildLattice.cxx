@@ -191,7 +191,7 @@ const int LocalBases[] = { vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::TR
   vtkFFDBuildLattice::TRICUBIC_BEZIER, vtkFFDBuildLattice::CUBIC_BSPLINE };
 
 // The formulas below are written out from the issue and the paper (Listings 1 and 2, equation 4, the uniform
-// cubic B-spline), independently of Filters/Kernels/FFDGridBasis.h.
+// cubic B-spline), independently of Evaluation/Kernels/FFDGridBasis.h.
 
 /// Control points along an axis of n voxels.
 int ExpectedPointsAlongAxis(int basis, int n)

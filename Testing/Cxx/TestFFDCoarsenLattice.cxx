@@ -166,7 +166,7 @@ TEST(vtkFFDCoarsenLattice, CoarseningARefinedLatticeReturnsTheOriginalControlPoi
     vtkSmartPointer<vtkPointSet> coarse = Coarsen(refine->GetOutput(), box, coarsen);
     ASSERT_EQ(coarse->GetNumberOfPoints(), original->GetNumberOfPoints());
 
-    // The bound (docs/level-of-detail.md; Filters/CPU/FFDLeastSquares.h): the solver takes eight steps of
+    // The bound (docs/level-of-detail.md; Filters/LevelOfDetail/FFDLeastSquares.h): the solver takes eight steps of
     // iterated Tikhonov with M = A + lambda R', A = W^T W (here from the reference's weights), R' the control
     // net's squared second differences plus 1e-6 I, lambda = Regularization mean(diag A). In the generalised
     // eigenvectors A v = mu R' v (R'-orthonormal) each step leaves lambda / (mu + lambda) of a component's error,

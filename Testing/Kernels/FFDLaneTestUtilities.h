@@ -7,7 +7,7 @@
 #ifndef FFDLaneTestUtilities_h
 #define FFDLaneTestUtilities_h
 
-#include "FFDGridLanes.h"
+#include "FFDGridPasses.h"
 #include "FFDKernelTestUtilities.h"
 
 #include <algorithm>
@@ -97,6 +97,14 @@ PointSet<Real> MeshLikePoints(Rng& rng, const GridLattice& lat, const K& k, int 
   return set;
 }
 
+/// The lattice of a deformation as the passes of the FFDCpu library take it (its cell table where it has one).
+template <typename D>
+ffd::GridLattice<typename D::Value> LatticeOf(const D& d)
+{
+  return { d.Basis, { d.Voxels[0], d.Voxels[1], d.Voxels[2] }, { d.Dims[0], d.Dims[1], d.Dims[2] }, d.Displacements,
+    d.Frame, D::UsesCellTable() ? d.CellTable : nullptr, d.CellVoxels, d.CellSupports };
+}
+
 /// Both passes over the whole set with blocks in at most maxCells cells in place (`gathered` listed for that
 /// limit), the in-place pass's range of blocks and the gathered pass's range of tiles cut where given (sorted,
 /// within the ranges); with `stream`, into memory aligned to 64 bytes, the in-place pass by non-temporal stores.
@@ -115,20 +123,20 @@ std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Rea
   std::int64_t begin = 0;
   for (std::int64_t cut : blockCuts)
   {
-    ffd::DeformBlocksInPlace(level, d, set.Values.data(), set.Cells.data(), out, listed, begin, cut, stream);
+    ffd::DeformBlocksInPlace(level, LatticeOf(d), set.Values.data(), set.Cells.data(), out, listed, begin, cut, stream);
     begin = cut;
   }
-  ffd::DeformBlocksInPlace(level, d, set.Values.data(), set.Cells.data(), out, listed, begin, blocks, stream);
+  ffd::DeformBlocksInPlace(level, LatticeOf(d), set.Values.data(), set.Cells.data(), out, listed, begin, blocks, stream);
   std::vector<Real> copy(3 * gathered.Order.size());
   ffd::CopyGatheredPoints(set.Values.data(), gathered, 0, std::int64_t(gathered.Order.size()), copy.data());
   std::vector<Real> staging(ffd::GatherStaging, std::numeric_limits<Real>::quiet_NaN());
   begin = 0;
   for (std::int64_t cut : gatheredCuts)
   {
-    ffd::DeformGathered(level, d, copy.data(), gathered, out, begin, cut, staging.data());
+    ffd::DeformGathered(level, LatticeOf(d), copy.data(), gathered, out, begin, cut, staging.data());
     begin = cut;
   }
-  ffd::DeformGathered(level, d, copy.data(), gathered, out, begin, gathered.TileCount(), staging.data());
+  ffd::DeformGathered(level, LatticeOf(d), copy.data(), gathered, out, begin, gathered.TileCount(), staging.data());
   return std::vector<Real>(out, out + set.Values.size());
 }
 

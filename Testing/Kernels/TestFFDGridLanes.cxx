@@ -4,7 +4,7 @@
 // ffdref::DeformLocal; a point's result the same bit for bit whichever pass deforms it, whatever its neighbours
 // and however the range is split; the list of gathered points.
 
-#include "FFDGridLanes.h"
+#include "FFDGridPasses.h"
 #include "FFDKernelTestUtilities.h"
 #include "FFDLaneTestUtilities.h"
 
@@ -276,7 +276,7 @@ TYPED_TEST(FFDGridLanesTest, JacobianAtEveryLevelMatchesReference)
               determinants(std::size_t(set.Size()), nan);
             for (std::size_t c = 0; c + 1 < cuts.size(); ++c)
             {
-              ffd::DeformWithJacobian(level, k.D, set.Values.data(), set.Cells.data(), listed, normals.data(),
+              ffd::DeformWithJacobian(level, ffdtest::LatticeOf(k.D), set.Values.data(), set.Cells.data(), listed, normals.data(),
                 out.data(), outNormals.data(), determinants.data(), cuts[c], cuts[c + 1]);
             }
             for (std::int64_t i = 0; i < set.Size(); ++i)

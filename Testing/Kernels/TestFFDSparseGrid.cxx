@@ -4,7 +4,7 @@
 // the dense lattice by keeping a random subset of its cells, independently of the filters' reader.
 
 #include "FFDCellTable.h"
-#include "FFDGridLanes.h"
+#include "FFDGridPasses.h"
 #include "FFDKernelTestUtilities.h"
 #include "FFDLaneTestUtilities.h"
 
@@ -192,7 +192,7 @@ TYPED_TEST(FFDSparseGridTest, DeformsAsTheDenseLatticeBitForBit)
               const Real nan = std::numeric_limits<Real>::quiet_NaN();
               std::vector<Real> out(set.Values.size(), nan), outNormals(normals.size(), nan),
                 determinants(std::size_t(set.Size()), nan);
-              ffd::DeformWithJacobian(level, d, set.Values.data(), set.Cells.data(), listed, normals.data(), out.data(),
+              ffd::DeformWithJacobian(level, ffdtest::LatticeOf(d), set.Values.data(), set.Cells.data(), listed, normals.data(), out.data(),
                 outNormals.data(), determinants.data(), 0, set.Size());
               out.insert(out.end(), outNormals.begin(), outNormals.end());
               out.insert(out.end(), determinants.begin(), determinants.end());

@@ -4,7 +4,7 @@
  * @brief An independent float64 reference of the global FFD, written straight from the paper's equations 1-3.
  *
  * Test-only and deliberately naive: binomial coefficients times powers, Cramer's rule through the triple
- * products of equation 2, absolute control-point positions P_ijk. It shares no code with Filters/Kernels
+ * products of equation 2, absolute control-point positions P_ijk. It shares no code with Evaluation/Kernels
  * (which uses the de Casteljau triangle, a dual basis and the displacement form), so agreement between the two
  * is evidence, not an identity.
  *

@@ -1,0 +1,295 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file FFDCellTable.h
+ * @brief A local basis's cells in power form, for GridDeformation's WithCellTable evaluation (host only).
+ *
+ * The CPU builds the table at every update where ffd::WorthCellTable() says it pays (FillCellTable());
+ * GridDeformation (Evaluation/Kernels/FFDGridDeformation.h) WithCellTable evaluates it by Horner's rule
+ * (PowerForm(), declared there and defined here: the CUDA backend never instantiates it).
+ */
+#ifndef FFDCellTable_h
+#define FFDCellTable_h
+
+#include "FFDGridDeformation.h"
+
+#include <algorithm>
+
+namespace ffd
+{
+
+/**
+ * A local basis's displacement in each of its cells [cellBegin, cellEnd) (flat indices, as BindToGrid()
+ * numbers them) in power form: at local coordinates (a, b, c) in [0, 1]^3 of the cell,
+ * D = sum over i, j, k <= degree of C_ijk a^i b^j c^k, the C from the cell's (degree + 1)^3 control points by the
+ * basis's change to monomials along each axis, in double. Horner's rule then takes (degree + 1)^3 - 1
+ * multiply-adds a component, against about 1.3 times that and the weights for the weighted sum of the control
+ * points (a half, and 14 against 7, for the trilinear basis). The rest lattice's coefficients are all 0, so it stays
+ * exactly the identity. `displacements` as GridDeformation::Displacements on a grid of `dims`; `table` holds
+ * CellTableStride(CellDegree(basis)) Reals per cell. For a sparse lattice, `cellVoxels` and `cellSupports` are
+ * GridDeformation's (null for a dense one): its cells' entries are read through them, the same values in the same
+ * order, so that its table is the dense lattice's, cell for cell.
+ */
+namespace detail
+{
+/// The change to monomials along an axis of a local basis: M[j][a], the coefficient of r^j in the basis function
+/// of the cell's control point a.
+template <GridBasis Basis>
+struct ToMonomials
+{
+  static constexpr int N = CellDegree(Basis) + 1;
+  double M[4][4] = {};
+
+  constexpr ToMonomials()
+  {
+    if (Basis == GridBasis::CubicBSpline)
+    {
+      const double m[4][4] = { { 1, 4, 1, 0 }, { -3, 0, 3, 0 }, { 3, -6, 3, 0 }, { -1, 3, -3, 1 } };
+      for (int j = 0; j < 4; ++j)
+      {
+        for (int a = 0; a < 4; ++a)
+        {
+          this->M[j][a] = m[j][a] / 6.0;
+        }
+      }
+      return;
+    }
+    // Bernstein: C(d, a) r^a (1 - r)^(d - a) = sum over j >= a of C(d, a) C(d - a, j - a) (-1)^(j - a) r^j.
+    const int d = N - 1;
+    for (int a = 0; a <= d; ++a)
+    {
+      for (int j = a; j <= d; ++j)
+      {
+        this->M[j][a] = Choose(d, a) * Choose(d - a, j - a) * ((j - a) % 2 == 0 ? 1.0 : -1.0);
+      }
+    }
+  }
+
+  static constexpr double Choose(int m, int k)
+  {
+    double c = 1.0;
+    for (int i = 1; i <= k; ++i)
+    {
+      c = c * (m - k + i) / i;
+    }
+    return c;
+  }
+};
+
+/// v (N^3 points of 3 components, x fastest) with its axis of stride Stride (1, N or N^2) changed to monomials
+/// by M (ToMonomials). M is a compile-time constant, so that its zeros and ones cost nothing, and the three
+/// components go together: the table is rebuilt at every update.
+template <int N, int Stride>
+inline void ToMonomialsAlong(const double (&m)[4][4], double (&v)[N * N * N][3])
+{
+  for (int outer = 0; outer < N * N * N; outer += N * Stride) // the axes above
+  {
+    for (int inner = 0; inner < Stride; ++inner) // the axes below
+    {
+      double out[N][3];
+      for (int j = 0; j < N; ++j)
+      {
+        for (int k = 0; k < 3; ++k)
+        {
+          double sum = 0.0;
+          for (int a = 0; a < N; ++a)
+          {
+            sum += m[j][a] * v[outer + a * Stride + inner][k];
+          }
+          out[j][k] = sum;
+        }
+      }
+      for (int j = 0; j < N; ++j)
+      {
+        for (int k = 0; k < 3; ++k)
+        {
+          v[outer + j * Stride + inner][k] = out[j][k];
+        }
+      }
+    }
+  }
+}
+
+/// FillCellTable() for one local basis.
+template <GridBasis Basis, typename Real>
+inline void FillCellTableOf(const Real* displacements, const int voxels[3], const int dims[3], const int* cellVoxels,
+  const int* cellSupports, Real* table, int cellBegin, int cellEnd)
+{
+  static constexpr ToMonomials<Basis> toMonomials;
+  constexpr int N = ToMonomials<Basis>::N;
+  constexpr int stride = CellTableStride(N - 1);
+  int c[3] = { cellBegin % voxels[0], cellBegin / voxels[0] % voxels[1], cellBegin / (voxels[0] * voxels[1]) };
+  for (int cell = cellBegin; cell < cellEnd; ++cell)
+  {
+    if (cellVoxels)
+    {
+      std::copy(cellVoxels + 3 * std::size_t(cell), cellVoxels + 3 * std::size_t(cell) + 3, c);
+    }
+    int first[3], count;
+    for (int a = 0; a < 3; ++a)
+    {
+      VoxelSupport(Basis, voxels[a], c[a], first[a], count);
+    }
+    Real* entry = table + std::size_t(cell) * stride;
+    for (int u = 0; u < 8; ++u)
+    {
+      entry[u] = Real(u < 3 ? c[u] : 0);
+    }
+    // The control points (x fastest), changed to monomials along x, then y, then z.
+    const Real* corner = displacements + 3 * (first[0] + dims[0] * (first[1] + dims[1] * first[2]));
+    const int* support = cellSupports ? cellSupports + std::size_t(cell) * (N * N * N) : nullptr;
+    double v[N * N * N][3];
+    for (int z = 0; z < N; ++z)
+    {
+      for (int y = 0; y < N; ++y)
+      {
+        for (int x = 0; x < N; ++x)
+        {
+          const int local = x + N * (y + N * z);
+          const Real* value =
+            support ? displacements + 3 * std::size_t(support[local]) : corner + 3 * (x + dims[0] * (y + dims[1] * z));
+          for (int k = 0; k < 3; ++k)
+          {
+            v[local][k] = double(value[k]);
+          }
+        }
+      }
+    }
+    ToMonomialsAlong<N, 1>(toMonomials.M, v);
+    ToMonomialsAlong<N, N>(toMonomials.M, v);
+    ToMonomialsAlong<N, N * N>(toMonomials.M, v);
+    for (int i = 0; i < N * N * N; ++i)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        entry[8 + 3 * i + k] = Real(v[i][k]);
+      }
+    }
+    // The next cell's indices (x fastest).
+    if (++c[0] == voxels[0])
+    {
+      c[0] = 0;
+      if (++c[1] == voxels[1])
+      {
+        c[1] = 0;
+        ++c[2];
+      }
+    }
+  }
+}
+} // namespace detail
+
+template <typename Real>
+inline void FillCellTable(GridBasis basis, const Real* displacements, const int voxels[3], const int dims[3],
+  const int* cellVoxels, const int* cellSupports, Real* table, int cellBegin, int cellEnd)
+{
+  switch (basis)
+  {
+    case GridBasis::Trilinear:
+      return detail::FillCellTableOf<GridBasis::Trilinear>(
+        displacements, voxels, dims, cellVoxels, cellSupports, table, cellBegin, cellEnd);
+    case GridBasis::TriquadraticBezier:
+      return detail::FillCellTableOf<GridBasis::TriquadraticBezier>(
+        displacements, voxels, dims, cellVoxels, cellSupports, table, cellBegin, cellEnd);
+    case GridBasis::TricubicBezier:
+      return detail::FillCellTableOf<GridBasis::TricubicBezier>(
+        displacements, voxels, dims, cellVoxels, cellSupports, table, cellBegin, cellEnd);
+    case GridBasis::CubicBSpline:
+      return detail::FillCellTableOf<GridBasis::CubicBSpline>(
+        displacements, voxels, dims, cellVoxels, cellSupports, table, cellBegin, cellEnd);
+    case GridBasis::Bernstein: // one cell: no table
+      break;
+  }
+}
+
+/**
+ * D of FillCellTable() (a basis of degree Degree) at local coordinates r[g] of the cell whose entry is `entry`, for
+ * G lane groups g at once, by Horner's rule, into d[g], and, where dDdr is not null, its derivatives into dDdr[g]:
+ * column a is dD/dr[a]. Each coefficient is read (broadcast to the lanes) once for all G groups: the broadcasts
+ * are a large part of a cell's cost.
+ */
+template <int Degree, int G, typename Lane, typename Real>
+FFD_INLINE void PowerForm(const Real* entry, const Lane (*r)[3], Vec3<Lane>* d, Mat3<Lane>* dDdr)
+{
+  constexpr int N = Degree + 1;
+  const Real* c = entry + 8;
+  Lane out[G][3];
+  FFD_UNROLL
+  for (int k = 0; k < 3; ++k)
+  {
+    // Along z, of polynomials along y, of polynomials along x; each with its derivative where asked.
+    Lane z[G], zx[G], zy[G], zz[G];
+    FFD_UNROLL
+    for (int iz = Degree; iz >= 0; --iz)
+    {
+      Lane y[G], yx[G], yy[G];
+      FFD_UNROLL
+      for (int iy = Degree; iy >= 0; --iy)
+      {
+        const Real* row = c + 3 * N * (iy + N * iz) + k;
+        Lane x[G], xx[G];
+        const Lane top = Lane(row[3 * Degree]);
+        FFD_UNROLL
+        for (int g = 0; g < G; ++g)
+        {
+          x[g] = top;
+          xx[g] = Lane(0);
+        }
+        FFD_UNROLL
+        for (int ix = Degree - 1; ix >= 0; --ix)
+        {
+          const Lane coefficient = Lane(row[3 * ix]);
+          FFD_UNROLL
+          for (int g = 0; g < G; ++g)
+          {
+            if (dDdr)
+            {
+              xx[g] = x[g] + r[g][0] * xx[g];
+            }
+            x[g] = coefficient + r[g][0] * x[g];
+          }
+        }
+        FFD_UNROLL
+        for (int g = 0; g < G; ++g)
+        {
+          if (dDdr)
+          {
+            yy[g] = iy == Degree ? Lane(0) : y[g] + r[g][1] * yy[g];
+            yx[g] = iy == Degree ? xx[g] : xx[g] + r[g][1] * yx[g];
+          }
+          y[g] = iy == Degree ? x[g] : x[g] + r[g][1] * y[g];
+        }
+      }
+      FFD_UNROLL
+      for (int g = 0; g < G; ++g)
+      {
+        if (dDdr)
+        {
+          zz[g] = iz == Degree ? Lane(0) : z[g] + r[g][2] * zz[g];
+          zx[g] = iz == Degree ? yx[g] : yx[g] + r[g][2] * zx[g];
+          zy[g] = iz == Degree ? yy[g] : yy[g] + r[g][2] * zy[g];
+        }
+        z[g] = iz == Degree ? y[g] : y[g] + r[g][2] * z[g];
+      }
+    }
+    FFD_UNROLL
+    for (int g = 0; g < G; ++g)
+    {
+      out[g][k] = z[g];
+      if (dDdr)
+      {
+        dDdr[g].M[k][0] = zx[g];
+        dDdr[g].M[k][1] = zy[g];
+        dDdr[g].M[k][2] = zz[g];
+      }
+    }
+  }
+  FFD_UNROLL
+  for (int g = 0; g < G; ++g)
+  {
+    d[g] = { out[g][0], out[g][1], out[g][2] };
+  }
+}
+
+} // namespace ffd
+
+#endif

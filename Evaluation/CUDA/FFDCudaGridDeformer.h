@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file FFDCudaGridDeformer.h
+ * @brief The CUDA backend for grid lattices: device-resident binding and evaluation of their deformation.
+ *
+ * Plain C++ (no CUDA, VTK, OpenVDB or TBB header); only FFDCudaGridDeformer.cu is compiled by nvcc. The device
+ * code calls the same Evaluation/Kernels functions as the CPU path (ffd::BindToGrid, ffd::GridDeformation), so both
+ * compute one function. Residency, downloads and failures: ResidentPoints (FFDCudaResidentPoints.h).
+ */
+#ifndef FFDCudaGridDeformer_h
+#define FFDCudaGridDeformer_h
+
+#include "FFDCudaResidentPoints.h"
+
+namespace ffd
+{
+namespace cuda
+{
+
+class GridDeformer : public ResidentPoints
+{
+public:
+  GridDeformer();
+
+  /// Binds the points to a lattice (ffd::BindToGrid): frame X0, S, T, U; basis (ffd::GridBasis value);
+  /// divisions (voxels per axis). The binding stays on the device.
+  bool Bind(const double frame[12], int basis, const int divisions[3], bool clampOutside);
+
+  /**
+   * Takes the binding of the points to a sparse lattice, computed on the host (its voxels' lookup needs the
+   * lattice's cells): each point's cell (-1: it keeps its position), and per cell its voxel's indices (3 ints)
+   * and its support's control points (SupportSize()^3 indices into the displacements, i fastest), as
+   * ffd::GridDeformation's CellVoxels and CellSupports. Frame, basis and divisions as Bind(); `controlPoints`
+   * is the sparse lattice's count, which Evaluate() is then given.
+   */
+  bool BindSparse(const double frame[12], int basis, const int divisions[3], const int* cellOfPoint,
+    const int* cellVoxels, const int* cellSupports, std::int64_t cells, std::int64_t controlPoints);
+
+  /// Uploads the displacements (3 doubles per control point, VTK order, `controlPoints` of them, as many as the
+  /// basis and divisions of Bind() give, or a sparse lattice's of BindSparse()) and evaluates every point on the
+  /// device, with the transformed normals (needs SetNormals()) and det(J) when asked for. The results stay on the
+  /// device until Download().
+  bool Evaluate(const double* displacements, std::int64_t controlPoints, bool withNormals, bool withDeterminants);
+
+private:
+  struct Impl;
+};
+
+} // namespace cuda
+} // namespace ffd
+
+#endif

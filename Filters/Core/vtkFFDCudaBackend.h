@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkFFDCudaBackend
+ * @brief   vtkFFDDeform's glue to the CUDA backend (Evaluation/CUDA): residency, precision, array layout
+ *
+ * Private to the Filters module (not wrapped). It keeps one ffd::cuda::GridDeformer and one
+ * ffd::cuda::TetrahedralDeformer per vtkFFDDeform, uploads the input's points and normals only when they change.
+ * A grid lattice's points are re-bound on the device only when they or the lattice's rest frame, shape or the
+ * outside policy change (the same key as the CPU binding, vtkFFDBindingKey); a tetrahedral lattice's binding is
+ * the host's (vtkFFDTetrahedralDeformer: it needs VTK's cell locator), uploaded once per binding, and so is a
+ * sparse grid lattice's (vtkFFDGridDeformer: it needs the lookup of its voxels' cells). An update
+ * uploads only the lattice's displacements (of control points or of nodes) and downloads straight into the
+ * output arrays.
+ *
+ * In a build without CUDA every call answers "not available", so vtkFFDDeform needs no conditional code.
+ */
+#ifndef vtkFFDCudaBackend_h
+#define vtkFFDCudaBackend_h
+
+#include "vtkFFDBindingKey.h"
+#include "vtkType.h"
+
+#include <memory>
+#include <string>
+
+class vtkDataArray;
+class vtkFFDGridDeformer;
+class vtkFFDTetrahedralDeformer;
+class vtkPoints;
+
+class vtkFFDCudaBackend
+{
+public:
+  vtkFFDCudaBackend();
+  ~vtkFFDCudaBackend();
+  vtkFFDCudaBackend(const vtkFFDCudaBackend&) = delete;
+  vtkFFDCudaBackend& operator=(const vtkFFDCudaBackend&) = delete;
+
+  /// True when this build has the CUDA backend and a device can be used; otherwise false and why not.
+  static bool IsAvailable(std::string& why);
+
+  /**
+   * Deforms on the device: the input's points (and normals, 3 components, may be null) bound per `key` to the
+   * grid lattice of `grid` (its last SetLattice()), displaced by its displacements. A dense lattice's points are
+   * bound on the device; a sparse lattice's binding is the host's (`grid`'s Bind() must have run for these
+   * points: finding a voxel's cell needs its lookup), uploaded with its cells when the key changes. The results
+   * go to outPoints (a float or double AOS array with the points' count of tuples: the evaluation's precision),
+   * outNormals and outDeterminants (of outPoints' type) when not null. `bound` tells whether the device's binding
+   * was (re)made. On any failure: false, the reason in `why`, the outputs to be discarded, and no device state
+   * kept.
+   */
+  bool DeformGrid(const vtkFFDGridDeformer& grid, const vtkFFDBindingKey& key, vtkPoints* points, vtkDataArray* normals,
+    vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants, bool& bound, std::string& why);
+
+  /**
+   * Deforms on the device the input's points bound by `tetrahedra` (whose Bind() ran for them; its binding is
+   * uploaded when the device does not hold it) by the nodes' displacements of its last SetLattice(), then moves
+   * the points clamped to the control mesh on the host with its ApplyClampedPoints(), as the CPU does. Outputs
+   * and failures as DeformGrid().
+   */
+  bool DeformTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points, vtkDataArray* normals,
+    vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants, std::string& why);
+
+private:
+  struct vtkState;
+  std::unique_ptr<vtkState> State;
+};
+
+#endif
