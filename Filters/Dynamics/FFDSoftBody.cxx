@@ -324,23 +324,15 @@ void SoftBody::SpringVector(const std::vector<double>& u, std::size_t k, double 
 }
 
 //------------------------------------------------------------------------------------------------------------
-bool SoftBody::Step(const std::vector<double>& acceleration, const std::vector<double>& targets,
-  const std::function<void(std::vector<double>&)>& constrain)
+std::vector<double> SoftBody::InertiaRightHandSide(
+  const std::vector<double>& acceleration, const std::vector<double>& targets, std::vector<double>& u) const
 {
-  if (!this->Solver && !this->Factorize())
-  {
-    return false;
-  }
-  const SoftBodySettings& s = this->Settings;
-  const double h = s.TimeStep;
+  const double h = this->Settings.TimeStep;
   const std::size_t n = this->Mass.size();
   const bool accelerated = acceleration.size() == 3 * n;
-
-  // The parts of the right-hand side that stay through the iterations: inertia, the springs' damping, and the
-  // springs to pinned particles (at their targets). 3 values a row.
-  Factor& factor = *this->Solver;
+  const Factor& factor = *this->Solver;
   std::vector<double> fixed(3 * std::size_t(factor.Rows));
-  std::vector<double> u = this->U;
+  u = this->U;
   for (std::size_t i = 0; i < n; ++i)
   {
     const int r = factor.Row[i];
@@ -359,7 +351,13 @@ bool SoftBody::Step(const std::vector<double>& acceleration, const std::vector<d
       }
     }
   }
-  const double damping = s.SpringDamping / h;
+  return fixed;
+}
+
+void SoftBody::AddDampingAndPinnedSprings(const std::vector<double>& u, std::vector<double>& fixed) const
+{
+  const Factor& factor = *this->Solver;
+  const double damping = this->Settings.SpringDamping / this->Settings.TimeStep;
   for (const auto& spring : this->Springs)
   {
     const int a = spring[0], b = spring[1];
@@ -377,64 +375,100 @@ bool SoftBody::Step(const std::vector<double>& acceleration, const std::vector<d
       }
     }
   }
+}
+
+void SoftBody::AddSpringPulls(const std::vector<double>& u, std::vector<double>& rhs) const
+{
+  const Factor& factor = *this->Solver;
+  for (std::size_t k = 0; k < this->Springs.size(); ++k)
+  {
+    const int a = this->Springs[k][0], b = this->Springs[k][1];
+    const double* rest = &this->RestVector[3 * k];
+    double d[3];
+    this->SpringVector(u, k, d);
+    const double length = Norm(d);
+    if (!(length > 0))
+    {
+      continue; // no direction to restore: the spring pulls toward its rest vector, k (p - D) = 0
+    }
+    const double scale = this->RestLength[k] / length;
+    const int ra = factor.Row[a], rb = factor.Row[b];
+    for (int c = 0; c < 3; ++c)
+    {
+      const double pull = this->Settings.SpringStiffness * (d[c] * scale - rest[c]); // k (p - D)
+      if (ra >= 0)
+      {
+        rhs[3 * ra + c] -= pull;
+      }
+      if (rb >= 0)
+      {
+        rhs[3 * rb + c] += pull;
+      }
+    }
+  }
+}
+
+void SoftBody::AddCorePull(const std::vector<double>& u, std::vector<double>& rhs) const
+{
+  const Factor& factor = *this->Solver;
+  const Core core = this->RigidCore(u);
+  for (std::size_t i = 0; i < this->Mass.size(); ++i)
+  {
+    const int r = factor.Row[i];
+    if (r < 0)
+    {
+      continue;
+    }
+    for (int c = 0; c < 3; ++c)
+    {
+      rhs[3 * r + c] += this->Settings.CoreStiffness * this->Mass[i] * core.Goal(&this->Centered[3 * i], c);
+    }
+  }
+}
+
+void SoftBody::SolveGlobalStep(std::vector<double>& rhs, std::vector<double>& u)
+{
+  Factor& factor = *this->Solver;
+  factor.Solve(rhs.data(), rhs.data());
+  for (std::size_t i = 0; i < this->Mass.size(); ++i)
+  {
+    const int r = factor.Row[i];
+    if (r >= 0)
+    {
+      std::copy(&rhs[3 * r], &rhs[3 * r] + 3, &u[3 * i]);
+    }
+  }
+}
+
+//------------------------------------------------------------------------------------------------------------
+bool SoftBody::Step(const std::vector<double>& acceleration, const std::vector<double>& targets,
+  const std::function<void(std::vector<double>&)>& constrain)
+{
+  if (!this->Solver && !this->Factorize())
+  {
+    return false;
+  }
+  const SoftBodySettings& s = this->Settings;
+  const double h = s.TimeStep;
+  const std::size_t n = this->Mass.size();
+
+  // The parts of the right-hand side that stay through the iterations: inertia, the springs' damping, and the
+  // springs to pinned particles (at their targets). 3 values a row.
+  std::vector<double> u;
+  std::vector<double> fixed = this->InertiaRightHandSide(acceleration, targets, u);
+  this->AddDampingAndPinnedSprings(u, fixed);
 
   std::vector<double> rhs(fixed.size());
   for (int iteration = 0; iteration < std::max(1, s.Iterations); ++iteration)
   {
     rhs = fixed;
     // Local step: each spring scaled to its rest length, each particle's place on the rigid core.
-    for (std::size_t k = 0; k < this->Springs.size(); ++k)
-    {
-      const int a = this->Springs[k][0], b = this->Springs[k][1];
-      const double* rest = &this->RestVector[3 * k];
-      double d[3];
-      this->SpringVector(u, k, d);
-      const double length = Norm(d);
-      if (!(length > 0))
-      {
-        continue; // no direction to restore: the spring pulls toward its rest vector, k (p - D) = 0
-      }
-      const double scale = this->RestLength[k] / length;
-      const int ra = factor.Row[a], rb = factor.Row[b];
-      for (int c = 0; c < 3; ++c)
-      {
-        const double pull = s.SpringStiffness * (d[c] * scale - rest[c]); // k (p - D)
-        if (ra >= 0)
-        {
-          rhs[3 * ra + c] -= pull;
-        }
-        if (rb >= 0)
-        {
-          rhs[3 * rb + c] += pull;
-        }
-      }
-    }
+    this->AddSpringPulls(u, rhs);
     if (s.CoreStiffness > 0)
     {
-      const Core core = this->RigidCore(u);
-      for (std::size_t i = 0; i < n; ++i)
-      {
-        const int r = factor.Row[i];
-        if (r < 0)
-        {
-          continue;
-        }
-        for (int c = 0; c < 3; ++c)
-        {
-          rhs[3 * r + c] += s.CoreStiffness * this->Mass[i] * core.Goal(&this->Centered[3 * i], c);
-        }
-      }
+      this->AddCorePull(u, rhs);
     }
-    // Global step.
-    factor.Solve(rhs.data(), rhs.data());
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      const int r = factor.Row[i];
-      if (r >= 0)
-      {
-        std::copy(&rhs[3 * r], &rhs[3 * r] + 3, &u[3 * i]);
-      }
-    }
+    this->SolveGlobalStep(rhs, u);
   }
   if (constrain)
   {
@@ -512,53 +546,62 @@ std::array<double, 3> SoftBody::Momentum() const
 }
 
 //------------------------------------------------------------------------------------------------------------
-double SoftBody::ExplicitTimeStepLimit() const
+void SoftBody::MultiplyRestHessian(const std::vector<double>& x, std::vector<double>& y) const
 {
+  // H x at rest: each spring k D^ D^T (x_b - x_a) (its stiffness along itself), and kappa m x for the core.
   const std::size_t n = this->Mass.size();
   const SoftBodySettings& s = this->Settings;
-  // H x at rest: each spring k D^ D^T (x_b - x_a) (its stiffness along itself), and kappa m x for the core.
-  auto multiply = [&](const std::vector<double>& x, std::vector<double>& y)
+  for (std::size_t i = 0; i < n; ++i)
   {
-    for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
     {
-      for (int c = 0; c < 3; ++c)
-      {
-        y[3 * i + c] = s.CoreStiffness * this->Mass[i] * x[3 * i + c];
-      }
+      y[3 * i + c] = s.CoreStiffness * this->Mass[i] * x[3 * i + c];
     }
-    for (std::size_t k = 0; k < this->Springs.size(); ++k)
+  }
+  for (std::size_t k = 0; k < this->Springs.size(); ++k)
+  {
+    const int a = this->Springs[k][0], b = this->Springs[k][1];
+    const double* d = &this->RestVector[3 * k];
+    const double l2 = this->RestLength[k] * this->RestLength[k];
+    double along = 0;
+    for (int c = 0; c < 3; ++c)
     {
-      const int a = this->Springs[k][0], b = this->Springs[k][1];
-      const double* d = &this->RestVector[3 * k];
-      const double l2 = this->RestLength[k] * this->RestLength[k];
-      double along = 0;
-      for (int c = 0; c < 3; ++c)
-      {
-        along += d[c] * (x[3 * b + c] - x[3 * a + c]);
-      }
-      for (int c = 0; c < 3; ++c)
-      {
-        const double f = s.SpringStiffness * along * d[c] / l2;
-        y[3 * a + c] -= f;
-        y[3 * b + c] += f;
-      }
+      along += d[c] * (x[3 * b + c] - x[3 * a + c]);
     }
-    for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
     {
-      for (int c = 0; c < 3; ++c)
-      {
-        y[3 * i + c] = this->Pinned[i] ? 0.0 : y[3 * i + c];
-      }
+      const double f = s.SpringStiffness * along * d[c] / l2;
+      y[3 * a + c] -= f;
+      y[3 * b + c] += f;
     }
-  };
-  // Power iteration on M^-1 H (self-adjoint for the M inner product) from a fixed pseudo-random start.
-  std::vector<double> x(3 * n), y(3 * n);
+  }
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      y[3 * i + c] = this->Pinned[i] ? 0.0 : y[3 * i + c];
+    }
+  }
+}
+
+std::vector<double> SoftBody::PowerIterationStart() const
+{
+  // Fixed and pseudo-random, so that the limit is the same every call; zero at pinned particles.
+  std::vector<double> x(3 * this->Mass.size());
   std::uint32_t seed = 12345u;
-  for (std::size_t j = 0; j < 3 * n; ++j)
+  for (std::size_t j = 0; j < x.size(); ++j)
   {
     seed = seed * 1664525u + 1013904223u;
     x[j] = this->Pinned[j / 3] ? 0.0 : double(seed >> 8) / double(1u << 24) - 0.5;
   }
+  return x;
+}
+
+double SoftBody::ExplicitTimeStepLimit() const
+{
+  const std::size_t n = this->Mass.size();
+  // Power iteration on M^-1 H (self-adjoint for the M inner product) from a fixed pseudo-random start.
+  std::vector<double> x = this->PowerIterationStart(), y(3 * n);
   double lambda = 0;
   for (int iteration = 0; iteration < 1000; ++iteration)
   {
@@ -576,7 +619,7 @@ double SoftBody::ExplicitTimeStepLimit() const
     {
       value /= norm;
     }
-    multiply(x, y);
+    this->MultiplyRestHessian(x, y);
     double rayleigh = 0;
     for (std::size_t j = 0; j < 3 * n; ++j)
     {

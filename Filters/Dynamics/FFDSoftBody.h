@@ -123,6 +123,25 @@ private:
   void SpringVector(const std::vector<double>& u, std::size_t k, double d[3]) const;
   bool Factorize();
 
+  ///@{
+  /// Steps of Step(). The right-hand side that stays through the iterations: inertia (u starts at the
+  /// momentum's guess, pinned particles at their targets), then the springs' damping and the springs to pinned
+  /// particles. The local step adds each spring's pull toward its rest length and each particle's pull toward the
+  /// rigid core; the global step solves for the free particles' displacements.
+  std::vector<double> InertiaRightHandSide(
+    const std::vector<double>& acceleration, const std::vector<double>& targets, std::vector<double>& u) const;
+  void AddDampingAndPinnedSprings(const std::vector<double>& u, std::vector<double>& fixed) const;
+  void AddSpringPulls(const std::vector<double>& u, std::vector<double>& rhs) const;
+  void AddCorePull(const std::vector<double>& u, std::vector<double>& rhs) const;
+  void SolveGlobalStep(std::vector<double>& rhs, std::vector<double>& u);
+  ///@}
+
+  ///@{
+  /// Steps of ExplicitTimeStepLimit(): y = H x at rest (zero at pinned particles), and the power iteration's start.
+  void MultiplyRestHessian(const std::vector<double>& x, std::vector<double>& y) const;
+  std::vector<double> PowerIterationStart() const;
+  ///@}
+
   std::vector<double> Rest;
   std::vector<double> Mass;
   std::vector<std::array<int, 2>> Springs;
