@@ -230,6 +230,33 @@ bool PrincipalAxes(
   axes.col(2) = axes.col(0).cross(axes.col(1));
   return true;
 }
+
+/// Marks the active voxels, each thread the voxels of its points: the voxel of a point is the cell that
+/// vtkFFDDeform binds it to (ffd::BindToCells, s = 1 in the last voxel). Points outside the frame and non-finite
+/// ones mark none.
+void MarkActiveVoxels(vtkDataArray* points, const double frame[12], const int divisions[3], vtkFFDActiveSet& active)
+{
+  const ffd::Frame<double> bound = ffd::Frame<double>::FromArray(frame);
+  WithPointRange(points,
+    [&](auto range)
+    {
+      active.Mark(points->GetNumberOfTuples(),
+        [&](vtkIdType begin, vtkIdType end, vtkFFDBoxMarker& marker)
+        {
+          const int one[3] = { 1, 1, 1 };
+          for (vtkIdType id = begin; id < end; ++id)
+          {
+            const auto p = range[id];
+            int v[3];
+            if (ffd::BindToCells(bound, divisions,
+                  { static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2]) }, false, v))
+            {
+              marker.Mark(v, one);
+            }
+          }
+        });
+    });
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -312,6 +339,45 @@ vtkTypeBool vtkFFDVoxelize::ProcessRequest(
 }
 
 //------------------------------------------------------------------------------
+bool vtkFFDVoxelize::ComputeFrame(
+  vtkDataArray* points, vtkMultiProcessController* controller, vtkIdType numPoints, double frame[12])
+{
+  if (this->FrameMode == EXPLICIT)
+  {
+    std::copy(this->FrameOrigin, this->FrameOrigin + 3, frame);
+    std::copy(this->FrameS, this->FrameS + 3, frame + 3);
+    std::copy(this->FrameT, this->FrameT + 3, frame + 6);
+    std::copy(this->FrameU, this->FrameU + 3, frame + 9);
+    return true;
+  }
+  OrientedBox box;
+  if (this->FrameMode == PRINCIPAL_AXES && !PrincipalAxes(points, controller, box.Anchor, box.Axes))
+  {
+    vtkErrorMacro(<< "The principal axes of the input's points could not be computed (no finite point, or "
+                     "the eigen-decomposition failed): remove the NaN/Inf points or set an explicit frame.");
+    return false;
+  }
+  box.Enclose(points);
+  vtkFFDBoundsOverProcesses(controller, box.Count, box.Min.data(), box.Max.data());
+  if (box.Count == 0)
+  {
+    vtkErrorMacro(<< "None of the input's " << numPoints
+                  << " points is finite, so no automatic frame can enclose them: remove the NaN/Inf "
+                     "points or give an explicit frame (FrameMode Explicit, SetFrame()).");
+    return false;
+  }
+  if (!((box.Max - box.Min).maxCoeff() > 0.0))
+  {
+    vtkErrorMacro(<< "All " << box.Count
+                  << " finite input points are identical, so an automatic frame has no size: "
+                     "give an explicit frame (FrameMode Explicit, SetFrame()).");
+    return false;
+  }
+  box.ToFrame(this->Padding, frame);
+  return true;
+}
+
+//------------------------------------------------------------------------------
 int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkPointSet* input = vtkPointSet::GetData(inputVector[0]);
@@ -336,41 +402,7 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
 
   // Phase 1: the frame.
   double frame[12];
-  if (this->FrameMode == EXPLICIT)
-  {
-    std::copy(this->FrameOrigin, this->FrameOrigin + 3, frame);
-    std::copy(this->FrameS, this->FrameS + 3, frame + 3);
-    std::copy(this->FrameT, this->FrameT + 3, frame + 6);
-    std::copy(this->FrameU, this->FrameU + 3, frame + 9);
-  }
-  else
-  {
-    OrientedBox box;
-    if (this->FrameMode == PRINCIPAL_AXES && !PrincipalAxes(points, controller, box.Anchor, box.Axes))
-    {
-      vtkErrorMacro(<< "The principal axes of the input's points could not be computed (no finite point, or "
-                       "the eigen-decomposition failed): remove the NaN/Inf points or set an explicit frame.");
-      return 0;
-    }
-    box.Enclose(points);
-    vtkFFDBoundsOverProcesses(controller, box.Count, box.Min.data(), box.Max.data());
-    if (box.Count == 0)
-    {
-      vtkErrorMacro(<< "None of the input's " << numPoints
-                    << " points is finite, so no automatic frame can enclose them: remove the NaN/Inf "
-                       "points or give an explicit frame (FrameMode Explicit, SetFrame()).");
-      return 0;
-    }
-    if (!((box.Max - box.Min).maxCoeff() > 0.0))
-    {
-      vtkErrorMacro(<< "All " << box.Count
-                    << " finite input points are identical, so an automatic frame has no size: "
-                       "give an explicit frame (FrameMode Explicit, SetFrame()).");
-      return 0;
-    }
-    box.ToFrame(this->Padding, frame);
-  }
-  if (!CheckFrame(this, frame))
+  if (!this->ComputeFrame(points, controller, numPoints, frame) || !CheckFrame(this, frame))
   {
     return 0;
   }
@@ -380,30 +412,9 @@ int vtkFFDVoxelize::RequestData(vtkInformation*, vtkInformationVector** inputVec
     return 1;
   }
 
-  // Phase 2: the active voxels, each thread marking the voxels of its points: the voxel of a point is the cell
-  // that vtkFFDDeform binds it to (ffd::BindToCells, s = 1 in the last voxel). Points outside the frame and
-  // non-finite ones mark none.
-  const ffd::Frame<double> bound = ffd::Frame<double>::FromArray(frame);
+  // Phase 2: the active voxels.
   vtkFFDActiveSet active;
-  WithPointRange(points,
-    [&](auto range)
-    {
-      active.Mark(points->GetNumberOfTuples(),
-        [&](vtkIdType begin, vtkIdType end, vtkFFDBoxMarker& marker)
-        {
-          const int one[3] = { 1, 1, 1 };
-          for (vtkIdType id = begin; id < end; ++id)
-          {
-            const auto p = range[id];
-            int v[3];
-            if (ffd::BindToCells(bound, this->Divisions,
-                  { static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2]) }, false, v))
-            {
-              marker.Mark(v, one);
-            }
-          }
-        });
-    });
+  MarkActiveVoxels(points, frame, this->Divisions, active);
   const vtkIdType numVoxels = active.GetNumberOfMarked();
   this->UpdateProgress(0.4);
   if (this->GetAbortExecute())

@@ -44,6 +44,7 @@
 #include "vtkFFDFiltersCoreModule.h" // For export macro
 #include "vtkUnstructuredGridAlgorithm.h"
 
+class vtkDataArray;
 class vtkMultiProcessController;
 
 class VTKFFDFILTERSCORE_EXPORT vtkFFDVoxelize : public vtkUnstructuredGridAlgorithm
@@ -131,6 +132,10 @@ protected:
   vtkMultiProcessController* Controller;
 
 private:
+  /// Phase 1 of RequestData: the explicit frame, or the box around the input's finite points (over every
+  /// process) along the frame mode's axes, padded. False, after an error, where no automatic frame exists.
+  bool ComputeFrame(vtkDataArray* points, vtkMultiProcessController* controller, vtkIdType numPoints, double frame[12]);
+
   vtkFFDVoxelize(const vtkFFDVoxelize&) = delete;
   void operator=(const vtkFFDVoxelize&) = delete;
 };
