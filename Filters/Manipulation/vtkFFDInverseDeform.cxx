@@ -123,6 +123,42 @@ bool InvertByTetrahedra(vtkAlgorithm* self, vtkUnstructuredGrid* lattice, vtkPoi
   }
   return true;
 }
+
+/// The input's point normals where they are 3-component with one tuple a point, else null: none to invert.
+vtkDataArray* PointNormals(vtkPointSet* input, vtkIdType n)
+{
+  vtkDataArray* normals = input->GetPointData()->GetNormals();
+  return normals && normals->GetNumberOfComponents() == 3 && normals->GetNumberOfTuples() == n ? normals : nullptr;
+}
+
+/// The arrays the inversion writes: rest positions, rest normals (only where the input has normals) and status.
+struct RestArrays
+{
+  vtkNew<vtkDoubleArray> Points;
+  vtkSmartPointer<vtkDoubleArray> Normals;
+  vtkNew<vtkUnsignedCharArray> Status;
+
+  RestArrays(vtkIdType n, vtkDataArray* normals)
+  {
+    this->Points->SetNumberOfComponents(3);
+    this->Points->SetNumberOfTuples(n);
+    if (normals)
+    {
+      this->Normals = vtkSmartPointer<vtkDoubleArray>::New();
+      this->Normals->SetName(normals->GetName());
+      this->Normals->SetNumberOfComponents(3);
+      this->Normals->SetNumberOfTuples(n);
+    }
+    this->Status->SetName(vtkFFDInverseDeform::InverseStatusArrayName());
+    this->Status->SetNumberOfTuples(n);
+  }
+
+  vtkFFDInverseOutput Output() const
+  {
+    return { this->Points->GetPointer(0), this->Normals ? this->Normals->GetPointer(0) : nullptr,
+      this->Status->GetPointer(0) };
+  }
+};
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -198,16 +234,8 @@ int vtkFFDInverseDeform::RequestData(
     return 0;
   }
   output->Initialize();
-  if (!std::isfinite(this->Tolerance) || this->Tolerance < 0)
+  if (!this->CheckSettings())
   {
-    vtkErrorMacro(<< "Tolerance is " << this->Tolerance
-                  << ": give SetTolerance() a finite number >= 0 (default 1e-12, relative to the frame's diagonal).");
-    return 0;
-  }
-  if (this->MaximumNumberOfIterations < 1)
-  {
-    vtkErrorMacro(<< "MaximumNumberOfIterations is " << this->MaximumNumberOfIterations
-                  << ": give SetMaximumNumberOfIterations() 1 or more (default 50).");
     return 0;
   }
   vtkPoints* points = input->GetPoints();
@@ -222,42 +250,10 @@ int vtkFFDInverseDeform::RequestData(
     return 0;
   }
 
-  const vtkIdType n = points->GetNumberOfPoints();
-  vtkNew<vtkDoubleArray> rest;
-  rest->SetNumberOfComponents(3);
-  rest->SetNumberOfTuples(n);
-  vtkDataArray* normals = input->GetPointData()->GetNormals();
-  if (normals && (normals->GetNumberOfComponents() != 3 || normals->GetNumberOfTuples() != n))
-  {
-    normals = nullptr;
-  }
-  vtkSmartPointer<vtkDoubleArray> restNormals;
-  if (normals)
-  {
-    restNormals = vtkSmartPointer<vtkDoubleArray>::New();
-    restNormals->SetName(normals->GetName());
-    restNormals->SetNumberOfComponents(3);
-    restNormals->SetNumberOfTuples(n);
-  }
-  vtkNew<vtkUnsignedCharArray> status;
-  status->SetName(InverseStatusArrayName());
-  status->SetNumberOfTuples(n);
-  const vtkFFDInverseOutput out{ rest->GetPointer(0), restNormals ? restNormals->GetPointer(0) : nullptr,
-    status->GetPointer(0) };
-
+  vtkDataArray* normals = PointNormals(input, points->GetNumberOfPoints());
+  const RestArrays rest(points->GetNumberOfPoints(), normals);
   std::string problem;
-  bool completed = false;
-  if (vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice))
-  {
-    completed = InvertByTetrahedra(this, vtkUnstructuredGrid::SafeDownCast(lattice), points, normals, out, problem);
-  }
-  else
-  {
-    vtkFFDGridDeformer deformer;
-    problem = deformer.SetLattice(lattice);
-    completed = problem.empty() &&
-      vtkFFDInvertByGrid(this, deformer, points, normals, this->Tolerance, this->MaximumNumberOfIterations, out);
-  }
+  const bool completed = this->Invert(lattice, points, normals, rest.Output(), problem);
   if (!problem.empty())
   {
     vtkErrorMacro(<< problem);
@@ -267,7 +263,47 @@ int vtkFFDInverseDeform::RequestData(
   {
     return 1;
   }
+  this->CountUnreliablePoints(rest.Status);
+  this->FillOutput(input, rest.Points, rest.Normals, rest.Status, output);
+  return 1;
+}
 
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDInverseDeform::CheckSettings()
+{
+  if (!std::isfinite(this->Tolerance) || this->Tolerance < 0)
+  {
+    vtkErrorMacro(<< "Tolerance is " << this->Tolerance
+                  << ": give SetTolerance() a finite number >= 0 (default 1e-12, relative to the frame's diagonal).");
+    return false;
+  }
+  if (this->MaximumNumberOfIterations < 1)
+  {
+    vtkErrorMacro(<< "MaximumNumberOfIterations is " << this->MaximumNumberOfIterations
+                  << ": give SetMaximumNumberOfIterations() 1 or more (default 50).");
+    return false;
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDInverseDeform::Invert(
+  vtkPointSet* lattice, vtkPoints* points, vtkDataArray* normals, const vtkFFDInverseOutput& out, std::string& problem)
+{
+  if (vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice))
+  {
+    return InvertByTetrahedra(this, vtkUnstructuredGrid::SafeDownCast(lattice), points, normals, out, problem);
+  }
+  vtkFFDGridDeformer deformer;
+  problem = deformer.SetLattice(lattice);
+  return problem.empty() &&
+    vtkFFDInvertByGrid(this, deformer, points, normals, this->Tolerance, this->MaximumNumberOfIterations, out);
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDInverseDeform::CountUnreliablePoints(vtkUnsignedCharArray* status)
+{
+  const vtkIdType n = status->GetNumberOfTuples();
   const unsigned char* s = status->GetPointer(0);
   this->NumberOfFoldedPoints = std::count(s, s + n, static_cast<unsigned char>(InverseStatus::Folded));
   this->NumberOfUnconvergedPoints = std::count(s, s + n, static_cast<unsigned char>(InverseStatus::NotConverged));
@@ -279,9 +315,14 @@ int vtkFFDInverseDeform::RequestData(
                     << " where Newton's method did not converge. The " << InverseStatusArrayName()
                     << " point array marks them (1 folded, 2 not converged); they keep the best position found.");
   }
+}
 
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDInverseDeform::FillOutput(vtkPointSet* input, vtkDoubleArray* rest, vtkDoubleArray* restNormals,
+  vtkUnsignedCharArray* status, vtkPointSet* output)
+{
   const bool single = this->OutputPointsPrecision == SINGLE_PRECISION ||
-    (this->OutputPointsPrecision == DEFAULT_PRECISION && points->GetDataType() == VTK_FLOAT);
+    (this->OutputPointsPrecision == DEFAULT_PRECISION && input->GetPoints()->GetDataType() == VTK_FLOAT);
   vtkNew<vtkPoints> outPoints;
   if (single)
   {
@@ -300,7 +341,6 @@ int vtkFFDInverseDeform::RequestData(
   output->GetPointData()->SetNormals(restNormals);
   output->GetCellData()->SetNormals(nullptr); // cell normals cannot follow a non-affine map
   output->GetPointData()->AddArray(status);
-  return 1;
 }
 
 //------------------------------------------------------------------------------------------------------------

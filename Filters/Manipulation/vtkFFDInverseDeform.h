@@ -33,6 +33,14 @@
 #include "vtkFFDFiltersManipulationModule.h" // For export macro
 #include "vtkPointSetAlgorithm.h"
 
+#include <string> // For the steps' problem
+
+class vtkDataArray;
+class vtkDoubleArray;
+class vtkPoints;
+class vtkUnsignedCharArray;
+struct vtkFFDInverseOutput;
+
 class VTKFFDFILTERSMANIPULATION_EXPORT vtkFFDInverseDeform : public vtkPointSetAlgorithm
 {
 public:
@@ -89,6 +97,18 @@ protected:
   vtkIdType NumberOfUnconvergedPoints;
 
 private:
+  ///@{
+  /// Steps of RequestData: check Tolerance and MaximumNumberOfIterations; invert the points through the lattice
+  /// (false: aborted, or `problem` says what is wrong with the lattice); count the folded and unconverged points
+  /// and warn of them; fill the output with the rest positions.
+  bool CheckSettings();
+  bool Invert(vtkPointSet* lattice, vtkPoints* points, vtkDataArray* normals, const vtkFFDInverseOutput& out,
+    std::string& problem);
+  void CountUnreliablePoints(vtkUnsignedCharArray* status);
+  void FillOutput(vtkPointSet* input, vtkDoubleArray* rest, vtkDoubleArray* restNormals, vtkUnsignedCharArray* status,
+    vtkPointSet* output);
+  ///@}
+
   vtkFFDInverseDeform(const vtkFFDInverseDeform&) = delete;
   void operator=(const vtkFFDInverseDeform&) = delete;
 };
