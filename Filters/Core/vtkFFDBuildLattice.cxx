@@ -20,6 +20,7 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkSMPTools.h"
+#include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStructuredGrid.h"
 #include "vtkUnsignedCharArray.h"
@@ -50,6 +51,86 @@ bool IsSparse(int form, int basis)
 {
   return form == vtkFFDBuildLattice::SPARSE ||
     (form == vtkFFDBuildLattice::AUTOMATIC && basis != vtkFFDBuildLattice::BERNSTEIN);
+}
+
+/// Which control points influence an active voxel: the union of the active voxels' supports (paper section
+/// III.D), 1 at each. Once a support covers the whole lattice (always so for the global basis) no further voxel
+/// can add to it.
+vtkSmartPointer<vtkUnsignedCharArray> MarkActiveControlPoints(
+  ffd::GridBasis basis, const int divisions[3], const int pointsPerAxis[3], vtkIntArray* voxels)
+{
+  const int nI = pointsPerAxis[0], nJ = pointsPerAxis[1], nK = pointsPerAxis[2];
+  const vtkIdType numControlPoints = static_cast<vtkIdType>(nI) * nJ * nK;
+  auto activeArray = vtkSmartPointer<vtkUnsignedCharArray>::New();
+  activeArray->SetName(vtkFFDDataContract::ActiveArrayName());
+  activeArray->SetNumberOfValues(numControlPoints);
+  unsigned char* active = activeArray->GetPointer(0);
+  std::fill(active, active + numControlPoints, static_cast<unsigned char>(0));
+  const int* ijk = voxels->GetPointer(0);
+  bool covered = false;
+  for (vtkIdType v = 0; v < voxels->GetNumberOfTuples() && !covered; ++v)
+  {
+    int first[3], count[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      ffd::VoxelSupport(basis, divisions[a], ijk[3 * v + a], first[a], count[a]);
+    }
+    for (int c = first[2]; c < first[2] + count[2]; ++c)
+    {
+      for (int b = first[1]; b < first[1] + count[1]; ++b)
+      {
+        unsigned char* row = active + static_cast<size_t>(nI) * (b + static_cast<size_t>(nJ) * c);
+        std::fill(row + first[0], row + first[0] + count[0], static_cast<unsigned char>(1));
+      }
+    }
+    covered = count[0] == nI && count[1] == nJ && count[2] == nK;
+  }
+  return activeArray;
+}
+
+/// The control points' positions and RestPosition array, each computed directly from the frame (no accumulated
+/// steps); the B-spline's outer ring has parameters outside [0, 1].
+void ComputeRestPositions(const double frame[12], ffd::GridBasis basis, const int divisions[3],
+  const int pointsPerAxis[3], vtkPoints* points, vtkDoubleArray* rest)
+{
+  const int nI = pointsPerAxis[0], nJ = pointsPerAxis[1], nK = pointsPerAxis[2];
+  const vtkIdType numControlPoints = static_cast<vtkIdType>(nI) * nJ * nK;
+  const ffd::Frame<double> bound = ffd::Frame<double>::FromArray(frame);
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(numControlPoints);
+  rest->SetName(vtkFFDDataContract::RestPositionArrayName());
+  rest->SetNumberOfComponents(3);
+  rest->SetNumberOfTuples(numControlPoints);
+  double* pointValues = vtkDoubleArray::SafeDownCast(points->GetData())->GetPointer(0);
+  double* restValues = rest->GetPointer(0);
+  vtkSMPTools::For(0, numControlPoints,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType id = begin; id < end; ++id)
+      {
+        const ffd::Vec3<double> x = vtkFFDRestPoint(
+          bound, basis, divisions, int(id % nI), int((id / nI) % nJ), int(id / (static_cast<vtkIdType>(nI) * nJ)));
+        for (int c = 0; c < 3; ++c)
+        {
+          pointValues[3 * id + c] = restValues[3 * id + c] = x[c];
+        }
+      }
+    });
+}
+
+/// Hides the culled control points: the ghost array exists only when some are.
+void AddPointGhosts(vtkUnsignedCharArray* activeArray, vtkPointData* pointData)
+{
+  const vtkIdType numControlPoints = activeArray->GetNumberOfValues();
+  const unsigned char* active = activeArray->GetPointer(0);
+  vtkNew<vtkUnsignedCharArray> pointGhosts;
+  pointGhosts->SetName(vtkDataSetAttributes::GhostArrayName());
+  pointGhosts->SetNumberOfValues(numControlPoints);
+  for (vtkIdType id = 0; id < numControlPoints; ++id)
+  {
+    pointGhosts->SetValue(id, active[id] ? 0 : vtkDataSetAttributes::HIDDENPOINT);
+  }
+  pointData->AddArray(pointGhosts);
 }
 } // namespace
 
@@ -228,41 +309,80 @@ int vtkFFDBuildLattice::RequestData(
   }
 
   double frame[12];
+  int divisions[3];
+  if (!this->ReadFrameAndDivisions(input, frame, divisions))
+  {
+    return 0;
+  }
+  const bool sparse = IsSparse(this->LatticeForm, this->Basis);
+  int pointsPerAxis[3];
+  if (!this->CheckForm(sparse, divisions, pointsPerAxis))
+  {
+    return 0;
+  }
+  vtkIntArray* voxels = this->GetActiveVoxels(input, divisions);
+  if (!voxels)
+  {
+    return 0;
+  }
+
+  const int built = sparse
+    ? this->BuildSparse(frame, divisions, voxels, vtkUnstructuredGrid::SafeDownCast(output))
+    : this->BuildDense(frame, divisions, pointsPerAxis, voxels, vtkStructuredGrid::SafeDownCast(output));
+  if (!built)
+  {
+    return 0;
+  }
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+bool vtkFFDBuildLattice::ReadFrameAndDivisions(vtkDataSet* input, double frame[12], int divisions[3])
+{
   if (!vtkFFDDataContract::GetFrame(input, frame))
   {
     vtkErrorMacro(<< "The input has no valid " << vtkFFDDataContract::FrameArrayName()
                   << " field array (12 finite doubles): connect the output of vtkFFDVoxelize.");
-    return 0;
+    return false;
   }
-  int divisions[3];
   if (!vtkFFDDataContract::GetDivisions(input, divisions))
   {
     vtkErrorMacro(<< "The input has no valid " << vtkFFDDataContract::DivisionsArrayName()
                   << " field array (3 ints >= 1): connect the output of vtkFFDVoxelize.");
-    return 0;
+    return false;
   }
   if (const ffd::FrameStatus status = ffd::CheckFrame(frame); status != ffd::FrameStatus::Valid)
   {
-    vtkErrorMacro(<< "The input's " << vtkFFDDataContract::FrameArrayName() << " "
-                  << ffd::DescribeFrameStatus(status) << ": connect the output of vtkFFDVoxelize or fix the frame.");
-    return 0;
+    vtkErrorMacro(<< "The input's " << vtkFFDDataContract::FrameArrayName() << " " << ffd::DescribeFrameStatus(status)
+                  << ": connect the output of vtkFFDVoxelize or fix the frame.");
+    return false;
   }
-  const bool sparse = IsSparse(this->LatticeForm, this->Basis);
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkFFDBuildLattice::CheckForm(bool sparse, const int divisions[3], int pointsPerAxis[3])
+{
   if (sparse && this->Basis == BERNSTEIN)
   {
     vtkErrorMacro(<< "A SPARSE lattice of the global BERNSTEIN basis is not possible: each of its control points "
                      "influences every voxel. Set LatticeForm to Dense or Automatic (SetLatticeFormToDense()), or "
                      "choose a local Basis.");
-    return 0;
+    return false;
   }
-  int pointsPerAxis[3];
   std::string why;
   if (!GetControlPointsPerAxis(this->Basis, divisions, pointsPerAxis, why, sparse ? SPARSE : DENSE))
   {
     vtkErrorMacro(<< "Cannot build the lattice: " << why);
-    return 0;
+    return false;
   }
+  return true;
+}
 
+//------------------------------------------------------------------------------
+vtkIntArray* vtkFFDBuildLattice::GetActiveVoxels(vtkDataSet* input, const int divisions[3])
+{
   // The active voxels: one (i, j, k) per cell, each within the divisions, each once.
   vtkIntArray* voxels =
     vtkIntArray::SafeDownCast(input->GetCellData()->GetAbstractArray(vtkFFDDataContract::VoxelIndexArrayName()));
@@ -272,7 +392,7 @@ int vtkFFDBuildLattice::RequestData(
     vtkErrorMacro(<< "The input has no " << vtkFFDDataContract::VoxelIndexArrayName()
                   << " cell array of 3 ints (a vtkIntArray) per cell, the (i, j, k) of each active voxel: "
                      "connect the output of vtkFFDVoxelize.");
-    return 0;
+    return nullptr;
   }
   const int* ijk = voxels->GetPointer(0);
   for (vtkIdType v = 0; v < numVoxels; ++v)
@@ -285,7 +405,7 @@ int vtkFFDBuildLattice::RequestData(
                     << vtkFFDDataContract::DivisionsArrayName() << " (" << divisions[0] << ", " << divisions[1] << ", "
                     << divisions[2] << "): each index must be in [0, divisions); connect the output of "
                     << "vtkFFDVoxelize or fix the voxel grid.");
-      return 0;
+      return nullptr;
     }
   }
   vtkFFDActiveSet distinct;
@@ -303,18 +423,9 @@ int vtkFFDBuildLattice::RequestData(
     vtkErrorMacro(<< "The input's " << numVoxels << " cells name only " << distinct.GetNumberOfMarked()
                   << " distinct voxels in " << vtkFFDDataContract::VoxelIndexArrayName()
                   << ": give each active voxel one cell, as vtkFFDVoxelize does.");
-    return 0;
+    return nullptr;
   }
-
-  const int built = sparse
-    ? this->BuildSparse(frame, divisions, voxels, vtkUnstructuredGrid::SafeDownCast(output))
-    : this->BuildDense(frame, divisions, pointsPerAxis, voxels, vtkStructuredGrid::SafeDownCast(output));
-  if (!built)
-  {
-    return 0;
-  }
-  this->UpdateProgress(1.0);
-  return 1;
+  return voxels;
 }
 
 //------------------------------------------------------------------------------
@@ -333,65 +444,18 @@ int vtkFFDBuildLattice::BuildDense(const double frame[12], const int divisions[3
     return 0;
   }
 
-  // Which control points influence an active voxel: the union of the active voxels' supports (paper section
-  // III.D). Once a support covers the whole lattice (always so for the global basis) no further voxel can add
-  // to it.
-  vtkNew<vtkUnsignedCharArray> activeArray;
-  activeArray->SetName(vtkFFDDataContract::ActiveArrayName());
-  activeArray->SetNumberOfValues(numControlPoints);
-  unsigned char* active = activeArray->GetPointer(0);
-  std::fill(active, active + numControlPoints, static_cast<unsigned char>(0));
-  const int* ijk = voxels->GetPointer(0);
-  bool covered = false;
-  for (vtkIdType v = 0; v < voxels->GetNumberOfTuples() && !covered; ++v)
-  {
-    int first[3], count[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      ffd::VoxelSupport(basis, divisions[a], ijk[3 * v + a], first[a], count[a]);
-    }
-    for (int c = first[2]; c < first[2] + count[2]; ++c)
-    {
-      for (int b = first[1]; b < first[1] + count[1]; ++b)
-      {
-        unsigned char* row = active + static_cast<size_t>(nI) * (b + static_cast<size_t>(nJ) * c);
-        std::fill(row + first[0], row + first[0] + count[0], static_cast<unsigned char>(1));
-      }
-    }
-    covered = count[0] == nI && count[1] == nJ && count[2] == nK;
-  }
+  const vtkSmartPointer<vtkUnsignedCharArray> activeArray =
+    MarkActiveControlPoints(basis, divisions, pointsPerAxis, voxels);
   this->UpdateProgress(0.5);
   if (this->GetAbortExecute())
   {
     return 1;
   }
-
-  // The rest positions, each computed directly from the frame (no accumulated steps); the B-spline's outer
-  // ring has parameters outside [0, 1].
-  const ffd::Frame<double> bound = ffd::Frame<double>::FromArray(frame);
   vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  points->SetNumberOfPoints(numControlPoints);
   vtkNew<vtkDoubleArray> rest;
-  rest->SetName(vtkFFDDataContract::RestPositionArrayName());
-  rest->SetNumberOfComponents(3);
-  rest->SetNumberOfTuples(numControlPoints);
-  double* pointValues = vtkDoubleArray::SafeDownCast(points->GetData())->GetPointer(0);
-  double* restValues = rest->GetPointer(0);
-  vtkSMPTools::For(0, numControlPoints,
-    [&](vtkIdType begin, vtkIdType end)
-    {
-      for (vtkIdType id = begin; id < end; ++id)
-      {
-        const ffd::Vec3<double> x = vtkFFDRestPoint(
-          bound, basis, divisions, int(id % nI), int((id / nI) % nJ), int(id / (static_cast<vtkIdType>(nI) * nJ)));
-        for (int c = 0; c < 3; ++c)
-        {
-          pointValues[3 * id + c] = restValues[3 * id + c] = x[c];
-        }
-      }
-    });
+  ComputeRestPositions(frame, basis, divisions, pointsPerAxis, points, rest);
 
+  const unsigned char* active = activeArray->GetPointer(0);
   const vtkIdType numActive = std::count(active, active + numControlPoints, static_cast<unsigned char>(1));
   output->SetExtent(0, nI - 1, 0, nJ - 1, 0, nK - 1);
   output->SetPoints(points);
@@ -399,15 +463,7 @@ int vtkFFDBuildLattice::BuildDense(const double frame[12], const int divisions[3
   output->GetPointData()->AddArray(activeArray);
   if (numActive < numControlPoints)
   {
-    // Culled control points are hidden; the ghost array exists only when some are.
-    vtkNew<vtkUnsignedCharArray> pointGhosts;
-    pointGhosts->SetName(vtkDataSetAttributes::GhostArrayName());
-    pointGhosts->SetNumberOfValues(numControlPoints);
-    for (vtkIdType id = 0; id < numControlPoints; ++id)
-    {
-      pointGhosts->SetValue(id, active[id] ? 0 : vtkDataSetAttributes::HIDDENPOINT);
-    }
-    output->GetPointData()->AddArray(pointGhosts);
+    AddPointGhosts(activeArray, output->GetPointData());
   }
   vtkFFDDataContract::SetFrame(output, frame);
   vtkFFDDataContract::SetDivisions(output, divisions);

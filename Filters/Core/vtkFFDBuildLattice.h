@@ -69,6 +69,7 @@
 
 #include <string> // For GetControlPointsPerAxis
 
+class vtkDataSet;
 class vtkIntArray;
 class vtkStructuredGrid;
 class vtkUnstructuredGrid;
@@ -153,6 +154,14 @@ protected:
   vtkIdType NumberOfActiveControlPoints;
 
 private:
+  ///@{
+  /// Checks of RequestData(), each false (or null) after reporting an error: the input's frame and divisions;
+  /// the lattice form against the basis, giving the control points per axis; the input's VoxelIndex cell array
+  /// (each index within the divisions, each once), which is returned.
+  bool ReadFrameAndDivisions(vtkDataSet* input, double frame[12], int divisions[3]);
+  bool CheckForm(bool sparse, const int divisions[3], int pointsPerAxis[3]);
+  vtkIntArray* GetActiveVoxels(vtkDataSet* input, const int divisions[3]);
+  ///@}
   /// The forms of RequestData(), after the input's checks: 1 on success, 0 on failure, with the error reported.
   int BuildDense(const double frame[12], const int divisions[3], const int pointsPerAxis[3], vtkIntArray* voxels,
     vtkStructuredGrid* output);
