@@ -6,6 +6,7 @@
 #include "vtkDataSet.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkFFDDataContract.h"
+#include "vtkFFDSortedKeys.h"
 #include "vtkGenericCell.h"
 #include "vtkIdList.h"
 #include "vtkInformation.h"
@@ -28,21 +29,31 @@ vtkStandardNewMacro(vtkFFDCellEdges);
 
 namespace
 {
-/// The control net of a sparse lattice: addEdge(a, b) for each two points whose LatticeIndex differ by one along
-/// one axis, found by binary search among the points' indices sorted as (k, j, i): whatever their values, which a
-/// flat key i + nI (j + nJ k) could overflow or alias where they are negative.
-template <typename AddEdge>
-void AddControlNet(vtkIntArray* latticeIndex, AddEdge&& addEdge)
+using Edges = std::vector<std::pair<vtkIdType, vtkIdType>>;
+
+/// Adds the edge (a, b) as (min, max), unless a and b are one point.
+void AddEdge(Edges& edges, vtkIdType a, vtkIdType b)
+{
+  if (a != b)
+  {
+    edges.emplace_back(std::min(a, b), std::max(a, b));
+  }
+}
+
+/// The control net of a sparse lattice: an edge for each two points whose LatticeIndex differ by one along one
+/// axis, found among the points' indices sorted as (k, j, i): whatever their values, which a flat key
+/// i + nI (j + nJ k) could overflow or alias where they are negative.
+void AddControlNet(vtkIntArray* latticeIndex, Edges& edges)
 {
   using Key = std::array<int, 3>; // (k, j, i)
   const vtkIdType n = latticeIndex->GetNumberOfTuples();
   const int* index = latticeIndex->GetPointer(0);
-  std::vector<std::pair<Key, vtkIdType>> sorted(static_cast<size_t>(n));
+  std::vector<std::pair<Key, vtkIdType>> keys(static_cast<size_t>(n));
   for (vtkIdType p = 0; p < n; ++p)
   {
-    sorted[p] = { { index[3 * p + 2], index[3 * p + 1], index[3 * p] }, p };
+    keys[p] = { { index[3 * p + 2], index[3 * p + 1], index[3 * p] }, p };
   }
-  std::sort(sorted.begin(), sorted.end());
+  const vtkFFDSortedKeys<vtkIdType, Key> sorted(std::move(keys));
   for (vtkIdType p = 0; p < n; ++p)
   {
     for (int a = 0; a < 3; ++a)
@@ -53,13 +64,83 @@ void AddControlNet(vtkIntArray* latticeIndex, AddEdge&& addEdge)
         continue;
       }
       ++next[2 - a];
-      const auto at = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(next, vtkIdType(0)));
-      if (at != sorted.end() && at->first == next)
+      if (const vtkIdType neighbour = sorted.FindId(next); neighbour >= 0)
       {
-        addEdge(p, at->second);
+        AddEdge(edges, p, neighbour);
       }
     }
   }
+}
+
+/// The input's own points on `output`: shared when it has a vtkPoints (lattices and voxel grids do), else copied.
+void SetPoints(vtkDataSet* input, vtkPolyData* output)
+{
+  vtkPointSet* pointSet = vtkPointSet::SafeDownCast(input);
+  if (pointSet && pointSet->GetPoints())
+  {
+    output->SetPoints(pointSet->GetPoints());
+    return;
+  }
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(input->GetNumberOfPoints());
+  for (vtkIdType id = 0; id < input->GetNumberOfPoints(); ++id)
+  {
+    points->SetPoint(id, input->GetPoint(id));
+  }
+  output->SetPoints(points);
+}
+
+/// The edges of the input's cells but hidden ghosts: false, with the error reported on `self`, where the ghost
+/// array does not fit the cells or a cell names a point the input lacks.
+bool AddCellEdges(vtkFFDCellEdges* self, vtkDataSet* input, Edges& edges)
+{
+  vtkUnsignedCharArray* ghosts = input->GetCellGhostArray();
+  const vtkIdType numberOfPoints = input->GetNumberOfPoints();
+  const vtkIdType numberOfCells = input->GetNumberOfCells();
+  if (ghosts && ghosts->GetNumberOfValues() != numberOfCells)
+  {
+    vtkErrorWithObjectMacro(self, << "The input's cell ghost array has " << ghosts->GetNumberOfValues()
+                                  << " values for " << numberOfCells << " cells.");
+    return false;
+  }
+  vtkNew<vtkGenericCell> cell;
+  vtkNew<vtkIdList> ids;
+  edges.reserve(static_cast<size_t>(numberOfCells) * 12);
+  for (vtkIdType cellId = 0; cellId < numberOfCells; ++cellId)
+  {
+    if (ghosts && (ghosts->GetValue(cellId) & vtkDataSetAttributes::HIDDENCELL))
+    {
+      continue;
+    }
+    input->GetCellPoints(cellId, ids); // checked before GetCell() reads the points they name
+    for (vtkIdType p = 0; p < ids->GetNumberOfIds(); ++p)
+    {
+      if (ids->GetId(p) < 0 || ids->GetId(p) >= numberOfPoints)
+      {
+        vtkErrorWithObjectMacro(self, << "The input's cell " << cellId << " names point " << ids->GetId(p)
+                                      << ", but it has " << numberOfPoints << " points.");
+        return false;
+      }
+    }
+    input->GetCell(cellId, cell);
+    if (cell->GetCellDimension() == 1)
+    {
+      // A line or polyline is its own edge list (vtkCell::GetNumberOfEdges() is 0 for them).
+      for (vtkIdType p = 0; p + 1 < cell->GetNumberOfPoints(); ++p)
+      {
+        AddEdge(edges, cell->GetPointId(p), cell->GetPointId(p + 1));
+      }
+      continue;
+    }
+    const int numberOfEdges = cell->GetNumberOfEdges();
+    for (int e = 0; e < numberOfEdges; ++e)
+    {
+      vtkCell* edge = cell->GetEdge(e);
+      AddEdge(edges, edge->GetPointId(0), edge->GetPointId(1));
+    }
+  }
+  return true;
 }
 } // namespace
 
@@ -86,88 +167,21 @@ int vtkFFDCellEdges::RequestData(
   {
     return 1;
   }
-
-  // The input's own points: shared when it has a vtkPoints (lattices and voxel grids do), copied otherwise.
-  vtkPointSet* pointSet = vtkPointSet::SafeDownCast(input);
-  if (pointSet && pointSet->GetPoints())
-  {
-    output->SetPoints(pointSet->GetPoints());
-  }
-  else
-  {
-    vtkNew<vtkPoints> points;
-    points->SetDataTypeToDouble();
-    points->SetNumberOfPoints(numberOfPoints);
-    for (vtkIdType id = 0; id < numberOfPoints; ++id)
-    {
-      points->SetPoint(id, input->GetPoint(id));
-    }
-    output->SetPoints(points);
-  }
+  SetPoints(input, output);
 
   // Edges as pairs of point ids, sorted and made unique at the end: the output does not depend on hashing.
-  std::vector<std::pair<vtkIdType, vtkIdType>> edges;
-  auto addEdge = [&edges](vtkIdType a, vtkIdType b)
-  {
-    if (a != b)
-    {
-      edges.emplace_back(std::min(a, b), std::max(a, b));
-    }
-  };
+  Edges edges;
   vtkIntArray* latticeIndex =
     vtkIntArray::SafeDownCast(input->GetPointData()->GetArray(vtkFFDDataContract::LatticeIndexArrayName()));
   if (latticeIndex && latticeIndex->GetNumberOfComponents() == 3 && latticeIndex->GetNumberOfTuples() == numberOfPoints)
   {
-    AddControlNet(latticeIndex, addEdge);
-    return this->Finish(edges, output);
+    AddControlNet(latticeIndex, edges);
   }
-  vtkUnsignedCharArray* ghosts = input->GetCellGhostArray();
-  const vtkIdType numberOfCells = input->GetNumberOfCells();
-  if (ghosts && ghosts->GetNumberOfValues() != numberOfCells)
+  else if (!AddCellEdges(this, input, edges))
   {
-    vtkErrorMacro(<< "The input's cell ghost array has " << ghosts->GetNumberOfValues() << " values for "
-                  << numberOfCells << " cells.");
     output->Initialize();
     return 0;
   }
-  vtkNew<vtkGenericCell> cell;
-  vtkNew<vtkIdList> ids;
-  edges.reserve(static_cast<size_t>(numberOfCells) * 12);
-  for (vtkIdType cellId = 0; cellId < numberOfCells; ++cellId)
-  {
-    if (ghosts && (ghosts->GetValue(cellId) & vtkDataSetAttributes::HIDDENCELL))
-    {
-      continue;
-    }
-    input->GetCellPoints(cellId, ids); // checked before GetCell() reads the points they name
-    for (vtkIdType p = 0; p < ids->GetNumberOfIds(); ++p)
-    {
-      if (ids->GetId(p) < 0 || ids->GetId(p) >= numberOfPoints)
-      {
-        vtkErrorMacro(<< "The input's cell " << cellId << " names point " << ids->GetId(p) << ", but it has "
-                      << numberOfPoints << " points.");
-        output->Initialize();
-        return 0;
-      }
-    }
-    input->GetCell(cellId, cell);
-    if (cell->GetCellDimension() == 1)
-    {
-      // A line or polyline is its own edge list (vtkCell::GetNumberOfEdges() is 0 for them).
-      for (vtkIdType p = 0; p + 1 < cell->GetNumberOfPoints(); ++p)
-      {
-        addEdge(cell->GetPointId(p), cell->GetPointId(p + 1));
-      }
-      continue;
-    }
-    const int numberOfEdges = cell->GetNumberOfEdges();
-    for (int e = 0; e < numberOfEdges; ++e)
-    {
-      vtkCell* edge = cell->GetEdge(e);
-      addEdge(edge->GetPointId(0), edge->GetPointId(1));
-    }
-  }
-
   return this->Finish(edges, output);
 }
 

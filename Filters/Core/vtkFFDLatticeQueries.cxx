@@ -145,14 +145,14 @@ vtkFFDControlPointIndex::vtkFFDControlPointIndex(const vtkFFDGridDeformer& defor
   }
   // The deformer has checked that every point has a LatticeIndex within the lattice.
   vtkDataArray* index = lattice->GetPointData()->GetArray(vtkFFDDataContract::LatticeIndexArrayName());
-  this->Sorted.resize(std::size_t(lattice->GetNumberOfPoints()));
+  std::vector<std::pair<vtkTypeInt64, vtkIdType>> keys(std::size_t(lattice->GetNumberOfPoints()));
   for (vtkIdType p = 0; p < lattice->GetNumberOfPoints(); ++p)
   {
-    this->Sorted[std::size_t(p)] = { vtkFFDFlatIndex(int(index->GetComponent(p, 0)), int(index->GetComponent(p, 1)),
-                                       int(index->GetComponent(p, 2)), this->Dims),
+    keys[std::size_t(p)] = { vtkFFDFlatIndex(int(index->GetComponent(p, 0)), int(index->GetComponent(p, 1)),
+                               int(index->GetComponent(p, 2)), this->Dims),
       p };
   }
-  std::sort(this->Sorted.begin(), this->Sorted.end());
+  this->Sorted = vtkFFDSortedKeys<vtkIdType>(std::move(keys));
 }
 
 //------------------------------------------------------------------------------------------------------------
@@ -167,6 +167,5 @@ vtkIdType vtkFFDControlPointIndex::Find(int i, int j, int k) const
   {
     return vtkIdType(key);
   }
-  const auto it = std::lower_bound(this->Sorted.begin(), this->Sorted.end(), std::make_pair(key, vtkIdType(-1)));
-  return it != this->Sorted.end() && it->first == key ? it->second : -1;
+  return this->Sorted.FindId(key);
 }

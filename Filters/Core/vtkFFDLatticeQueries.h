@@ -16,6 +16,7 @@
 #define vtkFFDLatticeQueries_h
 
 #include "vtkFFDGridDeformer.h"
+#include "vtkFFDSortedKeys.h"
 #include "vtkType.h"
 
 #include "FFDGridDeformation.h"
@@ -87,7 +88,7 @@ public:
 private:
   int Dims[3];
   bool Dense;
-  std::vector<std::pair<vtkTypeInt64, vtkIdType>> Sorted; // a sparse lattice's keys i + nI (j + nJ k) and ids
+  vtkFFDSortedKeys<vtkIdType> Sorted; // a sparse lattice's flat indices and point ids
 };
 
 #endif

@@ -17,6 +17,7 @@
 #define vtkFFDSparseCells_h
 
 #include "vtkDataArray.h"
+#include "vtkFFDSortedKeys.h"
 #include "vtkSmartPointer.h"
 #include "vtkType.h"
 
@@ -38,7 +39,7 @@ public:
   std::string Read(vtkUnstructuredGrid* lattice, ffd::GridBasis basis, const int divisions[3]);
 
   /// The cells: their number, each one's voxel (3 ints) and support (SupportCount()^3 point ids).
-  int GetNumberOfCells() const { return static_cast<int>(this->Keys.size()); }
+  int GetNumberOfCells() const { return static_cast<int>(this->Keys.GetSize()); }
   const std::vector<int>& GetVoxels() const { return this->Voxels; }
   const int* GetSupports() const { return this->Supports; }
 
@@ -49,7 +50,7 @@ public:
   std::uint64_t GetFingerprint() const { return this->Fingerprint; }
 
 private:
-  std::vector<std::int64_t> Keys; // each cell's voxel's flat index, increasing
+  vtkFFDSortedKeys<> Keys; // each cell's voxel's flat index, increasing
   std::vector<int> Voxels;
   const int* Supports = nullptr;              // SupportCount()^3 a cell: into one of the two below
   std::vector<int> SupportsCopy;              // where the lattice's connectivity is not them

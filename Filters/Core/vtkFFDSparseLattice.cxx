@@ -7,6 +7,7 @@
 #include "vtkDoubleArray.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDSortedKeys.h"
 #include "vtkHigherOrderHexahedron.h"
 #include "vtkIntArray.h"
 #include "vtkNew.h"
@@ -63,25 +64,6 @@ private:
   openvdb::tree::ValueAccessor<MaskTree, false> Accessor;
 };
 
-/// The first element of the sorted [begin, end) not below `key`, searched outwards from `hint`: the voxels come in
-/// increasing order from vtkFFDVoxelize, so a row of a voxel's support lies a few places after the same row of the
-/// previous voxel's, found in O(log distance) rather than O(log size) with its cache misses.
-const vtkTypeInt64* FindFrom(
-  const vtkTypeInt64* begin, const vtkTypeInt64* end, const vtkTypeInt64* hint, vtkTypeInt64 key)
-{
-  if (hint == end || *hint > key)
-  {
-    return std::lower_bound(begin, hint, key);
-  }
-  std::ptrdiff_t step = 1;
-  while (end - hint > step && hint[step] <= key)
-  {
-    hint += step;
-    step *= 2;
-  }
-  return std::lower_bound(hint, hint + std::min(step, end - hint), key);
-}
-
 /// The cells of `lattice` over the voxels, with ids stored as ArrayT's values (32 or 64 bits).
 template <typename ArrayT>
 vtkSmartPointer<vtkCellArray> MakeCells(
@@ -112,14 +94,13 @@ vtkSmartPointer<vtkCellArray> MakeCells(
   connectivity->SetNumberOfValues(n * perCell);
   Id* offset = offsets->GetPointer(0);
   Id* ids = connectivity->GetPointer(0);
-  const vtkTypeInt64* keys = lattice.Points.data();
-  const vtkTypeInt64* keysEnd = keys + lattice.Points.size();
-  const vtkTypeInt64 nI = lattice.PointsPerAxis[0], nJ = lattice.PointsPerAxis[1];
+  const vtkFFDSortedKeys<> keys(lattice.Points.data(), lattice.Points.data() + lattice.Points.size()); // viewed
   vtkSMPTools::For(0, n,
     [&](vtkIdType begin, vtkIdType end)
     {
-      // Per row (b, d) of the support: where the previous voxel's row was found.
-      std::vector<const vtkTypeInt64*> hints(c * c, keys);
+      // Per row (b, d) of the support: where the previous voxel's row was found. The voxels come in increasing
+      // order from vtkFFDVoxelize, so a row lies a few places after the same row of the previous voxel's support.
+      std::vector<vtkIdType> hints(c * c, 0);
       for (vtkIdType v = begin; v < end; ++v)
       {
         int first[3], count[3];
@@ -134,10 +115,10 @@ vtkSmartPointer<vtkCellArray> MakeCells(
           for (int b = 0; b < c; ++b)
           {
             // A row's c points have consecutive linear indices, all in the set: they are consecutive there too.
-            const vtkTypeInt64 key = first[0] + nI * (first[1] + b + nJ * vtkTypeInt64(first[2] + d));
-            const vtkTypeInt64*& hint = hints[b + c * d];
-            hint = FindFrom(keys, keysEnd, hint, key);
-            const Id rank = Id(hint - keys);
+            vtkIdType& hint = hints[b + c * d];
+            hint =
+              keys.LowerBoundFrom(hint, vtkFFDFlatIndex(first[0], first[1] + b, first[2] + d, lattice.PointsPerAxis));
+            const Id rank = Id(hint);
             for (int a = 0; a < c; ++a)
             {
               cell[place[a + c * (b + c * d)]] = rank + Id(a);

@@ -5,6 +5,7 @@
 #include "vtkFFDBuildLattice.h"
 #include "vtkFFDDataContract.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDSortedKeys.h"
 #include "vtkFFDSparseLattice.h"
 #include "vtkFFDStatistics.h"
 #include "vtkInformation.h"
@@ -390,13 +391,27 @@ bool CheckNoOtherValues(vtkFFDVDBReader* self, const Grids& found, vtkUnstructur
     vtkIntArray::SafeDownCast(lattice->GetPointData()->GetArray(vtkFFDDataContract::LatticeIndexArrayName()))
       ->GetPointer(0);
   const int* perAxis = found.PointsPerAxis;
-  const vtkTypeInt64 nI = perAxis[0], nJ = perAxis[1];
-  auto key = [&](const int* ijk) { return ijk[0] + nI * (ijk[1] + nJ * vtkTypeInt64(ijk[2])); };
+  vtkFFDSortedKeys<> keys; // the points' flat indices, in their (increasing) order: made where needed
   for (const openvdb::Vec3DGrid::Ptr& vectors : { found.Displacement, found.Position })
   {
     if (vtkIdType(vectors->activeVoxelCount()) == numPoints)
     {
       continue; // it holds every control point, so nothing else
+    }
+    if (keys.GetSize() == 0)
+    {
+      // Only on the way to an error (PlacePoints() found every point, so the grid holds more), and 8 bytes a
+      // point, which the lattice's builder held too (since freed): the peak does not grow.
+      std::vector<vtkTypeInt64> flat(static_cast<size_t>(numPoints));
+      vtkSMPTools::For(0, numPoints,
+        [&](vtkIdType begin, vtkIdType end)
+        {
+          for (vtkIdType p = begin; p < end; ++p)
+          {
+            flat[p] = vtkFFDFlatIndex(indices[3 * p], indices[3 * p + 1], indices[3 * p + 2], perAxis);
+          }
+        });
+      keys = vtkFFDSortedKeys<>(std::move(flat));
     }
     // A value where the lattice has no control point: the first one, found in the increasing LatticeIndex.
     vectors->tree().voxelizeActiveTiles();
@@ -405,21 +420,7 @@ bool CheckNoOtherValues(vtkFFDVDBReader* self, const Grids& found, vtkUnstructur
       const openvdb::Coord x = it.getCoord();
       const bool inside =
         x.x() >= 0 && x.y() >= 0 && x.z() >= 0 && x.x() < perAxis[0] && x.y() < perAxis[1] && x.z() < perAxis[2];
-      const vtkTypeInt64 wanted = key(x.asPointer());
-      vtkIdType low = 0, high = numPoints;
-      while (low < high)
-      {
-        const vtkIdType middle = low + (high - low) / 2;
-        if (key(indices + 3 * middle) < wanted)
-        {
-          low = middle + 1;
-        }
-        else
-        {
-          high = middle;
-        }
-      }
-      if (!inside || low == numPoints || key(indices + 3 * low) != wanted)
+      if (!inside || keys.Find(vtkFFDFlatIndex(x.x(), x.y(), x.z(), perAxis)) < 0)
       {
         vtkErrorWithObjectMacro(self, << "The grid \"" << vectors->getName() << "\" of " << self->GetFileName()
                                       << " has a value at " << Ijk(x) << ", which is not a control point of the "
