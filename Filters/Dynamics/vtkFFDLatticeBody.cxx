@@ -155,11 +155,9 @@ std::vector<double> ShareMass(const std::vector<double>& share, double totalMass
   }
   return masses;
 }
-} // namespace
 
-//------------------------------------------------------------------------------------------------------------
-std::string vtkFFDLatticeBody::Read(
-  vtkPointSet* lattice, vtkPointSet* mesh, int neighborhood, double totalMass, double minimumMassFraction)
+/// What keeps the lattice's points from being simulated at all, or an empty string.
+std::string CheckLatticePoints(vtkPointSet* lattice)
 {
   if (!lattice || !lattice->GetPoints() || lattice->GetNumberOfPoints() == 0)
   {
@@ -177,87 +175,120 @@ std::string vtkFFDLatticeBody::Read(
   {
     return "The lattice has no RestPosition point array of 3 components per point.";
   }
+  return std::string();
+}
 
-  // The lattice's kind, read and checked by vtkFFDDeform's own readers; the mesh's points bound to it.
-  const bool tetrahedral = vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice);
-  vtkFFDGridDeformer grid;
-  vtkFFDTetrahedralDeformer tetrahedra;
-  std::string why =
-    tetrahedral ? tetrahedra.SetLattice(vtkUnstructuredGrid::SafeDownCast(lattice)) : grid.SetLattice(lattice);
-  if (!why.empty())
-  {
-    return "Cannot simulate the lattice: " + why;
-  }
-
-  // Particles: the active control points.
-  this->ParticleOf.assign(std::size_t(count), -1);
-  this->PointOf.clear();
+/// The body's particles: the lattice's active control points, with their rest positions. An empty string, or
+/// what is wrong.
+std::string ReadParticles(vtkPointSet* lattice, vtkFFDLatticeBody& body)
+{
+  const vtkIdType count = lattice->GetNumberOfPoints();
+  vtkDataArray* rest = lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
+  body.ParticleOf.assign(std::size_t(count), -1);
+  body.PointOf.clear();
   vtkDataArray* active = lattice->GetPointData()->GetArray(vtkFFDDataContract::ActiveArrayName());
   if (active && (active->GetNumberOfComponents() != 1 || active->GetNumberOfTuples() != count))
   {
     return "The lattice's Active point array does not have one value per point.";
   }
-  this->RestPositions.clear();
+  body.RestPositions.clear();
   for (vtkIdType p = 0; p < count; ++p)
   {
     if (!active || active->GetComponent(p, 0) != 0)
     {
-      this->ParticleOf[p] = static_cast<int>(this->PointOf.size());
-      this->PointOf.push_back(p);
+      body.ParticleOf[p] = static_cast<int>(body.PointOf.size());
+      body.PointOf.push_back(p);
       double x[3];
       rest->GetTuple(p, x);
-      this->RestPositions.insert(this->RestPositions.end(), x, x + 3);
+      body.RestPositions.insert(body.RestPositions.end(), x, x + 3);
     }
   }
-  if (this->PointOf.empty())
+  if (body.PointOf.empty())
   {
     return "The lattice has no active control point to simulate.";
   }
+  return std::string();
+}
 
-  // Springs.
-  const int offsets = OffsetCount[neighborhood];
+/// The springs of the lattice read by `tetrahedra` (where `tetrahedral`) or by `grid`.
+std::vector<Pair> LatticeSprings(bool tetrahedral, const vtkFFDTetrahedralDeformer& tetrahedra,
+  const vtkFFDGridDeformer& grid, const std::vector<int>& particleOf, int offsets)
+{
   if (tetrahedral)
   {
-    this->Springs = TetrahedronSprings(tetrahedra.GetNodes(), this->ParticleOf);
+    return TetrahedronSprings(tetrahedra.GetNodes(), particleOf);
   }
-  else if (const vtkFFDSparseCells* cells = grid.GetSparseCells())
+  if (const vtkFFDSparseCells* cells = grid.GetSparseCells())
   {
-    this->Springs = SparseSprings(
-      *cells, ffd::SupportSize(grid.GetLattice().Basis, grid.GetLattice().Divisions[0]), this->ParticleOf, offsets);
+    return SparseSprings(
+      *cells, ffd::SupportSize(grid.GetLattice().Basis, grid.GetLattice().Divisions[0]), particleOf, offsets);
+  }
+  return DenseSprings(grid.GetLattice().ControlPointsPerAxis, particleOf, offsets);
+}
+
+/// Each particle's share of the mesh's points (none without a mesh): the sum of their weights on it.
+std::vector<double> MeshShares(vtkPointSet* mesh, bool tetrahedral, vtkFFDTetrahedralDeformer& tetrahedra,
+  vtkFFDGridDeformer& grid, const std::vector<int>& particleOf, std::size_t particles)
+{
+  std::vector<double> share(particles, 0.0);
+  if (!mesh || !mesh->GetPoints() || mesh->GetNumberOfPoints() == 0)
+  {
+    return share;
+  }
+  vtkPoints* points = mesh->GetPoints();
+  bool rebound = false;
+  auto add = [&](vtkIdType point, double weight)
+  {
+    const int particle = particleOf[point];
+    if (particle >= 0)
+    {
+      share[particle] += weight;
+    }
+  };
+  if (tetrahedral)
+  {
+    tetrahedra.Bind(points, vtkFFDTetrahedralDeformer::KEEP_POSITION, nullptr, 0, 1, rebound);
+    vtkFFDForEachTetrahedronWeight(tetrahedra, points, 0, mesh->GetNumberOfPoints(),
+      [&](vtkIdType, vtkIdType node, double weight) { add(node, weight); });
   }
   else
   {
-    this->Springs = DenseSprings(grid.GetLattice().ControlPointsPerAxis, this->ParticleOf, offsets);
+    grid.Bind(points, 0 /* KEEP_POSITION */, nullptr, 0, 1, rebound);
+    vtkFFDForEachGridWeight(grid, points, 0, mesh->GetNumberOfPoints(),
+      [&](vtkIdType, vtkIdType controlPoint, double weight) { add(controlPoint, weight); });
+  }
+  return share;
+}
+} // namespace
+
+//------------------------------------------------------------------------------------------------------------
+std::string vtkFFDLatticeBody::Read(
+  vtkPointSet* lattice, vtkPointSet* mesh, int neighborhood, double totalMass, double minimumMassFraction)
+{
+  std::string why = CheckLatticePoints(lattice);
+  if (!why.empty())
+  {
+    return why;
   }
 
-  // Masses: each particle's share of the mesh's points, through their weights.
-  const std::size_t particles = this->PointOf.size();
-  std::vector<double> share(particles, 0.0);
-  if (mesh && mesh->GetPoints() && mesh->GetNumberOfPoints() > 0)
+  // The lattice's kind, read and checked by vtkFFDDeform's own readers; the mesh's points bound to it.
+  const bool tetrahedral = vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice);
+  vtkFFDGridDeformer grid;
+  vtkFFDTetrahedralDeformer tetrahedra;
+  why = tetrahedral ? tetrahedra.SetLattice(vtkUnstructuredGrid::SafeDownCast(lattice)) : grid.SetLattice(lattice);
+  if (!why.empty())
   {
-    vtkPoints* points = mesh->GetPoints();
-    bool rebound = false;
-    auto add = [&](vtkIdType point, double weight)
-    {
-      const int particle = this->ParticleOf[point];
-      if (particle >= 0)
-      {
-        share[particle] += weight;
-      }
-    };
-    if (tetrahedral)
-    {
-      tetrahedra.Bind(points, vtkFFDTetrahedralDeformer::KEEP_POSITION, nullptr, 0, 1, rebound);
-      vtkFFDForEachTetrahedronWeight(tetrahedra, points, 0, mesh->GetNumberOfPoints(),
-        [&](vtkIdType, vtkIdType node, double weight) { add(node, weight); });
-    }
-    else
-    {
-      grid.Bind(points, 0 /* KEEP_POSITION */, nullptr, 0, 1, rebound);
-      vtkFFDForEachGridWeight(grid, points, 0, mesh->GetNumberOfPoints(),
-        [&](vtkIdType, vtkIdType controlPoint, double weight) { add(controlPoint, weight); });
-    }
+    return "Cannot simulate the lattice: " + why;
   }
-  this->Masses = ShareMass(share, totalMass, minimumMassFraction);
+
+  why = ReadParticles(lattice, *this);
+  if (!why.empty())
+  {
+    return why;
+  }
+  this->Springs = LatticeSprings(tetrahedral, tetrahedra, grid, this->ParticleOf, OffsetCount[neighborhood]);
+  // Masses: each particle's share of the mesh's points, through their weights.
+  this->Masses = ShareMass(MeshShares(mesh, tetrahedral, tetrahedra, grid, this->ParticleOf, this->PointOf.size()),
+    totalMass, minimumMassFraction);
   return std::string();
 }
