@@ -50,6 +50,55 @@ struct EvaluateWorker
       outPoints, determinants, self, vtkFFDGrain(n, 8.0), progressBegin, progressEnd);
   }
 };
+
+/// What keeps `lattice` from being a lattice of tetrahedra (no cells, or a cell of another type), or an empty
+/// string. `fix` ends each message.
+std::string CheckAllTetrahedra(vtkUnstructuredGrid* lattice, const std::string& fix)
+{
+  const vtkIdType numberOfCells = lattice->GetNumberOfCells();
+  if (numberOfCells == 0 || lattice->GetNumberOfPoints() == 0)
+  {
+    return "The tetrahedral lattice has no cells." + fix;
+  }
+  const bool allTetrahedra = lattice->IsHomogeneous() && lattice->GetCellType(0) == VTK_TETRA;
+  for (vtkIdType c = 0; c < numberOfCells && !allTetrahedra; ++c)
+  {
+    if (lattice->GetCellType(c) != VTK_TETRA)
+    {
+      std::ostringstream msg;
+      msg << "The tetrahedral lattice's cell " << c << " is not a tetrahedron (VTK cell type "
+          << lattice->GetCellType(c) << ")." << fix;
+      return msg.str();
+    }
+  }
+  return std::string();
+}
+
+/// What is wrong with the point ids of tetrahedron `c` (not 4 of them, or one outside [0, numberOfNodes)), or an
+/// empty string. `fix` ends the message.
+std::string CellIdsProblem(
+  vtkIdType c, vtkIdType count, const vtkIdType* ids, vtkIdType numberOfNodes, const std::string& fix)
+{
+  const vtkIdType* bad = count == 4
+    ? std::find_if(ids, ids + 4, [numberOfNodes](vtkIdType id) { return id < 0 || id >= numberOfNodes; })
+    : ids;
+  if (bad == ids + 4)
+  {
+    return std::string();
+  }
+  std::ostringstream msg;
+  msg << "The tetrahedral lattice's cell " << c;
+  if (count != 4)
+  {
+    msg << " is a tetrahedron of " << count << " point ids instead of 4.";
+  }
+  else
+  {
+    msg << " names point " << *bad << ", but the lattice has " << numberOfNodes << " points (ids 0 to "
+        << numberOfNodes - 1 << ").";
+  }
+  return msg.str() + fix;
+}
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -72,27 +121,17 @@ std::string vtkFFDTetrahedralDeformer::SetLattice(vtkUnstructuredGrid* lattice)
                           "tetrahedra with a RestPosition point array (see vtkFFDDeform).";
   const vtkIdType numberOfCells = lattice->GetNumberOfCells();
   const vtkIdType numberOfNodes = lattice->GetNumberOfPoints();
-  if (numberOfCells == 0 || numberOfNodes == 0)
+  std::string why = CheckAllTetrahedra(lattice, fix);
+  if (!why.empty())
   {
-    return "The tetrahedral lattice has no cells." + fix;
-  }
-  const bool allTetrahedra = lattice->IsHomogeneous() && lattice->GetCellType(0) == VTK_TETRA;
-  for (vtkIdType c = 0; c < numberOfCells && !allTetrahedra; ++c)
-  {
-    if (lattice->GetCellType(c) != VTK_TETRA)
-    {
-      std::ostringstream msg;
-      msg << "The tetrahedral lattice's cell " << c << " is not a tetrahedron (VTK cell type "
-          << lattice->GetCellType(c) << ")." << fix;
-      return msg.str();
-    }
+    return why;
   }
   vtkDataArray* rest = lattice->GetPointData()->GetArray(vtkFFDDataContract::RestPositionArrayName());
   if (!rest || rest->GetNumberOfComponents() != 3 || rest->GetNumberOfTuples() != numberOfNodes)
   {
     return "The tetrahedral lattice has no RestPosition point array of 3 components per point." + fix;
   }
-  std::string why = vtkFFDCheckLatticePrecision(lattice, rest, "The tetrahedral lattice");
+  why = vtkFFDCheckLatticePrecision(lattice, rest, "The tetrahedral lattice");
   if (!why.empty())
   {
     return why;
@@ -108,49 +147,45 @@ std::string vtkFFDTetrahedralDeformer::SetLattice(vtkUnstructuredGrid* lattice)
     return "The tetrahedral lattice has " + std::to_string(numberOfCells) + " tetrahedra; at most " +
       std::to_string(MaxTetrahedra) + " are supported.";
   }
+  return this->ReadNodes(lattice, fix);
+}
+
+//------------------------------------------------------------------------------------------------------------
+std::string vtkFFDTetrahedralDeformer::ReadNodes(vtkUnstructuredGrid* lattice, const std::string& fix)
+{
   // The connectivity is read again only when it changed (an update usually moves nodes only): the cell array,
   // or its arrays edited in place (vtkCellArray's time does not follow theirs), or the count of nodes its ids
   // must stay below.
+  const vtkIdType numberOfCells = lattice->GetNumberOfCells();
+  const vtkIdType numberOfNodes = lattice->GetNumberOfPoints();
   vtkCellArray* cells = lattice->GetCells();
   const vtkMTimeType cellsTime =
     std::max({ cells->GetMTime(), cells->GetConnectivityArray()->GetMTime(), cells->GetOffsetsArray()->GetMTime() });
-  if (cells != this->NodesSource || cellsTime != this->NodesSourceMTime ||
-    numberOfNodes != this->NodesSourceNodeCount || this->Nodes.size() != static_cast<size_t>(4 * numberOfCells))
+  if (cells == this->NodesSource && cellsTime == this->NodesSourceMTime &&
+    numberOfNodes == this->NodesSourceNodeCount && this->Nodes.size() == static_cast<size_t>(4 * numberOfCells))
   {
-    // Every cell's point ids are checked here, before anything reads a node through them.
-    this->Nodes.resize(4 * numberOfCells);
-    for (vtkIdType c = 0; c < numberOfCells; ++c)
-    {
-      vtkIdType count;
-      const vtkIdType* ids;
-      cells->GetCellAtId(c, count, ids);
-      const vtkIdType* bad = count == 4
-        ? std::find_if(ids, ids + 4, [numberOfNodes](vtkIdType id) { return id < 0 || id >= numberOfNodes; })
-        : ids;
-      if (bad != ids + 4)
-      {
-        this->Nodes.clear();
-        this->NodesSource = nullptr;
-        std::ostringstream msg;
-        msg << "The tetrahedral lattice's cell " << c;
-        if (count != 4)
-        {
-          msg << " is a tetrahedron of " << count << " point ids instead of 4.";
-        }
-        else
-        {
-          msg << " names point " << *bad << ", but the lattice has " << numberOfNodes << " points (ids 0 to "
-              << numberOfNodes - 1 << ").";
-        }
-        return msg.str() + fix;
-      }
-      std::copy(ids, ids + 4, this->Nodes.begin() + 4 * c);
-    }
-    this->NodesSource = cells;
-    this->NodesSourceMTime = cellsTime;
-    this->NodesSourceNodeCount = numberOfNodes;
-    this->NodesRead = true;
+    return std::string();
   }
+  // Every cell's point ids are checked here, before anything reads a node through them.
+  this->Nodes.resize(4 * numberOfCells);
+  for (vtkIdType c = 0; c < numberOfCells; ++c)
+  {
+    vtkIdType count;
+    const vtkIdType* ids;
+    cells->GetCellAtId(c, count, ids);
+    std::string problem = CellIdsProblem(c, count, ids, numberOfNodes, fix);
+    if (!problem.empty())
+    {
+      this->Nodes.clear();
+      this->NodesSource = nullptr;
+      return problem;
+    }
+    std::copy(ids, ids + 4, this->Nodes.begin() + 4 * c);
+  }
+  this->NodesSource = cells;
+  this->NodesSourceMTime = cellsTime;
+  this->NodesSourceNodeCount = numberOfNodes;
+  this->NodesRead = true;
   return std::string();
 }
 

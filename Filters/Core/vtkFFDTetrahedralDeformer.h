@@ -138,6 +138,10 @@ private:
   template <typename Real>
   void ComputeMaps(std::vector<ffd::TetrahedronMap<Real>>& maps) const;
 
+  /// The step of SetLattice() that reads the tetrahedra's nodes, only where the connectivity changed, checking
+  /// each id: an empty string, or what is wrong (`fix` ending it).
+  std::string ReadNodes(vtkUnstructuredGrid* lattice, const std::string& fix);
+
   ///@{
   /// The steps of Bind(). The walks and VTK's locator return false when aborted.
   void ComputeRestFrames();
