@@ -619,71 +619,72 @@ struct GridDeformer::Impl : ResidentPoints::State
     }
     const ffd::Frame<float> frame = ffd::Frame<float>::FromArray(this->Frame);
     const int controlPoints = dims[0] * dims[1] * dims[2];
-    bool tensor = controlPoints >= 400;
-    if (tensor)
-    {
-      const int ks = (dims[0] + 7) / 8, nt = (3 * dims[1] + 7) / 8;
-      const std::size_t shared = TensorSharedBytes(ks, nt, dims[2]);
-      auto launch = [&](auto ksConstant, auto ntConstant)
-      {
-        const auto kernel = BernsteinTensorKernel<decltype(ksConstant)::value, decltype(ntConstant)::value>;
-        cudaFuncAttributes attributes;
-        Check(cudaFuncGetAttributes(&attributes, kernel), "querying the evaluation kernel");
-        if (attributes.binaryVersion < 80)
-        {
-          tensor = false; // built for a device without TF32 tensor cores
-          return;
-        }
-        Check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(shared)),
-          "allowing the evaluation's shared memory");
-        int perMultiprocessor = 0;
-        Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&perMultiprocessor, kernel, 32 * TensorWarps, shared),
-          "sizing the evaluation");
-        const std::int64_t tiles = (this->Count + TensorTilePoints - 1) / TensorTilePoints;
-        const std::int64_t blocks =
-          std::min<std::int64_t>(std::int64_t(std::max(perMultiprocessor, 1)) * this->Multiprocessors,
-            (tiles + TensorWarps - 1) / TensorWarps);
-        kernel<<<unsigned(blocks), 32 * TensorWarps, shared, this->Stream>>>(this->Points.As<float>(),
-          this->Cells.As<int>(), this->Count, frame, dims[0], dims[1], dims[2], displacements,
-          this->OutPoints.As<float>());
-      };
-      auto withNT = [&](auto ksConstant)
-      {
-        switch (nt)
-        {
-          case 1:
-            launch(ksConstant, std::integral_constant<int, 1>());
-            break;
-          case 2:
-            launch(ksConstant, std::integral_constant<int, 2>());
-            break;
-          case 3:
-            launch(ksConstant, std::integral_constant<int, 3>());
-            break;
-          case 4:
-            launch(ksConstant, std::integral_constant<int, 4>());
-            break;
-          case 5:
-            launch(ksConstant, std::integral_constant<int, 5>());
-            break;
-          default:
-            launch(ksConstant, std::integral_constant<int, 6>());
-            break;
-        }
-      };
-      if (ks == 1)
-      {
-        withNT(std::integral_constant<int, 1>());
-      }
-      else
-      {
-        withNT(std::integral_constant<int, 2>());
-      }
-    }
-    if (tensor)
+    if (controlPoints >= 400 && this->LaunchBernsteinTensor(displacements, dims, frame))
     {
       return true;
     }
+    return this->LaunchBernsteinShared(displacements, dims, frame, largest);
+  }
+
+  // BernsteinTensorKernel instantiated for the lattice's k-steps and n-tiles. False, launching nothing, where the
+  // binary was built for a device without TF32 tensor cores.
+  bool LaunchBernsteinTensor(const float4* displacements, const int dims[3], const ffd::Frame<float>& frame)
+  {
+    const int ks = (dims[0] + 7) / 8, nt = (3 * dims[1] + 7) / 8;
+    const std::size_t shared = TensorSharedBytes(ks, nt, dims[2]);
+    auto withNT = [&](auto ksConstant)
+    {
+      constexpr int KS = decltype(ksConstant)::value;
+      switch (nt)
+      {
+        case 1:
+          return this->LaunchTensorKernel<KS, 1>(displacements, dims, frame, shared);
+        case 2:
+          return this->LaunchTensorKernel<KS, 2>(displacements, dims, frame, shared);
+        case 3:
+          return this->LaunchTensorKernel<KS, 3>(displacements, dims, frame, shared);
+        case 4:
+          return this->LaunchTensorKernel<KS, 4>(displacements, dims, frame, shared);
+        case 5:
+          return this->LaunchTensorKernel<KS, 5>(displacements, dims, frame, shared);
+        default:
+          return this->LaunchTensorKernel<KS, 6>(displacements, dims, frame, shared);
+      }
+    };
+    return ks == 1 ? withNT(std::integral_constant<int, 1>()) : withNT(std::integral_constant<int, 2>());
+  }
+
+  // One instantiation of BernsteinTensorKernel, in as many blocks as the device holds at once (fewer where the
+  // points need fewer); false, launching nothing, where the binary has no TF32 tensor cores.
+  template <int KS, int NT>
+  bool LaunchTensorKernel(
+    const float4* displacements, const int dims[3], const ffd::Frame<float>& frame, std::size_t shared)
+  {
+    const auto kernel = BernsteinTensorKernel<KS, NT>;
+    cudaFuncAttributes attributes;
+    Check(cudaFuncGetAttributes(&attributes, kernel), "querying the evaluation kernel");
+    if (attributes.binaryVersion < 80)
+    {
+      return false; // built for a device without TF32 tensor cores
+    }
+    Check(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(shared)),
+      "allowing the evaluation's shared memory");
+    int perMultiprocessor = 0;
+    Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&perMultiprocessor, kernel, 32 * TensorWarps, shared),
+      "sizing the evaluation");
+    const std::int64_t tiles = (this->Count + TensorTilePoints - 1) / TensorTilePoints;
+    const std::int64_t blocks = std::min<std::int64_t>(
+      std::int64_t(std::max(perMultiprocessor, 1)) * this->Multiprocessors, (tiles + TensorWarps - 1) / TensorWarps);
+    kernel<<<unsigned(blocks), 32 * TensorWarps, shared, this->Stream>>>(this->Points.As<float>(),
+      this->Cells.As<int>(), this->Count, frame, dims[0], dims[1], dims[2], displacements, this->OutPoints.As<float>());
+    return true;
+  }
+
+  // BernsteinKernel, the lattice in shared memory: false where it does not fit (48 KiB).
+  bool LaunchBernsteinShared(
+    const float4* displacements, const int dims[3], const ffd::Frame<float>& frame, int largest)
+  {
+    const int controlPoints = dims[0] * dims[1] * dims[2];
     const std::size_t shared = std::size_t(controlPoints) * sizeof(float4);
     if (shared > 48 * 1024)
     {
