@@ -204,14 +204,10 @@ vtkFFDCudaBackend::vtkFFDCudaBackend()
 
 vtkFFDCudaBackend::~vtkFFDCudaBackend() = default;
 
+#ifdef VOXELFFD_HAS_CUDA
 bool vtkFFDCudaBackend::IsAvailable(std::string& why)
 {
-#ifdef VOXELFFD_HAS_CUDA
   return ffd::cuda::DeviceAvailable(&why);
-#else
-  why = "VoxelFFD was built without CUDA";
-  return false;
-#endif
 }
 
 bool vtkFFDCudaBackend::DeformGrid(const vtkFFDGridDeformer& grid, const vtkFFDBindingKey& key, vtkPoints* points,
@@ -219,7 +215,6 @@ bool vtkFFDCudaBackend::DeformGrid(const vtkFFDGridDeformer& grid, const vtkFFDB
   std::string& why)
 {
   bound = false;
-#ifdef VOXELFFD_HAS_CUDA
   std::vector<double> storage;
   const double* displacements = grid.ReadDisplacements(storage);
   const vtkIdType controlPoints = grid.GetLattice().Points->GetNumberOfTuples();
@@ -234,24 +229,12 @@ bool vtkFFDCudaBackend::DeformGrid(const vtkFFDGridDeformer& grid, const vtkFFDB
     why = this->State->Grid.GetLastError();
   }
   return ok;
-#else
-  (void)grid;
-  (void)key;
-  (void)points;
-  (void)normals;
-  (void)outPoints;
-  (void)outNormals;
-  (void)outDeterminants;
-  why = "VoxelFFD was built without CUDA";
-  return false;
-#endif
 }
 
 bool vtkFFDCudaBackend::DeformTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points,
   vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
   std::string& why)
 {
-#ifdef VOXELFFD_HAS_CUDA
   const bool ok = vtkState::WithOutputs(outPoints, outDeterminants,
     [&](auto* out, auto* determinants)
     { return this->State->RunTetrahedra(tetrahedra, points, normals, out, outNormals, determinants); });
@@ -260,14 +243,25 @@ bool vtkFFDCudaBackend::DeformTetrahedra(const vtkFFDTetrahedralDeformer& tetrah
     why = this->State->Tetrahedra.GetLastError();
   }
   return ok;
+}
 #else
-  (void)tetrahedra;
-  (void)points;
-  (void)normals;
-  (void)outPoints;
-  (void)outNormals;
-  (void)outDeterminants;
+// Built without CUDA: the backend is never available, and says so.
+bool vtkFFDCudaBackend::IsAvailable(std::string& why)
+{
   why = "VoxelFFD was built without CUDA";
   return false;
-#endif
 }
+
+bool vtkFFDCudaBackend::DeformGrid(const vtkFFDGridDeformer&, const vtkFFDBindingKey&, vtkPoints*, vtkDataArray*,
+  vtkDataArray*, vtkDataArray*, vtkDataArray*, bool& bound, std::string& why)
+{
+  bound = false;
+  return vtkFFDCudaBackend::IsAvailable(why);
+}
+
+bool vtkFFDCudaBackend::DeformTetrahedra(const vtkFFDTetrahedralDeformer&, vtkPoints*, vtkDataArray*, vtkDataArray*,
+  vtkDataArray*, vtkDataArray*, std::string& why)
+{
+  return vtkFFDCudaBackend::IsAvailable(why);
+}
+#endif
