@@ -238,6 +238,24 @@ struct ResidentPoints::State
     }
   }
 
+  /// Guard() of `deformer`'s RunEvaluate() (a State of its own) in the points' precision.
+  template <typename Deformer, typename... Args>
+  static bool EvaluateInPrecision(Deformer& deformer, const Args&... args)
+  {
+    return deformer.Guard(
+      [&]
+      {
+        if (deformer.IsDouble)
+        {
+          deformer.template RunEvaluate<double>(args...);
+        }
+        else
+        {
+          deformer.template RunEvaluate<float>(args...);
+        }
+      });
+  }
+
   template <typename Real>
   void Upload(const Real* xyz, std::int64_t count);
 

@@ -773,19 +773,8 @@ bool GridDeformer::BindSparse(const double frame[12], int basis, const int divis
 bool GridDeformer::Evaluate(
   const double* displacements, std::int64_t controlPoints, bool withNormals, bool withDeterminants)
 {
-  Impl& p = static_cast<Impl&>(*this->S);
-  return p.Guard(
-    [&]
-    {
-      if (p.IsDouble)
-      {
-        p.RunEvaluate<double>(displacements, controlPoints, withNormals, withDeterminants);
-      }
-      else
-      {
-        p.RunEvaluate<float>(displacements, controlPoints, withNormals, withDeterminants);
-      }
-    });
+  return ResidentPoints::State::EvaluateInPrecision(
+    static_cast<Impl&>(*this->S), displacements, controlPoints, withNormals, withDeterminants);
 }
 
 } // namespace cuda

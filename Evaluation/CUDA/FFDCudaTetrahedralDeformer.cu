@@ -149,19 +149,8 @@ bool TetrahedralDeformer::Bind(const int* tetrahedronOfPoint, const ffd::Frame<d
 bool TetrahedralDeformer::Evaluate(
   const double* displacements, std::int64_t nodes, bool withNormals, bool withDeterminants)
 {
-  Impl& p = static_cast<Impl&>(*this->S);
-  return p.Guard(
-    [&]
-    {
-      if (p.IsDouble)
-      {
-        p.RunEvaluate<double>(displacements, nodes, withNormals, withDeterminants);
-      }
-      else
-      {
-        p.RunEvaluate<float>(displacements, nodes, withNormals, withDeterminants);
-      }
-    });
+  return ResidentPoints::State::EvaluateInPrecision(
+    static_cast<Impl&>(*this->S), displacements, nodes, withNormals, withDeterminants);
 }
 
 } // namespace cuda
