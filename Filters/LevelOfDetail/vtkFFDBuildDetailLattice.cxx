@@ -7,6 +7,7 @@
 #include "vtkFFDGridDeformer.h"
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
+#include "vtkFFDSortedKeys.h"
 #include "vtkFFDSparseLattice.h"
 #include "vtkFFDStatistics.h"
 #include "vtkFFDTetrahedralDeformer.h"
@@ -262,11 +263,11 @@ void MarkMovable(vtkUnstructuredGrid* output, const std::vector<vtkTypeInt64>& m
   vtkNew<vtkUnsignedCharArray> ghosts;
   ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
   ghosts->SetNumberOfValues(output->GetNumberOfPoints());
+  const vtkFFDSortedKeys<> movableKeys(movable.data(), movable.data() + movable.size());
   for (vtkIdType p = 0; p < output->GetNumberOfPoints(); ++p)
   {
     const int* ijk = latticeIndex->GetPointer(3 * p);
-    const bool isMovable =
-      std::binary_search(movable.begin(), movable.end(), vtkFFDFlatIndex(ijk[0], ijk[1], ijk[2], finePoints));
+    const bool isMovable = movableKeys.Find(vtkFFDFlatIndex(ijk[0], ijk[1], ijk[2], finePoints)) >= 0;
     active->SetValue(p, isMovable ? 1 : 0);
     ghosts->SetValue(p, isMovable ? 0 : vtkDataSetAttributes::HIDDENPOINT);
   }
