@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
  * @file FFDGridLanes.h
- * @brief Deforms points W at a time on the CPU, with the widest SIMD the CPU has (host only).
+ * @brief How the CPU passes deform points W at a time in SIMD lanes (host only; the FFDCpu library's own).
  *
  * GridDeformation's functions instantiated on Lanes<Real, W> (FFDLanes.h) deform W points at once. The points
  * are taken in blocks of BlockSize consecutive points, and a binding chooses how (MaxCellsInPlace(), from its
  * mean number of cells a block):
- * - In place (DeformBlocksInPlace()), reading and writing memory in order. A lane group in one cell reads each
+ * - In place (ffd::DeformBlocksInPlace(), FFDGridPasses.h), reading and writing memory in order. A lane group in one cell reads each
  *   control point once for all lanes. A group in several cells (listed at binding, ListBlockCells()) computes
  *   each lane's weights once, then each cell's sum in all lanes, kept in that cell's lanes
  *   (DeformInLaneCells(), FFDLaneCells.h).
@@ -22,10 +22,8 @@
  * takes it and however the work is split among threads. The one-point code (SimdLevel::None) computes the same
  * function; it may differ in the last bit, where the wide code fuses a multiply and an add.
  *
- * The default build must run on any x86-64, so the wide variants are compiled with GCC's target attribute
- * (AVX-512: 16 floats or 8 doubles a lane group; AVX2 and FMA: 8 or 4) and chosen at run time by
- * SimdLevelOfCpu(); `flatten` inlines every kernel function into them, so that no out-of-line copy compiled for
- * one instruction set is shared with code compiled for another. SSE2 (any x86-64) takes 4 floats or 2 doubles.
+ * Included only by the library's translation unit of each level, which defines that level's kernels
+ * (FFD_DEFINE_GRID_KERNELS(), compiled for its instruction set: FFDSimdLevel.h) and instantiates its passes.
  */
 #ifndef FFDGridLanes_h
 #define FFDGridLanes_h
