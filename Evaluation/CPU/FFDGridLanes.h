@@ -6,10 +6,10 @@
  * GridDeformation's functions instantiated on Lanes<Real, W> (FFDLanes.h) deform W points at once. The points
  * are taken in blocks of BlockSize consecutive points, and a binding chooses how (MaxCellsInPlace(), from its
  * mean number of cells a block):
- * - In place (ffd::DeformBlocksInPlace(), FFDGridPasses.h), reading and writing memory in order. A lane group in one cell reads each
- *   control point once for all lanes. A group in several cells (listed at binding, ListBlockCells()) computes
- *   each lane's weights once, then each cell's sum in all lanes, kept in that cell's lanes
- *   (DeformInLaneCells(), FFDLaneCells.h).
+ * - In place (ffd::DeformBlocksInPlace(), FFDGridPasses.h), reading and writing memory in order. A lane group in one
+ * cell reads each control point once for all lanes. A group in several cells (listed at binding, ListBlockCells())
+ * computes each lane's weights once, then each cell's sum in all lanes, kept in that cell's lanes (DeformInLaneCells(),
+ * FFDLaneCells.h).
  * - Gathered (DeformGathered()): the points of the blocks in more than MaxCellsInPlace() cells are listed once,
  *   at binding, tile by tile, each tile's sorted by cell (ListGatheredPoints()); the caller keeps a copy of
  *   their coordinates in that order (CopyGatheredPoints()). The pass deforms a tile's list in order into a
@@ -31,8 +31,8 @@
 #include "FFDCellTable.h"
 #include "FFDDeformPoint.h"
 #include "FFDGridDeformation.h"
-#include "FFDLaneCells.h"
 #include "FFDGridPassLevels.h"
+#include "FFDLaneCells.h"
 #include "FFDPointBlocks.h"
 #include "FFDSimdLevel.h"
 
@@ -53,21 +53,6 @@ struct LevelTag
 {
 };
 
-/// Lanes x y z stored interleaved at p, by non-temporal stores where `stream` (a run-time flag: one copy of the
-/// pass for both, the branch taken the same way throughout a pass).
-template <typename Lane, typename Real>
-inline void Store3(const Vec3<Lane>& y, Real* p, bool stream)
-{
-  if (stream)
-  {
-    Lane::template Interleave3<true>(y.x, y.y, y.z, p);
-  }
-  else
-  {
-    Lane::template Interleave3<false>(y.x, y.y, y.z, p);
-  }
-}
-
 template <typename Lane>
 inline typename Lane::IndexVector LaneCellsOf(const int* cells)
 {
@@ -78,10 +63,10 @@ inline typename Lane::IndexVector LaneCellsOf(const int* cells)
 }
 
 /// Blocks of the in-place pass (of a local basis) whose points are not all in one cell.
-template <typename Lane, typename Deformation, typename Wide, typename Real>
+template <typename Lane, bool Streaming, typename Deformation, typename Wide, typename Real>
 inline void DeformInSeveralCells(const Deformation& deformation, const Wide& wide, const CellSplit& split,
   const BlockCells& blocks, const Real* in, Real* out, std::int64_t outFirst, const std::int64_t* several,
-  int severalCount, bool stream)
+  int severalCount)
 {
   for (int s = 0; s < severalCount; ++s)
   {
@@ -98,16 +83,16 @@ inline void DeformInSeveralCells(const Deformation& deformation, const Wide& wid
         const Vec3<Lane> yc = DeformInLaneCells(wide, x, cells);
         y = { Select(cells.Bound, yc.x, x.x), Select(cells.Bound, yc.y, x.y), Select(cells.Bound, yc.z, x.z) };
       }
-      Store3(y, out + 3 * (i - outFirst), stream);
+      Lane::template Interleave3<Streaming>(y.x, y.y, y.z, out + 3 * (i - outFirst));
     }
   }
 }
 
 /// The in-place pass over blocks [blockBegin, blockEnd); point i's result goes to out + 3 (i - outFirst), by
-/// non-temporal stores where `stream` (out + 3 (blockBegin BlockSize - outFirst) aligned to 64 bytes).
-template <int W, typename Deformation, typename Real>
+/// non-temporal stores where Streaming (out + 3 (blockBegin BlockSize - outFirst) aligned to 64 bytes).
+template <int W, bool Streaming, typename Deformation, typename Real>
 inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in, const int* cells, Real* out,
-  const BlockCells& blocks, std::int64_t blockBegin, std::int64_t blockEnd, std::int64_t outFirst, bool stream)
+  const BlockCells& blocks, std::int64_t blockBegin, std::int64_t blockEnd, std::int64_t outFirst)
 {
   static_assert(BlockSize % W == 0, "a block is a whole number of lane groups");
   using Lane = Lanes<Real, W>;
@@ -184,10 +169,10 @@ inline void BlocksInPlaceInLanes(const Deformation& deformation, const Real* in,
       }
       for (int g = 0; g < Groups; ++g)
       {
-        Store3(y[g], out + 3 * (begin + g * W - outFirst), stream);
+        Lane::template Interleave3<Streaming>(y[g].x, y[g].y, y[g].z, out + 3 * (begin + g * W - outFirst));
       }
     }
-    DeformInSeveralCells<Lane>(deformation, wide, split, blocks, in, out, outFirst, several, severalCount, stream);
+    DeformInSeveralCells<Lane, Streaming>(deformation, wide, split, blocks, in, out, outFirst, several, severalCount);
   }
 }
 
@@ -303,28 +288,32 @@ inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, 
 }
 
 /// The kernels of one level: in its own translation unit (FFDGridPasses<Level>.cxx), compiled for its instruction
-/// set. The gathered pass deforms a tile into staging by the level's in-place kernel, called (noinline: one copy
-/// of it), then writes the tile out (WriteTile(), compiled for the same set: float64 points copied as 4 Reals
-/// take one 32-byte move with AVX).
+/// set. The gathered pass deforms a tile into staging by the level's in-place kernel, called (noinline: not a
+/// third copy of it), then writes the tile out (WriteTile(), compiled for the same set: float64 points copied as
+/// 4 Reals take one 32-byte move with AVX). The non-temporal stores stay a compile-time choice: as a run-time
+/// flag they cost 4-7 % in float32 (BENCHMARKS.md, "What did not help").
 #define FFD_DEFINE_GRID_KERNELS(Level, Target, Bytes)                                                                  \
   template <typename Deformation, typename Real>                                                                       \
-  Target __attribute__((noinline)) void InPlaceIn(LevelTag<Level>, const Deformation& deformation, const Real* in,    \
-    const int* cells, Real* out, const BlockCells& blocks, std::int64_t blockBegin, std::int64_t blockEnd,            \
+  Target __attribute__((noinline)) void InPlaceIn(LevelTag<Level>, const Deformation& deformation, const Real* in,     \
+    const int* cells, Real* out, const BlockCells& blocks, std::int64_t blockBegin, std::int64_t blockEnd,             \
     std::int64_t outFirst, bool stream)                                                                                \
   {                                                                                                                    \
-    BlocksInPlaceInLanes<Bytes / int(sizeof(Real))>(                                                                   \
-      deformation, in, cells, out, blocks, blockBegin, blockEnd, outFirst, stream);                                    \
     if (stream)                                                                                                        \
     {                                                                                                                  \
+      BlocksInPlaceInLanes<Bytes / int(sizeof(Real)), true>(                                                           \
+        deformation, in, cells, out, blocks, blockBegin, blockEnd, outFirst);                                          \
       _mm_sfence(); /* the non-temporal stores are seen by other threads after this */                                 \
+      return;                                                                                                          \
     }                                                                                                                  \
+    BlocksInPlaceInLanes<Bytes / int(sizeof(Real)), false>(                                                            \
+      deformation, in, cells, out, blocks, blockBegin, blockEnd, outFirst);                                            \
   }                                                                                                                    \
   template <typename Deformation, typename Real>                                                                       \
   Target void WithJacobianIn(LevelTag<Level>, const Deformation& deformation, const Real* in, const int* cells,        \
     const BlockCells& blocks, const Real* inNormals, Real* out, Real* outNormals, Real* determinants,                  \
     std::int64_t begin, std::int64_t end)                                                                              \
   {                                                                                                                    \
-    WithJacobianInLanes<Bytes / int(sizeof(Real))>(                                                                   \
+    WithJacobianInLanes<Bytes / int(sizeof(Real))>(                                                                    \
       deformation, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);                           \
   }                                                                                                                    \
   template <typename Deformation, typename Real>                                                                       \
@@ -332,8 +321,8 @@ inline void WithJacobianInLanes(const Deformation& deformation, const Real* in, 
     const GatheredPoints& gathered, std::int64_t t, Real* staged, Real* out)                                           \
   {                                                                                                                    \
     const std::int64_t first = gathered.TileBlocks[std::size_t(t)];                                                    \
-    InPlaceIn(LevelTag<Level>(), deformation, listed, gathered.Cells.data(), staged, gathered.Blocks, first,            \
-      gathered.TileBlocks[std::size_t(t) + 1], first * BlockSize, false);                                              \
+    InPlaceIn(LevelTag<Level>(), deformation, listed, gathered.Cells.data(), staged, gathered.Blocks, first,           \
+      gathered.TileBlocks[std::size_t(t) + 1], first* BlockSize, false);                                               \
     WriteTile(gathered, t, staged, out);                                                                               \
   }
 
@@ -351,7 +340,8 @@ void WithJacobianAt(const GridLattice<Real>& lattice, const Real* in, const int*
   const Real* inNormals, Real* out, Real* outNormals, Real* determinants, std::int64_t begin, std::int64_t end)
 {
   WithGridDeformation(lattice,
-    [&](const auto& deformation) {
+    [&](const auto& deformation)
+    {
       WithJacobianIn(
         LevelTag<Level>(), deformation, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
     });
@@ -361,8 +351,8 @@ template <SimdLevel Level, typename Real>
 void GatheredAt(const GridLattice<Real>& lattice, const Real* listed, const GatheredPoints& gathered, std::int64_t t,
   Real* staged, Real* out)
 {
-  WithGridDeformation(
-    lattice, [&](const auto& deformation) { GatheredIn(LevelTag<Level>(), deformation, listed, gathered, t, staged, out); });
+  WithGridDeformation(lattice,
+    [&](const auto& deformation) { GatheredIn(LevelTag<Level>(), deformation, listed, gathered, t, staged, out); });
 }
 
 } // namespace detail
