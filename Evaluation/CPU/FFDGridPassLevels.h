@@ -73,7 +73,6 @@ inline void DeformOnePointWithJacobian(const Deformation& deformation, const Rea
     determinants ? determinants + i : nullptr);
 }
 
-
 template <SimdLevel Level, typename Real>
 void InPlaceAt(const GridLattice<Real>& lattice, const Real* in, const int* cells, Real* out, const BlockCells& blocks,
   std::int64_t blockBegin, std::int64_t blockEnd, bool stream);
@@ -89,14 +88,14 @@ void GatheredAt(const GridLattice<Real>& lattice, const Real* listed, const Gath
 
 // The explicit instantiations of one level's passes in both precisions (in its translation unit).
 #define FFD_INSTANTIATE_GRID_PASSES_OF(Level, Real)                                                                    \
-  template void ffd::detail::InPlaceAt<Level, Real>(const ffd::GridLattice<Real>&, const Real*, const int*, Real*,         \
-    const ffd::BlockCells&, std::int64_t, std::int64_t, bool);                                                             \
-  template void ffd::detail::WithJacobianAt<Level, Real>(const ffd::GridLattice<Real>&, const Real*, const int*,           \
-    const ffd::BlockCells&, const Real*, Real*, Real*, Real*, std::int64_t, std::int64_t);                                 \
-  template void ffd::detail::GatheredAt<Level, Real>(                                                                 \
+  template void ffd::detail::InPlaceAt<Level, Real>(const ffd::GridLattice<Real>&, const Real*, const int*, Real*,     \
+    const ffd::BlockCells&, std::int64_t, std::int64_t, bool);                                                         \
+  template void ffd::detail::WithJacobianAt<Level, Real>(const ffd::GridLattice<Real>&, const Real*, const int*,       \
+    const ffd::BlockCells&, const Real*, Real*, Real*, Real*, std::int64_t, std::int64_t);                             \
+  template void ffd::detail::GatheredAt<Level, Real>(                                                                  \
     const ffd::GridLattice<Real>&, const Real*, const ffd::GatheredPoints&, std::int64_t, Real*, Real*);
 #define FFD_INSTANTIATE_GRID_PASSES(Level)                                                                             \
-  FFD_INSTANTIATE_GRID_PASSES_OF(Level, float)                                                                        \
+  FFD_INSTANTIATE_GRID_PASSES_OF(Level, float)                                                                         \
   FFD_INSTANTIATE_GRID_PASSES_OF(Level, double)
 
 #endif

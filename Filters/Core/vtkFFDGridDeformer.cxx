@@ -475,8 +475,8 @@ struct LanesFunctor
     }
     else
     {
-      ffd::DeformBlocksInPlace(level, this->Lattice, this->InPoints, this->Binding.CellOfPoint.data(),
-        this->OutPoints, this->Binding.Blocks, begin, end, this->Stream);
+      ffd::DeformBlocksInPlace(level, this->Lattice, this->InPoints, this->Binding.CellOfPoint.data(), this->OutPoints,
+        this->Binding.Blocks, begin, end, this->Stream);
     }
   }
 };

@@ -24,7 +24,7 @@
 #define vtkFFDBuildDetailLattice_h
 
 #include "vtkFFDFiltersLevelOfDetailModule.h" // For export macro
-#include "vtkSmartPointer.h"     // For SelectedVoxels
+#include "vtkSmartPointer.h"                  // For SelectedVoxels
 #include "vtkUnstructuredGridAlgorithm.h"
 
 class vtkIntArray;

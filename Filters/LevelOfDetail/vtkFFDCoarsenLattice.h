@@ -11,8 +11,8 @@
  *     sum over the mesh's points p of |D(x_p) - d_p|^2,
  *
  * with d_p the input lattice's displacement of point p and D the output's (ffd::LeastSquares,
- * Filters/LevelOfDetail/FFDLeastSquares.h: eight steps of iterated Tikhonov regularisation towards the smoothest control
- * net, on a sparse factorisation of the normal equations). `Regularization` sets what counts as determined:
+ * Filters/LevelOfDetail/FFDLeastSquares.h: eight steps of iterated Tikhonov regularisation towards the smoothest
+ * control net, on a sparse factorisation of the normal equations). `Regularization` sets what counts as determined:
  * combinations of control points whose weight over the mesh's points, relative to their roughness, is below about
  * Regularization times the mean weight keep the smooth values their neighbours extend to them, instead of
  * least-squares values that can be huge (a mesh's surface barely touches some control points of the cubic bases:

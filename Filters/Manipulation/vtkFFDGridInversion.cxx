@@ -561,8 +561,8 @@ void WithStaticBasisOf(const ffd::GridDeformation<MaxCount, double>& d, int cell
 //------------------------------------------------------------------------------------------------------------
 // Grid lattices: Newton's method on the lattice's float64 evaluation, in SIMD lanes over tiles of points ordered
 // by cell (OrderedTile, InvertInGroups()).
-bool vtkFFDInvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, vtkPoints* points, vtkDataArray* normals,
-  double tolerance, int maxIterations, const vtkFFDInverseOutput& out)
+bool vtkFFDInvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, vtkPoints* points,
+  vtkDataArray* normals, double tolerance, int maxIterations, const vtkFFDInverseOutput& out)
 {
   const double* f = deformer.GetLattice().Frame;
   const double diagonal = std::hypot(f[3] + f[6] + f[9], f[4] + f[7] + f[10], f[5] + f[8] + f[11]);

@@ -233,9 +233,9 @@ bool FindGrids(vtkFFDVDBReader* self, const openvdb::GridPtrVec& grids, Grids& f
     const std::string missing = ReadDescription(*grid, g > 0, descriptions[g]);
     if (!missing.empty())
     {
-      vtkErrorWithObjectMacro(self, << "The grid \"" << names[g] << "\" of " << self->GetFileName()
-                                    << " has no metadata " << missing
-                                    << ": write the file with vtkFFDVDBWriter, or add it (docs/interchange-and-files.md, \".vdb files\").");
+      vtkErrorWithObjectMacro(
+        self, << "The grid \"" << names[g] << "\" of " << self->GetFileName() << " has no metadata " << missing
+              << ": write the file with vtkFFDVDBWriter, or add it (docs/interchange-and-files.md, \".vdb files\").");
       return false;
     }
   }

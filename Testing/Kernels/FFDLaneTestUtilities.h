@@ -126,7 +126,8 @@ std::vector<Real> DeformAll(ffd::SimdLevel level, const D& d, const PointSet<Rea
     ffd::DeformBlocksInPlace(level, LatticeOf(d), set.Values.data(), set.Cells.data(), out, listed, begin, cut, stream);
     begin = cut;
   }
-  ffd::DeformBlocksInPlace(level, LatticeOf(d), set.Values.data(), set.Cells.data(), out, listed, begin, blocks, stream);
+  ffd::DeformBlocksInPlace(
+    level, LatticeOf(d), set.Values.data(), set.Cells.data(), out, listed, begin, blocks, stream);
   std::vector<Real> copy(3 * gathered.Order.size());
   ffd::CopyGatheredPoints(set.Values.data(), gathered, 0, std::int64_t(gathered.Order.size()), copy.data());
   std::vector<Real> staging(ffd::GatherStaging, std::numeric_limits<Real>::quiet_NaN());

@@ -276,8 +276,8 @@ TYPED_TEST(FFDGridLanesTest, JacobianAtEveryLevelMatchesReference)
               determinants(std::size_t(set.Size()), nan);
             for (std::size_t c = 0; c + 1 < cuts.size(); ++c)
             {
-              ffd::DeformWithJacobian(level, ffdtest::LatticeOf(k.D), set.Values.data(), set.Cells.data(), listed, normals.data(),
-                out.data(), outNormals.data(), determinants.data(), cuts[c], cuts[c + 1]);
+              ffd::DeformWithJacobian(level, ffdtest::LatticeOf(k.D), set.Values.data(), set.Cells.data(), listed,
+                normals.data(), out.data(), outNormals.data(), determinants.data(), cuts[c], cuts[c + 1]);
             }
             for (std::int64_t i = 0; i < set.Size(); ++i)
             {

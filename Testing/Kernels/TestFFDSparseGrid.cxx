@@ -192,8 +192,8 @@ TYPED_TEST(FFDSparseGridTest, DeformsAsTheDenseLatticeBitForBit)
               const Real nan = std::numeric_limits<Real>::quiet_NaN();
               std::vector<Real> out(set.Values.size(), nan), outNormals(normals.size(), nan),
                 determinants(std::size_t(set.Size()), nan);
-              ffd::DeformWithJacobian(level, ffdtest::LatticeOf(d), set.Values.data(), set.Cells.data(), listed, normals.data(), out.data(),
-                outNormals.data(), determinants.data(), 0, set.Size());
+              ffd::DeformWithJacobian(level, ffdtest::LatticeOf(d), set.Values.data(), set.Cells.data(), listed,
+                normals.data(), out.data(), outNormals.data(), determinants.data(), 0, set.Size());
               out.insert(out.end(), outNormals.begin(), outNormals.end());
               out.insert(out.end(), determinants.begin(), determinants.end());
               return out;
