@@ -196,13 +196,20 @@ std::size_t TensorSharedBytes(int ks, int nt, int dimU)
     std::size_t(TensorWarps) * TensorTableFloats * sizeof(float);
 }
 
-// The lattice as the mma's B fragments in shared memory: for k, k-step ks, n-tile nt, lane (g = lane / 4,
-// q = lane % 4): rows i = 8 ks + q and 8 ks + q + 4, column n = 8 nt + g, i.e. D[i, j = n / 3, k][c = n % 3], as
-// (hi, hi, lo, lo); zero outside the lattice. The block's threads share the work.
+// TF32 mma needs sm_80 or later: built for an older target the kernel is empty, and LaunchBernstein, which reads
+// the binary's version, does not launch it.
 template <int KS, int NT>
-__device__ __forceinline__ void StageFragments(
-  const float4* __restrict__ displacements, int dimS, int dimT, int dimU, float4* fragments)
+__global__ void __launch_bounds__(32 * TensorWarps, 2) BernsteinTensorKernel(const float* __restrict__ points,
+  const int* __restrict__ cells, std::int64_t count, ffd::Frame<float> frame, int dimS, int dimT, int dimU,
+  const float4* __restrict__ displacements, float* __restrict__ outPoints)
 {
+  static_assert(KS >= 1 && KS <= 2 && NT >= 1 && NT <= 6, "up to 16 control points along each axis");
+#if !defined(__CUDA_ARCH__) || __CUDA_ARCH__ >= 800
+  constexpr int TP = TensorTilePoints;
+  extern __shared__ float4 smem[];
+  // B fragments: for k, k-step ks, n-tile nt, lane (g = lane / 4, q = lane % 4): rows i = 8 ks + q and 8 ks + q + 4,
+  // column n = 8 nt + g, i.e. D[i, j = n / 3, k][c = n % 3], as (hi, hi, lo, lo); zero outside the lattice.
+  float4* fragments = smem;
   const int fragmentCount = dimU * KS * NT * 32;
   for (int f = threadIdx.x; f < fragmentCount; f += blockDim.x)
   {
@@ -220,230 +227,184 @@ __device__ __forceinline__ void StageFragments(
     const unsigned l0 = ToTF32(v[0] - __uint_as_float(h0)), l1 = ToTF32(v[1] - __uint_as_float(h1));
     fragments[f] = make_float4(__uint_as_float(h0), __uint_as_float(h1), __uint_as_float(l0), __uint_as_float(l1));
   }
-}
-
-// A warp's table of its tile: the weights Bs [TP][17], Bt [TP][17], Bu [16][TP] (padded against bank conflicts)
-// and the points (x, y, z, bound).
-struct TensorTable
-{
-  float* S;
-  float* T;
-  float* U;
-  float* X;
-};
-
-// Lane l computes the weights of the tile's point l along each axis in turn (the same function as the CPU's).
-__device__ __forceinline__ void TileWeights(const float* __restrict__ points, const int* __restrict__ cells,
-  std::int64_t count, const ffd::Frame<float>& frame, int dimS, int dimT, int dimU, std::int64_t base, int lane,
-  const TensorTable& table)
-{
-  constexpr int TP = TensorTilePoints;
-  const std::int64_t i = base + lane;
-  const bool inRange = i < count;
-  const float* p = points + 3 * (inRange ? i : 0);
-  const ffd::Vec3<float> x = { p[0], p[1], p[2] };
-  const bool bound = inRange && cells[i] >= 0;
-  const ffd::Vec3<float> stu = frame.ToParametric(x);
-  for (int axis = 0; axis < 3; ++axis)
-  {
-    // Unbound points (kept in place) get finite weights, so that no NaN enters the tile's products.
-    const float t = bound ? ffd::Clamp01(axis == 0 ? stu.x : (axis == 1 ? stu.y : stu.z)) : 0.0f;
-    const int dim = axis == 0 ? dimS : (axis == 1 ? dimT : dimU);
-    float b[16];
-    ffd::BernsteinBasisBounded<16>(dim - 1, t, b);
-    FFD_UNROLL
-    for (int e = 0; e < 16; ++e)
-    {
-      const float w = e < dim ? b[e] : 0.0f;
-      if (axis == 0)
-      {
-        table.S[lane * 17 + e] = w;
-      }
-      else if (axis == 1)
-      {
-        table.T[lane * 17 + e] = w;
-      }
-      else
-      {
-        table.U[e * TP + lane] = w;
-      }
-    }
-  }
-  table.X[4 * lane] = x.x;
-  table.X[4 * lane + 1] = x.y;
-  table.X[4 * lane + 2] = x.z;
-  table.X[4 * lane + 3] = bound ? 1.0f : 0.0f;
-}
-
-// acc[mt][nt] = P's tile for this lane: sum over k and the k-steps of A = Bs_i Bu_k (split by truncation into
-// hi, the top 19 bits, and lo, the exact rest) times the B fragments, 3 mma each (3xTF32).
-template <int KS, int NT>
-__device__ __forceinline__ void AccumulateTile(
-  const TensorTable& table, const float4* fragments, int dimU, int lane, float (&acc)[2][NT][4])
-{
-  constexpr int TP = TensorTilePoints;
-  const int g = lane / 4, q = lane % 4;
-  // Bs of this lane's A rows (g, g + 8 of each m-tile) and columns (q, q + 4 of each k-step).
-  float as[2][2][KS][2];
-  FFD_UNROLL
-  for (int mt = 0; mt < 2; ++mt)
-  {
-    FFD_UNROLL
-    for (int r = 0; r < 2; ++r)
-    {
-      FFD_UNROLL
-      for (int ks = 0; ks < KS; ++ks)
-      {
-        as[mt][r][ks][0] = table.S[(16 * mt + g + 8 * r) * 17 + 8 * ks + q];
-        as[mt][r][ks][1] = table.S[(16 * mt + g + 8 * r) * 17 + 8 * ks + q + 4];
-      }
-    }
-  }
-  FFD_UNROLL
-  for (int mt = 0; mt < 2; ++mt)
-  {
-    FFD_UNROLL
-    for (int nt = 0; nt < NT; ++nt)
-    {
-      acc[mt][nt][0] = acc[mt][nt][1] = acc[mt][nt][2] = acc[mt][nt][3] = 0.0f;
-    }
-  }
-#pragma unroll 2
-  for (int k = 0; k < dimU; ++k)
-  {
-    float bu[2][2];
-    FFD_UNROLL
-    for (int mt = 0; mt < 2; ++mt)
-    {
-      bu[mt][0] = table.U[k * TP + 16 * mt + g];
-      bu[mt][1] = table.U[k * TP + 16 * mt + g + 8];
-    }
-    FFD_UNROLL
-    for (int ks = 0; ks < KS; ++ks)
-    {
-      float4 b[NT];
-      FFD_UNROLL
-      for (int nt = 0; nt < NT; ++nt)
-      {
-        b[nt] = fragments[((k * KS + ks) * NT + nt) * 32 + lane];
-      }
-      unsigned ahi[2][4], alo[2][4];
-      FFD_UNROLL
-      for (int mt = 0; mt < 2; ++mt)
-      {
-        const float a[4] = { as[mt][0][ks][0] * bu[mt][0], as[mt][1][ks][0] * bu[mt][1], as[mt][0][ks][1] * bu[mt][0],
-          as[mt][1][ks][1] * bu[mt][1] };
-        FFD_UNROLL
-        for (int e = 0; e < 4; ++e)
-        {
-          ahi[mt][e] = __float_as_uint(a[e]) & 0xffffe000u;
-          alo[mt][e] = __float_as_uint(a[e] - __uint_as_float(ahi[mt][e]));
-        }
-      }
-      FFD_UNROLL
-      for (int nt = 0; nt < NT; ++nt)
-      {
-        const unsigned bh0 = __float_as_uint(b[nt].x), bh1 = __float_as_uint(b[nt].y);
-        const unsigned bl0 = __float_as_uint(b[nt].z), bl1 = __float_as_uint(b[nt].w);
-        FFD_UNROLL
-        for (int mt = 0; mt < 2; ++mt)
-        {
-          MmaTF32(acc[mt][nt], alo[mt], bh0, bh1);
-          MmaTF32(acc[mt][nt], ahi[mt], bl0, bl1);
-          MmaTF32(acc[mt][nt], ahi[mt], bh0, bh1);
-        }
-      }
-    }
-  }
-}
-
-// out[p, c] = x[p, c] + sum_j Bt_j[p] P[p, (j, c)]: this lane holds rows g, g + 8 (r = 0, 1) of each m-tile and
-// columns n = 8 nt + 2 q + e, whose sums over the four lanes of the row are the results; lane (g, q) writes
-// point 16 mt + g + 8 r with 2 mt + r = q.
-template <int NT>
-__device__ __forceinline__ void WriteTensorTile(const TensorTable& table, const float (&acc)[2][NT][4],
-  std::int64_t base, std::int64_t count, int lane, float* __restrict__ outPoints)
-{
-  const int g = lane / 4, q = lane % 4;
-  float sum[2][2][3];
-  FFD_UNROLL
-  for (int mt = 0; mt < 2; ++mt)
-  {
-    FFD_UNROLL
-    for (int r = 0; r < 2; ++r)
-    {
-      sum[mt][r][0] = sum[mt][r][1] = sum[mt][r][2] = 0.0f;
-      const float* bt = table.T + (16 * mt + g + 8 * r) * 17;
-      FFD_UNROLL
-      for (int nt = 0; nt < NT; ++nt)
-      {
-        FFD_UNROLL
-        for (int e = 0; e < 2; ++e)
-        {
-          const int n = 8 * nt + 2 * q + e, j = (n * 43) >> 7, c = n - 3 * j; // j = n / 3 for n < 128
-          const float v = bt[j] * acc[mt][nt][2 * r + e];
-          sum[mt][r][0] += c == 0 ? v : 0.0f;
-          sum[mt][r][1] += c == 1 ? v : 0.0f;
-          sum[mt][r][2] += c == 2 ? v : 0.0f;
-        }
-      }
-      FFD_UNROLL
-      for (int c = 0; c < 3; ++c)
-      {
-        sum[mt][r][c] += __shfl_xor_sync(0xffffffffu, sum[mt][r][c], 1);
-        sum[mt][r][c] += __shfl_xor_sync(0xffffffffu, sum[mt][r][c], 2);
-      }
-    }
-  }
-  FFD_UNROLL
-  for (int mt = 0; mt < 2; ++mt)
-  {
-    FFD_UNROLL
-    for (int r = 0; r < 2; ++r)
-    {
-      const int p = 16 * mt + g + 8 * r;
-      const std::int64_t i = base + p;
-      if (q == 2 * mt + r && i < count)
-      {
-        const bool bound = table.X[4 * p + 3] != 0.0f;
-        FFD_UNROLL
-        for (int c = 0; c < 3; ++c)
-        {
-          outPoints[3 * i + c] = bound ? table.X[4 * p + c] + sum[mt][r][c] : table.X[4 * p + c];
-        }
-      }
-    }
-  }
-}
-
-// TF32 mma needs sm_80 or later: built for an older target the kernel is empty, and LaunchBernstein, which reads
-// the binary's version, does not launch it. Each warp takes tiles of TensorTilePoints points from a persistent grid.
-template <int KS, int NT>
-__global__ void __launch_bounds__(32 * TensorWarps, 2) BernsteinTensorKernel(const float* __restrict__ points,
-  const int* __restrict__ cells, std::int64_t count, ffd::Frame<float> frame, int dimS, int dimT, int dimU,
-  const float4* __restrict__ displacements, float* __restrict__ outPoints)
-{
-  static_assert(KS >= 1 && KS <= 2 && NT >= 1 && NT <= 6, "up to 16 control points along each axis");
-#if !defined(__CUDA_ARCH__) || __CUDA_ARCH__ >= 800
-  constexpr int TP = TensorTilePoints;
-  extern __shared__ float4 smem[];
-  float4* fragments = smem;
-  StageFragments<KS, NT>(displacements, dimS, dimT, dimU, fragments);
+  // Per warp: the tile's weights Bs [TP][17], Bt [TP][17], Bu [16][TP] (padded against bank conflicts) and points.
   const int warp = threadIdx.x / 32, lane = threadIdx.x % 32;
-  float* ws = reinterpret_cast<float*>(smem + dimU * KS * NT * 32) + warp * TensorTableFloats;
-  const TensorTable table = { ws, ws + TP * 17, ws + 2 * TP * 17, ws + 2 * TP * 17 + 16 * TP };
+  float* ws = reinterpret_cast<float*>(smem + fragmentCount) + warp * TensorTableFloats;
+  float* wt = ws + TP * 17;
+  float* wu = wt + TP * 17;
+  float* xs = wu + 16 * TP; // x, y, z, bound
   __syncthreads();
 
+  const int g = lane / 4, q = lane % 4;
   const std::int64_t tiles = (count + TP - 1) / TP;
   for (std::int64_t tile = blockIdx.x * std::int64_t(TensorWarps) + warp; tile < tiles;
        tile += std::int64_t(gridDim.x) * TensorWarps)
   {
     const std::int64_t base = tile * TP;
-    TileWeights(points, cells, count, frame, dimS, dimT, dimU, base, lane, table);
+    // Lane l computes the weights of point l along each axis in turn (the same function as the CPU's).
+    {
+      const std::int64_t i = base + lane;
+      const bool inRange = i < count;
+      const float* p = points + 3 * (inRange ? i : 0);
+      const ffd::Vec3<float> x = { p[0], p[1], p[2] };
+      const bool bound = inRange && cells[i] >= 0;
+      const ffd::Vec3<float> stu = frame.ToParametric(x);
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        // Unbound points (kept in place) get finite weights, so that no NaN enters the tile's products.
+        const float t = bound ? ffd::Clamp01(axis == 0 ? stu.x : (axis == 1 ? stu.y : stu.z)) : 0.0f;
+        const int dim = axis == 0 ? dimS : (axis == 1 ? dimT : dimU);
+        float b[16];
+        ffd::BernsteinBasisBounded<16>(dim - 1, t, b);
+        FFD_UNROLL
+        for (int e = 0; e < 16; ++e)
+        {
+          const float w = e < dim ? b[e] : 0.0f;
+          if (axis == 0)
+          {
+            ws[lane * 17 + e] = w;
+          }
+          else if (axis == 1)
+          {
+            wt[lane * 17 + e] = w;
+          }
+          else
+          {
+            wu[e * TP + lane] = w;
+          }
+        }
+      }
+      xs[4 * lane] = x.x;
+      xs[4 * lane + 1] = x.y;
+      xs[4 * lane + 2] = x.z;
+      xs[4 * lane + 3] = bound ? 1.0f : 0.0f;
+    }
     __syncwarp();
+    // Bs of this lane's A rows (g, g + 8 of each m-tile) and columns (q, q + 4 of each k-step).
+    float as[2][2][KS][2];
+    FFD_UNROLL
+    for (int mt = 0; mt < 2; ++mt)
+    {
+      FFD_UNROLL
+      for (int r = 0; r < 2; ++r)
+      {
+        FFD_UNROLL
+        for (int ks = 0; ks < KS; ++ks)
+        {
+          as[mt][r][ks][0] = ws[(16 * mt + g + 8 * r) * 17 + 8 * ks + q];
+          as[mt][r][ks][1] = ws[(16 * mt + g + 8 * r) * 17 + 8 * ks + q + 4];
+        }
+      }
+    }
     float acc[2][NT][4];
-    AccumulateTile<KS, NT>(table, fragments, dimU, lane, acc);
-    WriteTensorTile<NT>(table, acc, base, count, lane, outPoints);
+    FFD_UNROLL
+    for (int mt = 0; mt < 2; ++mt)
+    {
+      FFD_UNROLL
+      for (int nt = 0; nt < NT; ++nt)
+      {
+        acc[mt][nt][0] = acc[mt][nt][1] = acc[mt][nt][2] = acc[mt][nt][3] = 0.0f;
+      }
+    }
+#pragma unroll 2
+    for (int k = 0; k < dimU; ++k)
+    {
+      float bu[2][2];
+      FFD_UNROLL
+      for (int mt = 0; mt < 2; ++mt)
+      {
+        bu[mt][0] = wu[k * TP + 16 * mt + g];
+        bu[mt][1] = wu[k * TP + 16 * mt + g + 8];
+      }
+      FFD_UNROLL
+      for (int ks = 0; ks < KS; ++ks)
+      {
+        float4 b[NT];
+        FFD_UNROLL
+        for (int nt = 0; nt < NT; ++nt)
+        {
+          b[nt] = fragments[((k * KS + ks) * NT + nt) * 32 + lane];
+        }
+        unsigned ahi[2][4], alo[2][4];
+        FFD_UNROLL
+        for (int mt = 0; mt < 2; ++mt)
+        {
+          const float a[4] = { as[mt][0][ks][0] * bu[mt][0], as[mt][1][ks][0] * bu[mt][1], as[mt][0][ks][1] * bu[mt][0],
+            as[mt][1][ks][1] * bu[mt][1] };
+          FFD_UNROLL
+          for (int e = 0; e < 4; ++e)
+          {
+            ahi[mt][e] = __float_as_uint(a[e]) & 0xffffe000u;
+            alo[mt][e] = __float_as_uint(a[e] - __uint_as_float(ahi[mt][e]));
+          }
+        }
+        FFD_UNROLL
+        for (int nt = 0; nt < NT; ++nt)
+        {
+          const unsigned bh0 = __float_as_uint(b[nt].x), bh1 = __float_as_uint(b[nt].y);
+          const unsigned bl0 = __float_as_uint(b[nt].z), bl1 = __float_as_uint(b[nt].w);
+          FFD_UNROLL
+          for (int mt = 0; mt < 2; ++mt)
+          {
+            MmaTF32(acc[mt][nt], alo[mt], bh0, bh1);
+            MmaTF32(acc[mt][nt], ahi[mt], bl0, bl1);
+            MmaTF32(acc[mt][nt], ahi[mt], bh0, bh1);
+          }
+        }
+      }
+    }
+    // out[p, c] = x[p, c] + sum_j Bt_j[p] P[p, (j, c)]: this lane holds rows g, g + 8 (r = 0, 1) of each m-tile and
+    // columns n = 8 nt + 2 q + e, whose sums over the four lanes of the row are the results.
+    float sum[2][2][3];
+    FFD_UNROLL
+    for (int mt = 0; mt < 2; ++mt)
+    {
+      FFD_UNROLL
+      for (int r = 0; r < 2; ++r)
+      {
+        sum[mt][r][0] = sum[mt][r][1] = sum[mt][r][2] = 0.0f;
+        const float* bt = wt + (16 * mt + g + 8 * r) * 17;
+        FFD_UNROLL
+        for (int nt = 0; nt < NT; ++nt)
+        {
+          FFD_UNROLL
+          for (int e = 0; e < 2; ++e)
+          {
+            const int n = 8 * nt + 2 * q + e, j = (n * 43) >> 7, c = n - 3 * j; // j = n / 3 for n < 128
+            const float v = bt[j] * acc[mt][nt][2 * r + e];
+            sum[mt][r][0] += c == 0 ? v : 0.0f;
+            sum[mt][r][1] += c == 1 ? v : 0.0f;
+            sum[mt][r][2] += c == 2 ? v : 0.0f;
+          }
+        }
+        FFD_UNROLL
+        for (int c = 0; c < 3; ++c)
+        {
+          sum[mt][r][c] += __shfl_xor_sync(0xffffffffu, sum[mt][r][c], 1);
+          sum[mt][r][c] += __shfl_xor_sync(0xffffffffu, sum[mt][r][c], 2);
+        }
+      }
+    }
+    // Lane (g, q) writes point 16 mt + g + 8 r with 2 mt + r = q.
+    FFD_UNROLL
+    for (int mt = 0; mt < 2; ++mt)
+    {
+      FFD_UNROLL
+      for (int r = 0; r < 2; ++r)
+      {
+        const int p = 16 * mt + g + 8 * r;
+        const std::int64_t i = base + p;
+        if (q == 2 * mt + r && i < count)
+        {
+          const bool bound = xs[4 * p + 3] != 0.0f;
+          FFD_UNROLL
+          for (int c = 0; c < 3; ++c)
+          {
+            outPoints[3 * i + c] = bound ? xs[4 * p + c] + sum[mt][r][c] : xs[4 * p + c];
+          }
+        }
+      }
+    }
     __syncwarp(); // the tables are rewritten by the next tile
   }
 #endif
