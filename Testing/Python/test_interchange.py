@@ -592,8 +592,15 @@ class TestVTKTransforms(InterchangeTest):
         flat.GetPointData().SetScalars(numpy_to_vtk(np.zeros((6 * 7 * 3, 3)), deep=True))
         small = vtkBSplineTransform()
         small.SetCoefficientData(flat)
-        with self.assertRaisesRegex(ValueError, "at least 4"):
+        with self.assertRaisesRegex(ValueError, "coefficient image is \\[6, 7, 3\\] points; .* at least 4"):
             interchange.lattice_from_bspline_transform(small)
+        thin = vtkImageData()
+        thin.SetDimensions(6, 1, 3)  # 1 point along y: no voxel of a vtkGridTransform's grid
+        thin.GetPointData().SetScalars(numpy_to_vtk(np.zeros((6 * 3, 3)), deep=True))
+        one_point = vtkGridTransform()
+        one_point.SetDisplacementGridData(thin)
+        with self.assertRaisesRegex(ValueError, "displacement grid is \\[6, 1, 3\\] points; .* at least 2"):
+            interchange.lattice_from_grid_transform(one_point)
         integers = vtkImageData()
         integers.SetDimensions(5, 5, 5)
         integers.GetPointData().SetScalars(numpy_to_vtk(np.zeros((125, 3), dtype=np.int32), deep=True))

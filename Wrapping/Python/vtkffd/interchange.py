@@ -399,6 +399,16 @@ def _image_node_zero(image):
     return np.array(image.GetOrigin()) + np.array(extent[0::2]) * np.array(image.GetSpacing())
 
 
+def _image_divisions(image, border, what, name):
+    """The divisions of the lattice over a transform's image of divisions + `border` points along each axis, and
+    the image's spacing; ValueError where an axis has too few points for one voxel."""
+    dims = np.array(image.GetDimensions())
+    if np.any(dims < border + 1):
+        raise ValueError("%s: the %s is %s points; a lattice needs at least %d (one voxel) along each axis"
+                         % (what, name, dims.tolist(), border + 1))
+    return dims - border, np.array(image.GetSpacing())
+
+
 def _image_vectors(image, what):
     """The image's 3-component point scalars as an (nK, nJ, nI, 3) float64 array."""
     scalars = image.GetPointData().GetScalars()
@@ -445,12 +455,7 @@ def lattice_from_bspline_transform(transform):
     coefficients, data_type = _image_vectors(image, "vtkBSplineTransform")
     if data_type not in (VTK_FLOAT, VTK_DOUBLE):
         raise ValueError("%s: vtkBSplineTransform evaluates float or double coefficients only" % what)
-    dims = np.array(image.GetDimensions())
-    if np.any(dims < 4):
-        raise ValueError("%s: the coefficient image is %s points; a lattice needs at least 4 (one voxel) along "
-                         "each axis" % (what, dims.tolist()))
-    spacing = np.array(image.GetSpacing())
-    divisions = dims - 3
+    divisions, spacing = _image_divisions(image, 3, what, "coefficient image")
     frame = np.concatenate([_image_node_zero(image) + spacing, np.diag(spacing * divisions).ravel()])
     return _lattice_with_displacements(frame, divisions, CUBIC_BSPLINE,
                                        coefficients * transform.GetDisplacementScale())
@@ -498,12 +503,7 @@ def lattice_from_grid_transform(transform):
         # vtkGridTransform::InternalUpdate refuses other types and then leaves every point where it is.
         raise ValueError("%s: vtkGridTransform reads (unsigned) char, (unsigned) short, float or double grids "
                          "only" % what)
-    dims = np.array(image.GetDimensions())
-    if np.any(dims < 2):
-        raise ValueError("%s: the displacement grid is %s points; a lattice needs at least 2 (one voxel) along "
-                         "each axis" % (what, dims.tolist()))
-    spacing = np.array(image.GetSpacing())
-    divisions = dims - 1
+    divisions, spacing = _image_divisions(image, 1, what, "displacement grid")
     frame = np.concatenate([_image_node_zero(image), np.diag(spacing * divisions).ravel()])
     displacement = values * transform.GetDisplacementScale() + transform.GetDisplacementShift()
     return _lattice_with_displacements(frame, divisions, TRILINEAR, displacement)
