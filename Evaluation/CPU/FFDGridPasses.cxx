@@ -26,10 +26,14 @@ void InPlace(SimdLevel level, const GridLattice<Real>& lattice, const Real* in, 
   switch (CompiledLevel(level))
   {
 #if FFD_HAVE_LANES
+#if FFD_WIDEST_LANES >= 3
     case SimdLevel::AVX512:
       return detail::InPlaceAt<SimdLevel::AVX512>(lattice, in, cells, out, blocks, blockBegin, blockEnd, stream);
+#endif
+#if FFD_WIDEST_LANES >= 2
     case SimdLevel::AVX2:
       return detail::InPlaceAt<SimdLevel::AVX2>(lattice, in, cells, out, blocks, blockBegin, blockEnd, stream);
+#endif
     case SimdLevel::SSE2:
       return detail::InPlaceAt<SimdLevel::SSE2>(lattice, in, cells, out, blocks, blockBegin, blockEnd, stream);
 #endif
@@ -61,12 +65,16 @@ void WithJacobian(SimdLevel level, const GridLattice<Real>& lattice, const Real*
   switch (CompiledLevel(level))
   {
 #if FFD_HAVE_LANES
+#if FFD_WIDEST_LANES >= 3
     case SimdLevel::AVX512:
       return detail::WithJacobianAt<SimdLevel::AVX512>(
         lattice, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
+#endif
+#if FFD_WIDEST_LANES >= 2
     case SimdLevel::AVX2:
       return detail::WithJacobianAt<SimdLevel::AVX2>(
         lattice, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
+#endif
     case SimdLevel::SSE2:
       return detail::WithJacobianAt<SimdLevel::SSE2>(
         lattice, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
@@ -98,12 +106,16 @@ void Gathered(SimdLevel level, const GridLattice<Real>& lattice, const Real* lis
     switch (CompiledLevel(level))
     {
 #if FFD_HAVE_LANES
+#if FFD_WIDEST_LANES >= 3
       case SimdLevel::AVX512:
         detail::GatheredAt<SimdLevel::AVX512>(lattice, listed, gathered, t, staging, out);
         continue;
+#endif
+#if FFD_WIDEST_LANES >= 2
       case SimdLevel::AVX2:
         detail::GatheredAt<SimdLevel::AVX2>(lattice, listed, gathered, t, staging, out);
         continue;
+#endif
       case SimdLevel::SSE2:
         detail::GatheredAt<SimdLevel::SSE2>(lattice, listed, gathered, t, staging, out);
         continue;
