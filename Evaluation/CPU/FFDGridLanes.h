@@ -47,12 +47,6 @@ namespace ffd
 {
 namespace detail
 {
-/// The level of the kernels FFD_DEFINE_GRID_KERNELS() defines.
-template <SimdLevel Level>
-struct LevelTag
-{
-};
-
 template <typename Lane>
 inline typename Lane::IndexVector LaneCellsOf(const int* cells)
 {

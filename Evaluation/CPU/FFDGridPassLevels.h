@@ -13,6 +13,7 @@
 #include "FFDDeformPoint.h"
 #include "FFDGridDeformation.h"
 #include "FFDGridPasses.h"
+#include "FFDInversePasses.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -73,6 +74,12 @@ inline void DeformOnePointWithJacobian(const Deformation& deformation, const Rea
     determinants ? determinants + i : nullptr);
 }
 
+/// The level of the kernels of a translation unit (FFD_DEFINE_GRID_KERNELS(), FFD_DEFINE_INVERSE_KERNEL()).
+template <SimdLevel Level>
+struct LevelTag
+{
+};
+
 template <SimdLevel Level, typename Real>
 void InPlaceAt(const GridLattice<Real>& lattice, const Real* in, const int* cells, Real* out, const BlockCells& blocks,
   std::int64_t blockBegin, std::int64_t blockEnd, bool stream);
@@ -82,11 +89,14 @@ void WithJacobianAt(const GridLattice<Real>& lattice, const Real* in, const int*
 template <SimdLevel Level, typename Real>
 void GatheredAt(const GridLattice<Real>& lattice, const Real* listed, const GatheredPoints& gathered, std::int64_t t,
   Real* staged, Real* out);
+template <SimdLevel Level>
+void InvertAt(const GridLattice<double>& lattice, const InverseLaneSearch& search, InverseLaneGroup& group);
 
 } // namespace detail
 } // namespace ffd
 
-// The explicit instantiations of one level's passes in both precisions (in its translation unit).
+// The explicit instantiations of one level's passes (each in its translation unit, so that a module links only
+// the passes it calls): the evaluation's in both precisions, the inverse's search in float64.
 #define FFD_INSTANTIATE_GRID_PASSES_OF(Level, Real)                                                                    \
   template void ffd::detail::InPlaceAt<Level, Real>(const ffd::GridLattice<Real>&, const Real*, const int*, Real*,     \
     const ffd::BlockCells&, std::int64_t, std::int64_t, bool);                                                         \
@@ -97,5 +107,8 @@ void GatheredAt(const GridLattice<Real>& lattice, const Real* listed, const Gath
 #define FFD_INSTANTIATE_GRID_PASSES(Level)                                                                             \
   FFD_INSTANTIATE_GRID_PASSES_OF(Level, float)                                                                         \
   FFD_INSTANTIATE_GRID_PASSES_OF(Level, double)
+#define FFD_INSTANTIATE_INVERSE_PASS(Level)                                                                            \
+  template void ffd::detail::InvertAt<Level>(                                                                          \
+    const ffd::GridLattice<double>&, const ffd::InverseLaneSearch&, ffd::InverseLaneGroup&);
 
 #endif

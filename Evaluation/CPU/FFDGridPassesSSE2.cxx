@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The CPU passes compiled for SSE2 (16-byte lanes), for every basis and both precisions: their one copy
-// (FFDGridPassLevels.h). Empty where the build leaves the level out (FFD_WIDEST_LANES) or has no lanes.
+// The evaluation's CPU passes compiled for SSE2 (16-byte lanes), for every basis and both precisions: their one
+// copy (FFDGridPassLevels.h). Empty where the build leaves the level out (FFD_WIDEST_LANES) or has no lanes.
 #include "FFDGridLanes.h"
 
 #if FFD_HAVE_LANES && FFD_WIDEST_LANES >= 1

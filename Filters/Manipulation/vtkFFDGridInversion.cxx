@@ -14,8 +14,7 @@
 #include "FFDCellTable.h"
 #include "FFDCpuTuning.h"
 #include "FFDInverse.h"
-#include "FFDLaneCells.h"
-#include "FFDSimdLevel.h"
+#include "FFDInversePasses.h"
 
 #include <algorithm>
 #include <cmath>
@@ -216,260 +215,37 @@ struct OrderedTile
   }
 };
 
-#if FFD_HAVE_LANES
-// Up to 8 points inverted together in SIMD lanes (NewtonInLanes()).
-struct LaneGroup
+// GridInversion::Bind() for the lanes of ffd::InvertInLanes().
+class GridInversionBinder : public ffd::InverseLaneBinder
 {
-  static constexpr int MaxWidth = 8;
-  int Count = 0;          // its points; the lanes past them repeat its last point
-  double Y[3 * MaxWidth]; // the deformed points, x y z each
-  int Cells[MaxWidth];    // their cells (GridInversion::Bind())
-  double X[3 * MaxWidth]; // the rest positions found
-  double J[9][MaxWidth];  // the Jacobian there, by element (row by row) and lane
-  unsigned Converged = 0; // the lanes whose rest position was found; the others are left to ffd::InvertPoint
+public:
+  explicit GridInversionBinder(const GridInversion& inversion)
+    : Inversion(inversion)
+  {
+  }
+  int Bind(const ffd::Vec3<double>& x) const override { return this->Inversion.Bind(x); }
+
+private:
+  const GridInversion& Inversion;
 };
 
-// The lanes at x that ffd::BindToCells() binds to `cell` (under clamping): along each axis of n cells, the
-// parameter clamped to [0, 1] times n, truncated, within [0, n - 1], is the cell's index. Tested in lanes: most
-// iterates stay in their cell, and binding them one by one would cost a fifth of the search.
-template <typename Deformation, typename Wide, typename Lane>
-inline unsigned StayingLanes(
-  const Deformation& deformation, const Wide& wide, const ffd::CellSplit& split, const ffd::Vec3<Lane>& x, int cell)
-{
-  using Mask = typename Lane::IndexVector;
-  int c[3];
-  deformation.CellIndices(split, cell, c);
-  const ffd::Vec3<Lane> stu = wide.Frame.ToParametric(x);
-  const Lane largest(std::numeric_limits<double>::max());
-  Mask stays = ~Mask{};
-  for (int a = 0; a < 3; ++a)
-  {
-    const int n = ffd::BindingCells(deformation.BasisOf(), deformation.Voxels[a]);
-    const Lane q = Clamp01(stu[a]) * Lane(n);
-    const Mask below = c[a] == n - 1 ? ~Mask{} : q.V < Lane(c[a] + 1).V;
-    stays &= InRange(stu[a], -largest, largest) & (q.V >= Lane(c[a]).V) & below;
-  }
-  return Lane::Bits(stays);
-}
-
-// The cells of the lanes in `active`: `known` where not null, else theirs in `cells` for the lanes of `keep`,
-// else GridInversion::Bind()'s. A lane without one leaves `active`, which is returned. The other lanes take the
-// first active lane's cell, so that they never add a cell to evaluate.
-template <typename Lane>
-inline unsigned BindLanes(const GridInversion& inversion, const ffd::Vec3<Lane>& x, const int* known, unsigned keep,
-  unsigned active, int* cells)
-{
-  for (int l = 0; l < Lane::Width; ++l)
-  {
-    if (active >> l & 1u)
-    {
-      cells[l] = known ? known[l] : keep >> l & 1u ? cells[l] : inversion.Bind({ x.x.V[l], x.y.V[l], x.z.V[l] });
-      active &= cells[l] >= 0 ? ~0u : ~(1u << l);
-    }
-  }
-  if (active != 0)
-  {
-    const int first = cells[__builtin_ctz(active)];
-    for (int l = 0; l < Lane::Width; ++l)
-    {
-      cells[l] = active >> l & 1u ? cells[l] : first;
-    }
-  }
-  return active;
-}
-
-// F(x), and J where `jacobian` is not null, at lanes bound to `cells`: all in one cell read each control point
-// once for all lanes; lanes in several cells (a local basis) read each its own cell's (ffd::DeformInLaneCells(),
-// as the evaluation does).
-template <typename Deformation, typename Wide, typename Lane>
-inline ffd::Vec3<Lane> DeformLanes(const Deformation& deformation, const Wide& wide, const ffd::CellSplit& split,
-  const ffd::Vec3<Lane>& x, const int* cells, ffd::Mat3<Lane>* jacobian)
-{
-  if (std::all_of(cells, cells + Lane::Width, [cells](int c) { return c == cells[0]; }))
-  {
-    return jacobian ? wide.Deform(x, cells[0], *jacobian) : wide.Deform(x, cells[0]);
-  }
-  // The cells and their lanes as an entry of ffd::BlockCells::List for one group: count, -, (cell, lane bits)...
-  int entry[2 + 2 * Lane::Width] = { 0 };
-  for (int l = 0; l < Lane::Width; ++l)
-  {
-    int k = 0;
-    while (k < entry[0] && entry[2 + 2 * k] != cells[l])
-    {
-      ++k;
-    }
-    entry[0] += k == entry[0];
-    entry[2 + 2 * k] = cells[l];
-    entry[3 + 2 * k] |= 1 << l;
-  }
-  const ffd::detail::GroupCells<Lane> group(deformation, split, entry, 0);
-  return jacobian ? ffd::DeformInLaneCells(wide, x, group, *jacobian) : ffd::DeformInLaneCells(wide, x, group);
-}
-
-// The search of a lane group: its iterate, the Jacobian of its last evaluation with one, the lanes still
-// searching and their last residuals, and the rest positions found with J there.
-template <typename Lane>
-struct LaneSearch
-{
-  ffd::Vec3<Lane> X;
-  ffd::Mat3<Lane> Jacobian;
-  Lane Det;
-  unsigned Active;
-  Lane Previous;
-  ffd::Vec3<Lane> Found;
-  ffd::Mat3<Lane> FoundJacobian;
-  unsigned Converged;
-};
-
-// Settles the searching lanes after an evaluation of residual `error`, in lanes: a lane leaves the search where
-// det J <= 0, where the residual did not fall, or where the steps ran out; it converged where the residual is
-// within the tolerance. Returns the largest residual of the lanes still searching.
-template <typename Lane>
-inline double SettleLanes(
-  const GridInversion& inversion, LaneSearch<Lane>& search, const Lane& error, int step, int iterations)
-{
-  using Mask = typename Lane::IndexVector;
-  const Mask found = error.V <= Lane(inversion.Tolerance).V;
-  Mask drop = ~IsPositive(search.Det);
-  if (step > 0)
-  {
-    drop |= ~(error.V < search.Previous.V);
-  }
-  if (step >= iterations)
-  {
-    drop |= ~found;
-  }
-  const unsigned converged = Lane::Bits(found & ~drop) & search.Active;
-  search.Active &= ~(Lane::Bits(drop) | converged);
-  search.Previous = error;
-  if (converged)
-  {
-    const Mask in = ffd::detail::MaskOfBits<Lane>(converged, std::make_index_sequence<Lane::Width>());
-    search.Found = { Select(in, search.X.x, search.Found.x), Select(in, search.X.y, search.Found.y),
-      Select(in, search.X.z, search.Found.z) };
-    for (int i = 0; i < 9; ++i)
-    {
-      search.FoundJacobian.M[i / 3][i % 3] =
-        Select(in, search.Jacobian.M[i / 3][i % 3], search.FoundJacobian.M[i / 3][i % 3]);
-    }
-    search.Converged |= converged;
-  }
-  double largest = 0;
-  for (unsigned active = search.Active; active; active &= active - 1)
-  {
-    largest = std::max(largest, error.V[__builtin_ctz(active)]);
-  }
-  return largest;
-}
-
-/**
- * ffd::InvertPoint's Newton iteration in W lanes, without its line search: from x = y, x -= J^-1 (F(x) - y),
- * each iterate bound again (GridInversion::Bind()). A lane converges where |F(x) - y| <= tolerance with det J > 0,
- * within `iterations` steps, the residual falling at every step. Any other lane (det J <= 0, a residual that
- * does not fall, no cell, the steps run out) is left to ffd::InvertPoint, which starts over. Once every residual
- * is within one Newton step of the tolerance (GridInversion::ChordResidual), the evaluations leave J out, the
- * steps taking the last J (a chord step), unless the normals need J where x is found.
- */
-template <int W, typename Deformation>
-inline void NewtonInLanes(
-  const GridInversion& inversion, const Deformation& deformation, int iterations, LaneGroup& group)
-{
-  using Lane = ffd::Lanes<double, W>;
-  const auto wide = deformation.template WithLanes<Lane>();
-  const ffd::CellSplit split = ffd::CellSplit::For(deformation.BasisOf(), deformation.Voxels);
-  ffd::Vec3<Lane> y;
-  Lane::Deinterleave3(group.Y, y.x, y.y, y.z);
-  const ffd::Mat3<Lane> identity = ffd::Mat3<Lane>::Identity();
-  LaneSearch<Lane> search{ y, identity, Lane(1.0), (1u << group.Count) - 1, Lane(0.0), y, identity, 0u };
-  bool withJacobian = true;
-  int cells[W];
-  for (int step = 0;; ++step)
-  {
-    const bool one = step > 0 && std::all_of(cells, cells + W, [&](int c) { return c == cells[0]; });
-    const unsigned keep = one ? StayingLanes(deformation, wide, split, search.X, cells[0]) : 0u;
-    search.Active = BindLanes(inversion, search.X, step == 0 ? group.Cells : nullptr, keep, search.Active, cells);
-    if (search.Active == 0)
-    {
-      Lane::Interleave3(search.Found.x, search.Found.y, search.Found.z, group.X);
-      for (int i = 0; i < 9; ++i)
-      {
-        std::memcpy(group.J[i], &search.FoundJacobian.M[i / 3][i % 3].V, sizeof(Lane));
-      }
-      group.Converged = search.Converged;
-      return;
-    }
-    const ffd::Vec3<Lane> r =
-      DeformLanes(deformation, wide, split, search.X, cells, withJacobian ? &search.Jacobian : nullptr) - y;
-    if (withJacobian)
-    {
-      search.Det = ffd::Determinant(search.Jacobian);
-    }
-    const double largest = SettleLanes(inversion, search, sqrt(ffd::Dot(r, r)), step, iterations);
-    withJacobian = inversion.Out.Normals || !(largest <= inversion.ChordResidual);
-    // J^-1 = Cofactor(J)^T / det J.
-    const ffd::Mat3<Lane> c = ffd::Cofactor(search.Jacobian);
-    const Lane scale = Lane(-1.0) / search.Det;
-    search.X = search.X +
-      scale *
-        ffd::Vec3<Lane>{ c.M[0][0] * r.x + c.M[1][0] * r.y + c.M[2][0] * r.z,
-          c.M[0][1] * r.x + c.M[1][1] * r.y + c.M[2][1] * r.z, c.M[0][2] * r.x + c.M[1][2] * r.y + c.M[2][2] * r.z };
-  }
-}
-
-// NewtonInLanes() compiled for each instruction set (as Evaluation/CPU/FFDGridLanes.h compiles its passes).
-#define FFD_INVERSE_VARIANT(Suffix, Target, W)                                                                         \
-  template <typename Deformation>                                                                                      \
-  Target void NewtonInLanes##Suffix(                                                                                   \
-    const GridInversion& inversion, const Deformation& deformation, int iterations, LaneGroup& group)                  \
-  {                                                                                                                    \
-    NewtonInLanes<W>(inversion, deformation, iterations, group);                                                       \
-  }
-FFD_INVERSE_VARIANT(AVX512, FFD_TARGET_AVX512, 8)
-FFD_INVERSE_VARIANT(AVX2, FFD_TARGET_AVX2, 4)
-FFD_INVERSE_VARIANT(SSE2, FFD_TARGET_SSE2, 2)
-#undef FFD_INVERSE_VARIANT
-#endif
-
-// The lanes of NewtonInLanes() at `level` (1: none, points go one at a time).
-int LaneWidth(ffd::SimdLevel level)
-{
-#if FFD_HAVE_LANES
-  switch (level)
-  {
-    case ffd::SimdLevel::AVX512:
-#if FFD_WIDEST_LANES >= 3
-      return 8;
-#endif
-      [[fallthrough]];
-    case ffd::SimdLevel::AVX2:
-#if FFD_WIDEST_LANES >= 2
-      return 4;
-#endif
-      [[fallthrough]];
-    case ffd::SimdLevel::SSE2:
-      return 2;
-    case ffd::SimdLevel::None:
-      break;
-  }
-#endif
-  (void)level;
-  return 1;
-}
-
-// The points order[begin, end) (of cells cells[begin, end)) in groups of LaneWidth(level), each through NewtonInLanes()
-// first, its lanes that did not converge there through GridInversion::InvertOne(). A few Newton steps in lanes find
-// nearly every point of a smooth deformation; ffd::InvertPoint alone costs several times more per point.
+// The points order[begin, end) (of cells cells[begin, end)) in groups of ffd::InverseLaneWidth(level), each through
+// ffd::InvertInLanes() first, its lanes that did not converge there through GridInversion::InvertOne(). A few Newton
+// steps in lanes find nearly every point of a smooth deformation; ffd::InvertPoint alone costs several times more
+// per point.
 template <typename Deformation>
-void InvertInGroups(const GridInversion& inversion, const Deformation& deformation, ffd::SimdLevel level,
-  const vtkIdType* order, const int* cells, vtkIdType begin, vtkIdType end)
+void InvertInGroups(const GridInversion& inversion, const ffd::GridLattice<double>& lattice,
+  const Deformation& deformation, ffd::SimdLevel level, const vtkIdType* order, const int* cells, vtkIdType begin,
+  vtkIdType end)
 {
-  const int width = LaneWidth(level);
-#if FFD_HAVE_LANES
+  const int width = ffd::InverseLaneWidth(level);
   constexpr int LaneSteps = 8; // beyond, ffd::InvertPoint's line search does better
-  const int iterations = std::min(inversion.MaxIterations, LaneSteps);
+  const GridInversionBinder binder(inversion);
+  const ffd::InverseLaneSearch search{ binder, inversion.Tolerance, inversion.ChordResidual,
+    std::min(inversion.MaxIterations, LaneSteps), inversion.Out.Normals != nullptr };
   for (vtkIdType i = begin; width > 1 && i < end; i += width)
   {
-    LaneGroup group;
+    ffd::InverseLaneGroup group;
     group.Count = int(std::min<vtkIdType>(width, end - i));
     for (int l = 0; l < width; ++l)
     {
@@ -477,21 +253,7 @@ void InvertInGroups(const GridInversion& inversion, const Deformation& deformati
       inversion.PointOf(order[at], group.Y + 3 * l);
       group.Cells[l] = cells[at];
     }
-    switch (width) // the wider variants only where compiled in, as in FFDGridLanes.h
-    {
-#if FFD_WIDEST_LANES >= 3
-      case 8:
-        NewtonInLanesAVX512(inversion, deformation, iterations, group);
-        break;
-#endif
-#if FFD_WIDEST_LANES >= 2
-      case 4:
-        NewtonInLanesAVX2(inversion, deformation, iterations, group);
-        break;
-#endif
-      default:
-        NewtonInLanesSSE2(inversion, deformation, iterations, group);
-    }
+    ffd::InvertInLanes(level, lattice, search, group);
     for (int l = 0; l < group.Count; ++l)
     {
       if (group.Converged >> l & 1u)
@@ -510,51 +272,38 @@ void InvertInGroups(const GridInversion& inversion, const Deformation& deformati
       }
     }
   }
-#endif
   for (vtkIdType i = begin; width == 1 && i < end; ++i)
   {
     inversion.InvertOne(deformation, order[i]);
   }
 }
 
-// Calls f with the float64 deformation of vtkFFDWithGridDeformation() with its basis known at compile time
-// (ffd::WithStaticBasis()), its fixed-size sums unrolled, and, for a local basis whose `cells` cells are few enough
-// for `points` points (ffd::WorthCellTable(), as vtkFFDDeform decides), its cells in power form
-// (ffd::FillCellTable()): F with its Jacobian by Horner's rule costs about half the sums of the control points'
-// weights and their derivatives. The table then takes at most 32 bytes a point (trilinear; 6 for the cubic
-// B-spline), where a sparse lattice of millions of cells would otherwise need GBs.
-template <int MaxCount, typename F>
-void WithStaticBasisOf(const ffd::GridDeformation<MaxCount, double>& d, int cells, vtkIdType points, F&& f)
+// The float64 lattice that `deformer` read as the passes take it, with its cells in power form where the
+// evaluation would take them so (ffd::WorthCellTable() of `cells` cells for `points` points, ffd::FillCellTable(),
+// into `table`): F with its Jacobian by Horner's rule costs about half the sums of the control points' weights and
+// their derivatives. The table then takes at most 32 bytes a point (trilinear; 6 for the cubic B-spline), where a
+// sparse lattice of millions of cells would otherwise need GBs.
+ffd::GridLattice<double> InversionLattice(
+  const vtkFFDGridDeformer& deformer, int cells, vtkIdType points, std::vector<double>& table)
 {
-  ffd::WithStaticBasis(d.Basis,
-    [&](auto maxCount, auto basis)
-    {
-      constexpr int Basis = decltype(basis)::value;
-      if constexpr (decltype(maxCount)::value == MaxCount)
+  const vtkFFDGridLattice& view = deformer.GetLattice();
+  const vtkFFDSparseCells* sparse = deformer.GetSparseCells();
+  ffd::GridLattice<double> lattice{ view.Basis, { view.Divisions[0], view.Divisions[1], view.Divisions[2] },
+    { view.ControlPointsPerAxis[0], view.ControlPointsPerAxis[1], view.ControlPointsPerAxis[2] },
+    view.Displacements.data(), ffd::Frame<double>::FromArray(view.Frame), nullptr,
+    sparse ? sparse->GetVoxels().data() : nullptr, sparse ? sparse->GetSupports() : nullptr };
+  if (ffd::WorthCellTable(view.Basis, cells, points))
+  {
+    table.resize(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(view.Basis)));
+    vtkSMPTools::For(0, cells, 256,
+      [&](int begin, int end)
       {
-        using Plain = ffd::GridDeformation<MaxCount, double, Basis>;
-        const Plain plain{ d.Basis, { d.Voxels[0], d.Voxels[1], d.Voxels[2] }, { d.Dims[0], d.Dims[1], d.Dims[2] },
-          d.Displacements, d.Frame, nullptr, d.CellVoxels, d.CellSupports };
-        if constexpr (Basis != int(ffd::GridBasis::Bernstein)) // one cell: no table
-        {
-          if (ffd::WorthCellTable(d.Basis, cells, points))
-          {
-            std::vector<double> table(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(d.Basis)));
-            vtkSMPTools::For(0, cells, 256,
-              [&](int begin, int end)
-              {
-                ffd::FillCellTable(
-                  d.Basis, d.Displacements, d.Voxels, d.Dims, d.CellVoxels, d.CellSupports, table.data(), begin, end);
-              });
-            f(ffd::GridDeformation<MaxCount, double, Basis, double, true>{ plain.Basis,
-              { d.Voxels[0], d.Voxels[1], d.Voxels[2] }, { d.Dims[0], d.Dims[1], d.Dims[2] }, d.Displacements, d.Frame,
-              table.data(), d.CellVoxels, d.CellSupports });
-            return;
-          }
-        }
-        f(plain);
-      }
-    });
+        ffd::FillCellTable(lattice.Basis, lattice.Displacements, lattice.Voxels, lattice.Dims, lattice.CellVoxels,
+          lattice.CellSupports, table.data(), begin, end);
+      });
+    lattice.CellTable = table.data();
+  }
+  return lattice;
 }
 } // namespace
 
@@ -583,27 +332,26 @@ bool vtkFFDInvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, 
     cellCount *= ffd::BindingCells(lattice.Basis, lattice.Divisions[a]);
   }
   cellCount = sparse ? sparse->GetNumberOfCells() : cellCount;
+  std::vector<double> table;
+  const ffd::GridLattice<double> passLattice = InversionLattice(deformer, cellCount, n, table);
   bool completed = false;
-  vtkFFDWithGridDeformation(deformer,
-    [&](const auto& dynamic)
+  ffd::WithGridDeformation(passLattice,
+    [&](const auto& deformation)
     {
-      WithStaticBasisOf(dynamic, cellCount, n,
-        [&](const auto& deformation)
+      // The tiles that start in [first, last), whole: a point's lane group, and so its result, is the same however
+      // the threads split the points.
+      auto invert = [&](vtkIdType first, vtkIdType last)
+      {
+        OrderedTile ordered;
+        for (vtkIdType begin = (first + tile - 1) / tile * tile; begin < last; begin += tile)
         {
-          // The tiles that start in [first, last), whole: a point's lane group, and so its result, is the same
-          // however the threads split the points.
-          auto invert = [&](vtkIdType first, vtkIdType last)
-          {
-            OrderedTile ordered;
-            for (vtkIdType begin = (first + tile - 1) / tile * tile; begin < last; begin += tile)
-            {
-              const vtkIdType end = std::min(n, begin + tile);
-              ordered.Sort(inversion, begin, end);
-              InvertInGroups(inversion, deformation, level, ordered.Order.data(), ordered.Cells.data(), 0, end - begin);
-            }
-          };
-          completed = vtkFFDForInChunks(self, n, tile, invert, 0.0, 1.0);
-        });
+          const vtkIdType end = std::min(n, begin + tile);
+          ordered.Sort(inversion, begin, end);
+          InvertInGroups(
+            inversion, passLattice, deformation, level, ordered.Order.data(), ordered.Cells.data(), 0, end - begin);
+        }
+      };
+      completed = vtkFFDForInChunks(self, n, tile, invert, 0.0, 1.0);
     });
   return completed;
 }

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
  * @file vtkFFDGridInversion.h
- * @brief vtkFFDInverseDeform's search on grid lattices (private to the Filters module).
+ * @brief vtkFFDInverseDeform's search on grid lattices (private to the Manipulation module).
  *
  * Newton's method on the lattice's float64 evaluation, from y minus the displacement at y: the points ordered by
  * cell in cache-sized tiles (a size of the point count alone, so that results do not depend on the threads), W at
- * a time in the forward map's SIMD lanes with the basis known at compile time (FFDGridLanes.h), a lane that does
- * not converge cleanly through ffd::InvertPoint, which reports folds and unconverged points.
+ * a time in the forward map's SIMD lanes with the basis known at compile time (FFDInversePasses.h, in FFDCpu), a
+ * lane that does not converge cleanly through ffd::InvertPoint, which reports folds and unconverged points.
  */
 #ifndef vtkFFDGridInversion_h
 #define vtkFFDGridInversion_h
