@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 namespace ffd
 {
@@ -79,6 +80,39 @@ template <SimdLevel Level>
 struct LevelTag
 {
 };
+
+/**
+ * f(level) with `level` (at most SimdLevelOfCpu()) as a compile-time constant, std::integral_constant<SimdLevel,
+ * L>, L the widest level compiled in (FFD_WIDEST_LANES) up to `level`: the one place that knows which levels a
+ * build has. False, and f not called, where there are no lanes or `level` is None.
+ */
+template <typename F>
+bool WithCompiledLevel(SimdLevel level, F&& f)
+{
+#if FFD_HAVE_LANES
+  switch (SimdLevel(std::min(int(level), FFD_WIDEST_LANES)))
+  {
+#if FFD_WIDEST_LANES >= 3
+    case SimdLevel::AVX512:
+      f(std::integral_constant<SimdLevel, SimdLevel::AVX512>());
+      return true;
+#endif
+#if FFD_WIDEST_LANES >= 2
+    case SimdLevel::AVX2:
+      f(std::integral_constant<SimdLevel, SimdLevel::AVX2>());
+      return true;
+#endif
+    case SimdLevel::SSE2:
+      f(std::integral_constant<SimdLevel, SimdLevel::SSE2>());
+      return true;
+    default:
+      break;
+  }
+#endif
+  (void)level;
+  (void)f;
+  return false;
+}
 
 template <SimdLevel Level, typename Real>
 void InPlaceAt(const GridLattice<Real>& lattice, const Real* in, const int* cells, Real* out, const BlockCells& blocks,

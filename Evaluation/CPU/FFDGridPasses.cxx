@@ -7,38 +7,17 @@ namespace ffd
 {
 namespace
 {
-/// The level asked for, or the widest compiled in below it (FFD_WIDEST_LANES); None where there are no lanes.
-SimdLevel CompiledLevel(SimdLevel level)
-{
-#if FFD_HAVE_LANES
-  return SimdLevel(std::min(int(level), FFD_WIDEST_LANES));
-#else
-  (void)level;
-  return SimdLevel::None;
-#endif
-}
-
 template <typename Real>
 void InPlace(SimdLevel level, const GridLattice<Real>& lattice, const Real* in, const int* cells, Real* out,
   const BlockCells& blocks, std::int64_t blockBegin, std::int64_t blockEnd, bool stream)
 {
   stream = stream && reinterpret_cast<std::uintptr_t>(out) % 64 == 0;
-  switch (CompiledLevel(level))
+  if (detail::WithCompiledLevel(level,
+        [&](auto compiled) {
+          detail::InPlaceAt<decltype(compiled)::value>(lattice, in, cells, out, blocks, blockBegin, blockEnd, stream);
+        }))
   {
-#if FFD_HAVE_LANES
-#if FFD_WIDEST_LANES >= 3
-    case SimdLevel::AVX512:
-      return detail::InPlaceAt<SimdLevel::AVX512>(lattice, in, cells, out, blocks, blockBegin, blockEnd, stream);
-#endif
-#if FFD_WIDEST_LANES >= 2
-    case SimdLevel::AVX2:
-      return detail::InPlaceAt<SimdLevel::AVX2>(lattice, in, cells, out, blocks, blockBegin, blockEnd, stream);
-#endif
-    case SimdLevel::SSE2:
-      return detail::InPlaceAt<SimdLevel::SSE2>(lattice, in, cells, out, blocks, blockBegin, blockEnd, stream);
-#endif
-    default:
-      break;
+    return;
   }
   WithGridDeformation(lattice,
     [&](const auto& deformation)
@@ -62,25 +41,14 @@ void WithJacobian(SimdLevel level, const GridLattice<Real>& lattice, const Real*
   const BlockCells& blocks, const Real* inNormals, Real* out, Real* outNormals, Real* determinants, std::int64_t begin,
   std::int64_t end)
 {
-  switch (CompiledLevel(level))
+  if (detail::WithCompiledLevel(level,
+        [&](auto compiled)
+        {
+          detail::WithJacobianAt<decltype(compiled)::value>(
+            lattice, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
+        }))
   {
-#if FFD_HAVE_LANES
-#if FFD_WIDEST_LANES >= 3
-    case SimdLevel::AVX512:
-      return detail::WithJacobianAt<SimdLevel::AVX512>(
-        lattice, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
-#endif
-#if FFD_WIDEST_LANES >= 2
-    case SimdLevel::AVX2:
-      return detail::WithJacobianAt<SimdLevel::AVX2>(
-        lattice, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
-#endif
-    case SimdLevel::SSE2:
-      return detail::WithJacobianAt<SimdLevel::SSE2>(
-        lattice, in, cells, blocks, inNormals, out, outNormals, determinants, begin, end);
-#endif
-    default:
-      break;
+    return;
   }
   WithGridDeformation(lattice,
     [&](const auto& deformation)
@@ -103,25 +71,11 @@ void Gathered(SimdLevel level, const GridLattice<Real>& lattice, const Real* lis
     {
       continue;
     }
-    switch (CompiledLevel(level))
+    if (detail::WithCompiledLevel(level,
+          [&](auto compiled)
+          { detail::GatheredAt<decltype(compiled)::value>(lattice, listed, gathered, t, staging, out); }))
     {
-#if FFD_HAVE_LANES
-#if FFD_WIDEST_LANES >= 3
-      case SimdLevel::AVX512:
-        detail::GatheredAt<SimdLevel::AVX512>(lattice, listed, gathered, t, staging, out);
-        continue;
-#endif
-#if FFD_WIDEST_LANES >= 2
-      case SimdLevel::AVX2:
-        detail::GatheredAt<SimdLevel::AVX2>(lattice, listed, gathered, t, staging, out);
-        continue;
-#endif
-      case SimdLevel::SSE2:
-        detail::GatheredAt<SimdLevel::SSE2>(lattice, listed, gathered, t, staging, out);
-        continue;
-#endif
-      default:
-        break;
+      continue;
     }
     WithGridDeformation(lattice,
       [&](const auto& deformation)
