@@ -451,6 +451,31 @@ private:
 
 namespace
 {
+// vtkFFDGridDeformer::PassLattice() in either precision.
+template <typename Real>
+ffd::GridLattice<Real> PassLatticeOf(const vtkFFDGridLattice& lattice, const vtkFFDSparseCells* sparse,
+  const Real* displacements, bool withCellTable, std::vector<Real>& table)
+{
+  ffd::GridLattice<Real> pass{ lattice.Basis, { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] },
+    { lattice.ControlPointsPerAxis[0], lattice.ControlPointsPerAxis[1], lattice.ControlPointsPerAxis[2] },
+    displacements, ffd::Frame<Real>::FromArray(lattice.Frame), nullptr, sparse ? sparse->GetVoxels().data() : nullptr,
+    sparse ? sparse->GetSupports() : nullptr };
+  if (withCellTable)
+  {
+    const int cells =
+      sparse ? sparse->GetNumberOfCells() : lattice.Divisions[0] * lattice.Divisions[1] * lattice.Divisions[2];
+    table.resize(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(lattice.Basis)));
+    vtkSMPTools::For(0, cells, 256,
+      [&](int begin, int end)
+      {
+        ffd::FillCellTable(pass.Basis, displacements, pass.Voxels, pass.Dims, pass.CellVoxels, pass.CellSupports,
+          table.data(), begin, end);
+      });
+    pass.CellTable = table.data();
+  }
+  return pass;
+}
+
 // Evaluation of the points alone (no normals, no determinants) from points of the output's precision, W at a
 // time in SIMD lanes (FFDGridPasses.h): first the blocks deformed in place, then the points of the other blocks,
 // gathered by cell at binding, tile by tile.
@@ -508,8 +533,8 @@ struct JacobianFunctor
 template <typename Real>
 struct EvaluateWorker
 {
-  const vtkFFDSparseCells* Sparse; // null for a dense lattice
-  const Real* Displacements;       // the lattice's, in Real (EvaluationDisplacements())
+  const vtkFFDGridDeformer& Deformer;
+  const Real* Displacements; // the lattice's, in Real (EvaluationDisplacements())
 
   template <typename PointArrayT>
   void operator()(PointArrayT* inPoints, const vtkFFDGridLattice& lattice, vtkFFDGridBinding& binding,
@@ -517,26 +542,9 @@ struct EvaluateWorker
     vtkAOSDataArrayTemplate<Real>* determinants, vtkAlgorithm* self, double progressBegin, double progressEnd,
     bool& completed)
   {
-    const vtkFFDSparseCells* sparse = this->Sparse;
     std::vector<Real> cellTable;
-    if (binding.CellTable)
-    {
-      const int cells =
-        sparse ? sparse->GetNumberOfCells() : lattice.Divisions[0] * lattice.Divisions[1] * lattice.Divisions[2];
-      cellTable.resize(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(lattice.Basis)));
-      vtkSMPTools::For(0, cells, 256,
-        [&](int begin, int end)
-        {
-          ffd::FillCellTable(lattice.Basis, this->Displacements, lattice.Divisions, lattice.ControlPointsPerAxis,
-            sparse ? sparse->GetVoxels().data() : nullptr, sparse ? sparse->GetSupports() : nullptr, cellTable.data(),
-            begin, end);
-        });
-    }
-    const ffd::GridLattice<Real> passLattice{ lattice.Basis,
-      { lattice.Divisions[0], lattice.Divisions[1], lattice.Divisions[2] },
-      { lattice.ControlPointsPerAxis[0], lattice.ControlPointsPerAxis[1], lattice.ControlPointsPerAxis[2] },
-      this->Displacements, ffd::Frame<Real>::FromArray(lattice.Frame), binding.CellTable ? cellTable.data() : nullptr,
-      sparse ? sparse->GetVoxels().data() : nullptr, sparse ? sparse->GetSupports() : nullptr };
+    const ffd::GridLattice<Real> passLattice =
+      this->Deformer.PassLattice(this->Displacements, binding.CellTable, cellTable);
     const vtkIdType n = inPoints->GetNumberOfTuples();
     // The work of a point: the control points it reads, and 16 for its parameters and output.
     double reads = 1.0;
@@ -718,7 +726,7 @@ bool vtkFFDGridDeformer::Evaluate(vtkPoints* points, vtkDataArray* normals, vtkD
   {
     using RealArray = std::remove_pointer_t<decltype(out)>;
     using Real = typename RealArray::ValueType;
-    EvaluateWorker<Real> worker{ this->GetSparseCells(), EvaluationDisplacements<Real>(this->Lattice) };
+    EvaluateWorker<Real> worker{ *this, EvaluationDisplacements<Real>(this->Lattice) };
     auto* determinants = static_cast<RealArray*>(outDeterminants);
     if (!vtkArrayDispatch::DispatchByValueType<PointArrays>::Execute(points->GetData(), worker, this->Lattice,
           *this->Binding, normals, outNormals, out, determinants, self, progressBegin, progressEnd, completed))
@@ -742,4 +750,17 @@ bool vtkFFDGridDeformer::Evaluate(vtkPoints* points, vtkDataArray* normals, vtkD
 const std::vector<int>& vtkFFDGridDeformer::GetCellOfPoint() const
 {
   return this->Binding->CellOfPoint;
+}
+
+//------------------------------------------------------------------------------------------------------------
+ffd::GridLattice<float> vtkFFDGridDeformer::PassLattice(
+  const float* displacements, bool withCellTable, std::vector<float>& table) const
+{
+  return PassLatticeOf(this->Lattice, this->GetSparseCells(), displacements, withCellTable, table);
+}
+
+ffd::GridLattice<double> vtkFFDGridDeformer::PassLattice(
+  const double* displacements, bool withCellTable, std::vector<double>& table) const
+{
+  return PassLatticeOf(this->Lattice, this->GetSparseCells(), displacements, withCellTable, table);
 }

@@ -27,6 +27,11 @@
 #include <string>
 #include <vector>
 
+namespace ffd
+{
+template <typename Real>
+struct GridLattice;
+}
 class vtkAlgorithm;
 class vtkPoints;
 class vtkPointSet;
@@ -93,6 +98,17 @@ public:
   /// The displacements of the last SetLattice()'s lattice: GetLattice().Displacements where kept, else read into
   /// `storage`.
   const double* ReadDisplacements(std::vector<double>& storage) const;
+
+  ///@{
+  /**
+   * The lattice of the last SetLattice() as the CPU passes read it (FFDGridPasses.h), from `displacements` (3 per
+   * control point, in the passes' precision: ReadDisplacements() or the deformer's own), with its cells in power
+   * form where `withCellTable` (ffd::FillCellTable(), in parallel, into `table`, which must outlive the result).
+   */
+  ffd::GridLattice<float> PassLattice(const float* displacements, bool withCellTable, std::vector<float>& table) const;
+  ffd::GridLattice<double> PassLattice(
+    const double* displacements, bool withCellTable, std::vector<double>& table) const;
+  ///@}
 
   /// The cells of the last SetLattice()'s lattice where it is sparse, else null.
   const vtkFFDSparseCells* GetSparseCells() const { return this->Lattice.Sparse ? &this->SparseCells : nullptr; }

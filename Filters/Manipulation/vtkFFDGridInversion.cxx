@@ -9,7 +9,6 @@
 #include "vtkFFDSparseLattice.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
-#include "vtkSMPTools.h"
 
 #include "FFDCellTable.h"
 #include "FFDCpuTuning.h"
@@ -278,33 +277,6 @@ void InvertInGroups(const GridInversion& inversion, const ffd::GridLattice<doubl
   }
 }
 
-// The float64 lattice that `deformer` read as the passes take it, with its cells in power form where the
-// evaluation would take them so (ffd::WorthCellTable() of `cells` cells for `points` points, ffd::FillCellTable(),
-// into `table`): F with its Jacobian by Horner's rule costs about half the sums of the control points' weights and
-// their derivatives. The table then takes at most 32 bytes a point (trilinear; 6 for the cubic B-spline), where a
-// sparse lattice of millions of cells would otherwise need GBs.
-ffd::GridLattice<double> InversionLattice(
-  const vtkFFDGridDeformer& deformer, int cells, vtkIdType points, std::vector<double>& table)
-{
-  const vtkFFDGridLattice& view = deformer.GetLattice();
-  const vtkFFDSparseCells* sparse = deformer.GetSparseCells();
-  ffd::GridLattice<double> lattice{ view.Basis, { view.Divisions[0], view.Divisions[1], view.Divisions[2] },
-    { view.ControlPointsPerAxis[0], view.ControlPointsPerAxis[1], view.ControlPointsPerAxis[2] },
-    view.Displacements.data(), ffd::Frame<double>::FromArray(view.Frame), nullptr,
-    sparse ? sparse->GetVoxels().data() : nullptr, sparse ? sparse->GetSupports() : nullptr };
-  if (ffd::WorthCellTable(view.Basis, cells, points))
-  {
-    table.resize(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(view.Basis)));
-    vtkSMPTools::For(0, cells, 256,
-      [&](int begin, int end)
-      {
-        ffd::FillCellTable(lattice.Basis, lattice.Displacements, lattice.Voxels, lattice.Dims, lattice.CellVoxels,
-          lattice.CellSupports, table.data(), begin, end);
-      });
-    lattice.CellTable = table.data();
-  }
-  return lattice;
-}
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -332,8 +304,11 @@ bool vtkFFDInvertByGrid(vtkAlgorithm* self, const vtkFFDGridDeformer& deformer, 
     cellCount *= ffd::BindingCells(lattice.Basis, lattice.Divisions[a]);
   }
   cellCount = sparse ? sparse->GetNumberOfCells() : cellCount;
+  // Cells in power form where the evaluation would take them so: F with its Jacobian by Horner's rule costs about
+  // half the sums of the control points' weights and their derivatives, for at most 32 bytes a point (trilinear).
   std::vector<double> table;
-  const ffd::GridLattice<double> passLattice = InversionLattice(deformer, cellCount, n, table);
+  const ffd::GridLattice<double> passLattice =
+    deformer.PassLattice(lattice.Displacements.data(), ffd::WorthCellTable(lattice.Basis, cellCount, n), table);
   bool completed = false;
   ffd::WithGridDeformation(passLattice,
     [&](const auto& deformation)
