@@ -202,7 +202,7 @@ struct ResidentPoints::State
   bool HasNormals = false;
   bool Bound = false;
   bool Evaluated = false, EvaluatedNormals = false, EvaluatedDeterminants = false;
-  Buffer Points, Normals, Cells, Lattice, OutPoints, OutNormals, OutDeterminants;
+  Buffer Points, Normals, Cells, Lattice, OutPoints, OutNormals, OutDeterminants, Reduction;
   Buffer Staging[2] = { Buffer(true), Buffer(true) };
   Buffer LatticeStaging{ true };
   cudaStream_t Stream = nullptr;
@@ -305,6 +305,9 @@ struct ResidentPoints::State
 
   template <typename Real>
   void RunDownload(Real* outPoints, Real* outNormals, Real* outDeterminants);
+
+  template <typename Real>
+  void RunComputeBounds(double bounds[6]);
 
   /// Copies `bytes` from the device to pageable host memory through the two pinned buffers, so that the host
   /// copy of one chunk overlaps the transfer of the next.

@@ -11,6 +11,53 @@ namespace cuda
 using detail::Check;
 using detail::CudaError;
 
+namespace
+{
+// The smallest of `lows` and the largest of `highs` per axis (item i's value on axis c at [3 i + c]; the points
+// themselves, or a previous pass's per-block results), non-finite values skipped, for the items of the grid's
+// stride loop: block b writes its three lows at outLows + 3 b and highs at outHighs + 3 b. Two passes (the
+// points, then the blocks' results in one block) give the bounds.
+template <typename Real>
+__global__ void __launch_bounds__(detail::ThreadsPerBlock) BoundsKernel(
+  const Real* __restrict__ lows, const Real* __restrict__ highs, std::int64_t count, Real* outLows, Real* outHighs)
+{
+  constexpr int T = detail::ThreadsPerBlock;
+  __shared__ Real low[3][T], high[3][T];
+  Real l[3] = { INFINITY, INFINITY, INFINITY }, h[3] = { -INFINITY, -INFINITY, -INFINITY };
+  for (std::int64_t i = blockIdx.x * std::int64_t(T) + threadIdx.x; i < count; i += std::int64_t(gridDim.x) * T)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      const Real a = lows[3 * i + c], b = highs[3 * i + c];
+      l[c] = isfinite(a) ? fmin(l[c], a) : l[c];
+      h[c] = isfinite(b) ? fmax(h[c], b) : h[c];
+    }
+  }
+  for (int c = 0; c < 3; ++c)
+  {
+    low[c][threadIdx.x] = l[c];
+    high[c][threadIdx.x] = h[c];
+  }
+  for (int half = T / 2; half > 0; half /= 2)
+  {
+    __syncthreads();
+    if (threadIdx.x < half)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        low[c][threadIdx.x] = fmin(low[c][threadIdx.x], low[c][threadIdx.x + half]);
+        high[c][threadIdx.x] = fmax(high[c][threadIdx.x], high[c][threadIdx.x + half]);
+      }
+    }
+  }
+  if (threadIdx.x < 3)
+  {
+    outLows[3 * blockIdx.x + threadIdx.x] = low[threadIdx.x][0];
+    outHighs[3 * blockIdx.x + threadIdx.x] = high[threadIdx.x][0];
+  }
+}
+} // namespace
+
 //------------------------------------------------------------------------------------------------------------
 bool DeviceAvailable(std::string* why)
 {
@@ -50,7 +97,7 @@ void ResidentPoints::State::EnsureStream()
 void ResidentPoints::State::Release()
 {
   for (Buffer* b : { &this->Points, &this->Normals, &this->Cells, &this->Lattice, &this->OutPoints, &this->OutNormals,
-         &this->OutDeterminants, &this->Staging[0], &this->Staging[1], &this->LatticeStaging })
+         &this->OutDeterminants, &this->Reduction, &this->Staging[0], &this->Staging[1], &this->LatticeStaging })
   {
     b->Free();
   }
@@ -188,6 +235,35 @@ void ResidentPoints::State::RunDownload(Real* outPoints, Real* outNormals, Real*
   }
 }
 
+template <typename Real>
+void ResidentPoints::State::RunComputeBounds(double bounds[6])
+{
+  if (!this->Evaluated || (this->IsDouble != (sizeof(Real) == sizeof(double))))
+  {
+    throw CudaError{ cudaErrorInvalidValue, "computing the bounds: nothing was evaluated" };
+  }
+  const unsigned blocks = std::max(1u, std::min(detail::BlocksFor(this->Count), 2u * unsigned(this->Multiprocessors)));
+  this->Reduction.Reserve((6 * std::size_t(blocks) + 6) * sizeof(Real), "allocating the bounds' reduction");
+  Real* partial = this->Reduction.As<Real>();
+  Real* result = partial + 6 * std::size_t(blocks);
+  const Real* points = this->OutPoints.As<Real>();
+  BoundsKernel<Real><<<blocks, detail::ThreadsPerBlock, 0, this->Stream>>>(
+    points, points, this->Count, partial, partial + 3 * std::size_t(blocks));
+  BoundsKernel<Real>
+    <<<1, detail::ThreadsPerBlock, 0, this->Stream>>>(partial, partial + 3 * std::size_t(blocks), blocks, result, result + 3);
+  Check(cudaGetLastError(), "launching the bounds' reduction");
+  Real lowsHighs[6];
+  Check(cudaMemcpyAsync(lowsHighs, result, sizeof lowsHighs, cudaMemcpyDeviceToHost, this->Stream),
+    "downloading the bounds");
+  Check(cudaStreamSynchronize(this->Stream), "computing the bounds");
+  for (int c = 0; c < 3; ++c)
+  {
+    bounds[2 * c] = lowsHighs[c];
+    bounds[2 * c + 1] = lowsHighs[3 + c];
+  }
+  this->Counts.BytesDownloaded += sizeof lowsHighs;
+}
+
 //------------------------------------------------------------------------------------------------------------
 ResidentPoints::ResidentPoints(std::unique_ptr<State> state)
   : S(std::move(state))
@@ -227,6 +303,22 @@ bool ResidentPoints::Download(float* outPoints, float* outNormals, float* outDet
 bool ResidentPoints::Download(double* outPoints, double* outNormals, double* outDeterminants)
 {
   return this->S->Guard([&] { this->S->RunDownload(outPoints, outNormals, outDeterminants); });
+}
+
+bool ResidentPoints::ComputeBounds(double bounds[6])
+{
+  return this->S->Guard(
+    [&]
+    {
+      if (this->S->IsDouble)
+      {
+        this->S->RunComputeBounds<double>(bounds);
+      }
+      else
+      {
+        this->S->RunComputeBounds<float>(bounds);
+      }
+    });
 }
 
 void ResidentPoints::Release()

@@ -79,6 +79,10 @@ public:
   bool Download(double* outPoints, double* outNormals, double* outDeterminants);
   ///@}
 
+  /// The bounds (xmin, xmax, ymin, ymax, zmin, zmax) of the last evaluation's points, reduced on the device
+  /// (non-finite coordinates are skipped; no finite one: xmin > xmax): 6 values cross the bus, not the points.
+  bool ComputeBounds(double bounds[6]);
+
   /// Frees every device and pinned buffer.
   void Release();
 
@@ -89,6 +93,8 @@ public:
   struct State;
 
 protected:
+  friend class GLBuffers; // writes the last evaluation into OpenGL buffers (FFDCudaGLBuffers.h)
+
   explicit ResidentPoints(std::unique_ptr<State> state);
   ~ResidentPoints();
 
