@@ -9,6 +9,7 @@
 #ifdef VOXELFFD_HAS_CUDA
 #include "FFDCudaGridDeformer.h"
 #include "FFDCudaTetrahedralDeformer.h"
+#include "vtkFFDDeviceOutput.h"
 #include "vtkFFDGridDeformer.h"
 #include "vtkFFDTetrahedralDeformer.h"
 #endif
@@ -43,12 +44,14 @@ struct NormalsOnDevice
 
 // The steps both lattices share, in the evaluation's precision Real: the input's points uploaded when
 // `uploadPoints` (which drops the device's binding and normals), bind() when `rebind`, the normals uploaded when
-// they changed, evaluate(withNormals, withDeterminants), the download into the output arrays. False on any
-// failure, after which the device holds nothing.
+// they changed, evaluate(withNormals, withDeterminants), the download into the output arrays unless the results
+// are `keptOnDevice` (a handle sharing `owner`, the device's state). False on any failure, after which the device
+// holds nothing.
 template <typename Real, typename Bind, typename Evaluate>
-bool Run(ffd::cuda::ResidentPoints& device, NormalsOnDevice& normalsOnDevice, bool uploadPoints, bool rebind,
-  vtkPoints* points, vtkDataArray* normals, vtkAOSDataArrayTemplate<Real>* outPoints, vtkDataArray* outNormals,
-  vtkAOSDataArrayTemplate<Real>* outDeterminants, Bind&& bind, Evaluate&& evaluate)
+bool Run(ffd::cuda::ResidentPoints& device, const std::shared_ptr<void>& owner, NormalsOnDevice& normalsOnDevice,
+  bool uploadPoints, bool rebind, vtkPoints* points, vtkDataArray* normals, vtkAOSDataArrayTemplate<Real>* outPoints,
+  vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outDeterminants,
+  vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice, Bind&& bind, Evaluate&& evaluate)
 {
   if (uploadPoints)
   {
@@ -73,6 +76,19 @@ bool Run(ffd::cuda::ResidentPoints& device, NormalsOnDevice& normalsOnDevice, bo
     }
     normalsOnDevice = { normals, normals->GetMTime() };
   }
+  if (keptOnDevice)
+  {
+    double bounds[6];
+    if (!evaluate(outNormals != nullptr, false) || !device.ComputeBounds(bounds))
+    {
+      return false;
+    }
+    *keptOnDevice = vtkSmartPointer<vtkFFDDeviceOutput>::New();
+    (*keptOnDevice)
+      ->SetDevice(std::shared_ptr<ffd::cuda::ResidentPoints>(owner, &device), points->GetNumberOfPoints(),
+        outNormals != nullptr, bounds);
+    return true;
+  }
   std::vector<Real> normalsCopy;
   auto* realNormals = outNormals ? vtkAOSDataArrayTemplate<Real>::FastDownCast(outNormals) : nullptr;
   if (outNormals && !realNormals)
@@ -95,7 +111,7 @@ bool Run(ffd::cuda::ResidentPoints& device, NormalsOnDevice& normalsOnDevice, bo
 }
 } // namespace
 
-struct vtkFFDCudaBackend::vtkState
+struct vtkFFDCudaBackend::vtkState : std::enable_shared_from_this<vtkFFDCudaBackend::vtkState>
 {
   ffd::cuda::GridDeformer Grid;
   vtkFFDBindingKey GridKey; // what the grid device's points and binding are for
@@ -113,13 +129,15 @@ struct vtkFFDCudaBackend::vtkState
   template <typename Real>
   bool RunGrid(const vtkFFDBindingKey& key, const vtkFFDGridDeformer* sparse, vtkPoints* points, vtkDataArray* normals,
     const double* displacements, vtkIdType controlPoints, vtkAOSDataArrayTemplate<Real>* outPoints,
-    vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outDeterminants, bool& bound)
+    vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outDeterminants,
+    vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice, bool& bound)
   {
     const int type = outPoints->GetDataType();
     const bool rebind = key != this->GridKey || type != this->GridType;
     this->GridKey = vtkFFDBindingKey(); // valid again once everything succeeded
     if (!Run(
-          this->Grid, this->GridNormals, rebind, rebind, points, normals, outPoints, outNormals, outDeterminants,
+          this->Grid, this->shared_from_this(), this->GridNormals, rebind, rebind, points, normals, outPoints,
+          outNormals, outDeterminants, keptOnDevice,
           [&]
           {
             if (!sparse)
@@ -144,7 +162,8 @@ struct vtkFFDCudaBackend::vtkState
 
   template <typename Real>
   bool RunTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points, vtkDataArray* normals,
-    vtkAOSDataArrayTemplate<Real>* outPoints, vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outDeterminants)
+    vtkAOSDataArrayTemplate<Real>* outPoints, vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outDeterminants,
+    vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice)
   {
     const int type = outPoints->GetDataType();
     const bool uploadPoints = points != this->TetrahedraPoints || points->GetMTime() != this->TetrahedraPointsMTime ||
@@ -161,8 +180,8 @@ struct vtkFFDCudaBackend::vtkState
     };
     auto evaluate = [&](bool withNormals, bool withDeterminants)
     { return this->Tetrahedra.Evaluate(tetrahedra.GetDisplacements().data(), nodes, withNormals, withDeterminants); };
-    if (!Run(this->Tetrahedra, this->TetrahedraNormals, uploadPoints, rebind, points, normals, outPoints, outNormals,
-          outDeterminants, bind, evaluate))
+    if (!Run(this->Tetrahedra, this->shared_from_this(), this->TetrahedraNormals, uploadPoints, rebind, points,
+          normals, outPoints, outNormals, outDeterminants, keptOnDevice, bind, evaluate))
     {
       return false;
     }
@@ -170,7 +189,10 @@ struct vtkFFDCudaBackend::vtkState
     this->TetrahedraPointsMTime = points->GetMTime();
     this->TetrahedraType = type;
     this->TetrahedraBindTime = tetrahedra.GetBindTime();
-    tetrahedra.ApplyClampedPoints(points, normals, outPoints, outNormals, outDeterminants);
+    if (!keptOnDevice)
+    {
+      tetrahedra.ApplyClampedPoints(points, normals, outPoints, outNormals, outDeterminants);
+    }
     return true;
   }
 
@@ -198,7 +220,7 @@ struct vtkFFDCudaBackend::vtkState
 
 //------------------------------------------------------------------------------------------------------------
 vtkFFDCudaBackend::vtkFFDCudaBackend()
-  : State(new vtkState)
+  : State(std::make_shared<vtkState>())
 {
 }
 
@@ -211,8 +233,8 @@ bool vtkFFDCudaBackend::IsAvailable(std::string& why)
 }
 
 bool vtkFFDCudaBackend::DeformGrid(const vtkFFDGridDeformer& grid, const vtkFFDBindingKey& key, vtkPoints* points,
-  vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants, bool& bound,
-  std::string& why)
+  vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
+  vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice, bool& bound, std::string& why)
 {
   bound = false;
   std::vector<double> storage;
@@ -222,7 +244,7 @@ bool vtkFFDCudaBackend::DeformGrid(const vtkFFDGridDeformer& grid, const vtkFFDB
     [&](auto* out, auto* determinants)
     {
       return this->State->RunGrid(key, grid.GetSparseCells() ? &grid : nullptr, points, normals, displacements,
-        controlPoints, out, outNormals, determinants, bound);
+        controlPoints, out, outNormals, determinants, keptOnDevice, bound);
     });
   if (!ok)
   {
@@ -233,16 +255,26 @@ bool vtkFFDCudaBackend::DeformGrid(const vtkFFDGridDeformer& grid, const vtkFFDB
 
 bool vtkFFDCudaBackend::DeformTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points,
   vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
-  std::string& why)
+  vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice, std::string& why)
 {
   const bool ok = vtkState::WithOutputs(outPoints, outDeterminants,
     [&](auto* out, auto* determinants)
-    { return this->State->RunTetrahedra(tetrahedra, points, normals, out, outNormals, determinants); });
+    { return this->State->RunTetrahedra(tetrahedra, points, normals, out, outNormals, determinants, keptOnDevice); });
   if (!ok)
   {
     why = this->State->Tetrahedra.GetLastError();
   }
   return ok;
+}
+
+vtkTypeUInt64 vtkFFDCudaBackend::GetLatticeBytesUploaded() const
+{
+  return this->State->Grid.GetCounters().LatticeBytes + this->State->Tetrahedra.GetCounters().LatticeBytes;
+}
+
+vtkTypeUInt64 vtkFFDCudaBackend::GetBytesDownloaded() const
+{
+  return this->State->Grid.GetCounters().BytesDownloaded + this->State->Tetrahedra.GetCounters().BytesDownloaded;
 }
 #else
 // Built without CUDA: the backend is never available, and says so.
@@ -253,15 +285,25 @@ bool vtkFFDCudaBackend::IsAvailable(std::string& why)
 }
 
 bool vtkFFDCudaBackend::DeformGrid(const vtkFFDGridDeformer&, const vtkFFDBindingKey&, vtkPoints*, vtkDataArray*,
-  vtkDataArray*, vtkDataArray*, vtkDataArray*, bool& bound, std::string& why)
+  vtkDataArray*, vtkDataArray*, vtkDataArray*, vtkSmartPointer<vtkFFDDeviceOutput>*, bool& bound, std::string& why)
 {
   bound = false;
   return vtkFFDCudaBackend::IsAvailable(why);
 }
 
 bool vtkFFDCudaBackend::DeformTetrahedra(const vtkFFDTetrahedralDeformer&, vtkPoints*, vtkDataArray*, vtkDataArray*,
-  vtkDataArray*, vtkDataArray*, std::string& why)
+  vtkDataArray*, vtkDataArray*, vtkSmartPointer<vtkFFDDeviceOutput>*, std::string& why)
 {
   return vtkFFDCudaBackend::IsAvailable(why);
+}
+
+vtkTypeUInt64 vtkFFDCudaBackend::GetLatticeBytesUploaded() const
+{
+  return 0;
+}
+
+vtkTypeUInt64 vtkFFDCudaBackend::GetBytesDownloaded() const
+{
+  return 0;
 }
 #endif

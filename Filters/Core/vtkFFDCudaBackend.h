@@ -10,7 +10,8 @@
  * the host's (vtkFFDTetrahedralDeformer: it needs VTK's cell locator), uploaded once per binding, and so is a
  * sparse grid lattice's (vtkFFDGridDeformer: it needs the lookup of its voxels' cells). An update
  * uploads only the lattice's displacements (of control points or of nodes) and downloads straight into the
- * output arrays.
+ * output arrays, or, for a renderer that draws from the device (GPU–GL interop), keeps the results there and
+ * hands out a vtkFFDDeviceOutput.
  *
  * In a build without CUDA every call answers "not available", so vtkFFDDeform needs no conditional code.
  */
@@ -18,12 +19,14 @@
 #define vtkFFDCudaBackend_h
 
 #include "vtkFFDBindingKey.h"
+#include "vtkSmartPointer.h"
 #include "vtkType.h"
 
 #include <memory>
 #include <string>
 
 class vtkDataArray;
+class vtkFFDDeviceOutput;
 class vtkFFDGridDeformer;
 class vtkFFDTetrahedralDeformer;
 class vtkPoints;
@@ -46,24 +49,34 @@ public:
    * points: finding a voxel's cell needs its lookup), uploaded with its cells when the key changes. The results
    * go to outPoints (a float or double AOS array with the points' count of tuples: the evaluation's precision),
    * outNormals and outDeterminants (of outPoints' type) when not null. `bound` tells whether the device's binding
-   * was (re)made. On any failure: false, the reason in `why`, the outputs to be discarded, and no device state
-   * kept.
+   * was (re)made. With `keptOnDevice` not null nothing is downloaded (outPoints and outNormals only give the
+   * precision and whether normals are evaluated): *keptOnDevice gets the handle of the results on the device.
+   * On any failure: false, the reason in `why`, the outputs to be discarded, and no device state kept.
    */
   bool DeformGrid(const vtkFFDGridDeformer& grid, const vtkFFDBindingKey& key, vtkPoints* points, vtkDataArray* normals,
-    vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants, bool& bound, std::string& why);
+    vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
+    vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice, bool& bound, std::string& why);
 
   /**
    * Deforms on the device the input's points bound by `tetrahedra` (whose Bind() ran for them; its binding is
    * uploaded when the device does not hold it) by the nodes' displacements of its last SetLattice(), then moves
    * the points clamped to the control mesh on the host with its ApplyClampedPoints(), as the CPU does. Outputs
-   * and failures as DeformGrid().
+   * and failures as DeformGrid(); `keptOnDevice` only where no point is clamped (they are moved on the host).
    */
   bool DeformTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points, vtkDataArray* normals,
-    vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants, std::string& why);
+    vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
+    vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice, std::string& why);
+
+  ///@{
+  /// What crossed the bus, in all (both lattice kinds): the lattices' displacements uploaded, and the bytes
+  /// downloaded (deformed points, normals, determinants, bounds).
+  vtkTypeUInt64 GetLatticeBytesUploaded() const;
+  vtkTypeUInt64 GetBytesDownloaded() const;
+  ///@}
 
 private:
   struct vtkState;
-  std::unique_ptr<vtkState> State;
+  std::shared_ptr<vtkState> State; // shared with the vtkFFDDeviceOutput handles of results kept on the device
 };
 
 #endif

@@ -2,6 +2,8 @@
 #include "vtkFFDDeform.h"
 
 #include "vtkFFDCudaBackend.h"
+#include "vtkFFDDeformExecutive.h"
+#include "vtkFFDDeviceOutput.h"
 #include "vtkFFDGridDeformer.h"
 #include "vtkFFDInputChecks.h"
 #include "vtkFFDMemory.h"
@@ -15,6 +17,8 @@
 #include "vtkDemandDrivenPipeline.h"
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
+#include "vtkInformationIntegerKey.h"
+#include "vtkInformationObjectBaseKey.h"
 #include "vtkInformationVector.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -31,6 +35,8 @@
 #include <type_traits>
 
 vtkStandardNewMacro(vtkFFDDeform);
+vtkInformationKeyMacro(vtkFFDDeform, KEEP_OUTPUT_ON_DEVICE, Integer);
+vtkInformationKeyMacro(vtkFFDDeform, DEVICE_OUTPUT, ObjectBase);
 
 namespace
 {
@@ -101,6 +107,31 @@ vtkSmartPointer<vtkDataArray> OutputArray(const KeptArrays& kept, vtkDataArray* 
   }
   return array;
 }
+
+// A copy of an input array in a given type, made again only when the input array changes: what an output kept
+// on the device shows in place of its deformed points or normals. Being the filter's own, unchanged from update
+// to update, it is uploaded to a renderer's vertex buffers once, not at every update, and no other renderer
+// draws it.
+struct InputCopy
+{
+  vtkSmartPointer<vtkDataArray> Copy;
+  const vtkDataArray* Source = nullptr;
+  vtkMTimeType SourceMTime = 0;
+
+  vtkDataArray* Of(vtkDataArray* source, int type)
+  {
+    if (!this->Copy || source != this->Source || source->GetMTime() != this->SourceMTime ||
+      this->Copy->GetDataType() != type)
+    {
+      this->Copy = vtk::TakeSmartPointer(vtkDataArray::CreateDataArray(type));
+      this->Copy->DeepCopy(source);
+      this->Copy->SetName(source->GetName());
+      this->Source = source;
+      this->SourceMTime = source->GetMTime();
+    }
+    return this->Copy;
+  }
+};
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -114,6 +145,14 @@ struct vtkFFDDeform::vtkInternals
   KeptArrays KeptPoints, KeptNormals, KeptDeterminants;
   // The update's outputs (normals and determinants may be null: not asked for).
   vtkSmartPointer<vtkDataArray> Points, Normals, Determinants;
+  // An output kept on the device (KEEP_OUTPUT_ON_DEVICE()): the device's handle, set by the CUDA backend, and the
+  // input's copies that stand in for the deformed points and normals.
+  bool OnDevice = false;
+  vtkSmartPointer<vtkFFDDeviceOutput> DeviceOutput;
+  InputCopy PointsOnDevice, NormalsOnDevice;
+  // The output's vtkPoints of the copy, kept across updates: vtkPoints::SetData() marks its array modified,
+  // which would upload it to the renderer's buffers at every update.
+  vtkSmartPointer<vtkPoints> PointsOfCopy;
 };
 
 //------------------------------------------------------------------------------------------------------------
@@ -141,6 +180,22 @@ int vtkFFDDeform::FillInputPortInformation(int port, vtkInformation* info)
     return 1;
   }
   return this->Superclass::FillInputPortInformation(port, info);
+}
+
+//------------------------------------------------------------------------------------------------------------
+vtkExecutive* vtkFFDDeform::CreateDefaultExecutive()
+{
+  return vtkFFDDeformExecutive::New();
+}
+
+vtkTypeUInt64 vtkFFDDeform::GetLatticeBytesUploaded() const
+{
+  return this->Internals->Cuda.GetLatticeBytesUploaded();
+}
+
+vtkTypeUInt64 vtkFFDDeform::GetBytesDownloaded() const
+{
+  return this->Internals->Cuda.GetBytesDownloaded();
 }
 
 //------------------------------------------------------------------------------------------------------------
@@ -179,6 +234,7 @@ int vtkFFDDeform::RequestData(vtkInformation*, vtkInformationVector** inputVecto
     return 0;
   }
   output->Initialize();
+  output->GetInformation()->Remove(DEVICE_OUTPUT());
   const vtkFFDStatisticsOnReturn statistics(
     output, [this](vtkDataObject* out) { vtkFFDRecordText(out, "LastBackendUsed", this->LastBackendUsed); });
   vtkPoints* points = input->GetPoints();
@@ -209,7 +265,9 @@ int vtkFFDDeform::RequestData(vtkInformation*, vtkInformationVector** inputVecto
   }
 
   vtkDataArray* normals = this->GetNormalsToTransform(input);
-  this->MakeOutputArrays(points, normals);
+  const bool keepOnDevice = outputVector->GetInformationObject(0)->Get(KEEP_OUTPUT_ON_DEVICE()) != 0 &&
+    this->Backend != CPU && !this->ComputeJacobianDeterminant;
+  this->MakeOutputArrays(points, normals, keepOnDevice);
   const bool completed = tetrahedra ? this->DeformByTetrahedra(points, normals) : this->DeformByGrid(points, normals);
   if (completed) // else aborted: the output stays empty
   {
@@ -234,13 +292,21 @@ vtkDataArray* vtkFFDDeform::GetNormalsToTransform(vtkPointSet* input)
 }
 
 //------------------------------------------------------------------------------------------------------------
-void vtkFFDDeform::MakeOutputArrays(vtkPoints* points, vtkDataArray* normals)
+void vtkFFDDeform::MakeOutputArrays(vtkPoints* points, vtkDataArray* normals, bool onDevice)
 {
   vtkInternals& internals = *this->Internals;
   internals.Points = internals.Normals = internals.Determinants = nullptr; // an aborted update's
+  internals.DeviceOutput = nullptr;
+  internals.OnDevice = onDevice;
   const vtkIdType count = points->GetNumberOfPoints();
   const bool useDouble = this->OutputPointsPrecision == vtkAlgorithm::DOUBLE_PRECISION ||
     (this->OutputPointsPrecision == vtkAlgorithm::DEFAULT_PRECISION && points->GetDataType() == VTK_DOUBLE);
+  if (onDevice)
+  {
+    internals.Points = internals.PointsOnDevice.Of(points->GetData(), useDouble ? VTK_DOUBLE : VTK_FLOAT);
+    internals.Normals = normals ? internals.NormalsOnDevice.Of(normals, normals->GetDataType()) : nullptr;
+    return;
+  }
   const auto real = vtk::TakeSmartPointer(vtkDataArray::CreateDataArray(useDouble ? VTK_DOUBLE : VTK_FLOAT));
   internals.Points = OutputArray(internals.KeptPoints, real, 3, count);
   if (normals)
@@ -288,14 +354,15 @@ bool vtkFFDDeform::DeformByGrid(vtkPoints* points, vtkDataArray* normals)
   vtkFFDGridDeformer& grid = internals.Grid;
   const vtkFFDGridLattice& lattice = grid.GetLattice();
   bool rebound = false;
+  vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice = internals.OnDevice ? &internals.DeviceOutput : nullptr;
   const bool onCuda = this->DeformedOnCuda(
     [&](std::string& why)
     {
       const vtkFFDBindingKey key = grid.KeyOf(points, this->OutsidePolicy);
       if (!lattice.Sparse)
       {
-        return internals.Cuda.DeformGrid(
-          grid, key, points, normals, internals.Points, internals.Normals, internals.Determinants, rebound, why);
+        return internals.Cuda.DeformGrid(grid, key, points, normals, internals.Points, internals.Normals,
+          internals.Determinants, keptOnDevice, rebound, why);
       }
       // A sparse lattice's voxels are looked up on the host: the points are bound there, then uploaded.
       bool boundOnHost = false;
@@ -305,8 +372,8 @@ bool vtkFFDDeform::DeformByGrid(vtkPoints* points, vtkDataArray* normals)
         return false;
       }
       this->NumberOfBindings += boundOnHost ? 1 : 0;
-      const bool deformed = internals.Cuda.DeformGrid(
-        grid, key, points, normals, internals.Points, internals.Normals, internals.Determinants, rebound, why);
+      const bool deformed = internals.Cuda.DeformGrid(grid, key, points, normals, internals.Points, internals.Normals,
+        internals.Determinants, keptOnDevice, rebound, why);
       rebound = false; // the upload of the host's binding, counted above
       return deformed;
     });
@@ -314,6 +381,10 @@ bool vtkFFDDeform::DeformByGrid(vtkPoints* points, vtkDataArray* normals)
   if (onCuda)
   {
     return true;
+  }
+  if (internals.OnDevice) // the CPU deforms: into arrays of its own, not the input's copies
+  {
+    this->MakeOutputArrays(points, normals, false);
   }
   if (!grid.Bind(points, this->OutsidePolicy, this, 0.0, 0.5, rebound))
   {
@@ -352,14 +423,22 @@ bool vtkFFDDeform::DeformByTetrahedra(vtkPoints* points, vtkDataArray* normals)
                          "outside policy.");
     }
   }
+  if (internals.OnDevice && tetrahedra.HasClampedPoints()) // they are moved on the host
+  {
+    this->MakeOutputArrays(points, normals, false);
+  }
   if (this->DeformedOnCuda(
         [&](std::string& why)
         {
-          return internals.Cuda.DeformTetrahedra(
-            tetrahedra, points, normals, internals.Points, internals.Normals, internals.Determinants, why);
+          return internals.Cuda.DeformTetrahedra(tetrahedra, points, normals, internals.Points, internals.Normals,
+            internals.Determinants, internals.OnDevice ? &internals.DeviceOutput : nullptr, why);
         }))
   {
     return true;
+  }
+  if (internals.OnDevice)
+  {
+    this->MakeOutputArrays(points, normals, false);
   }
   if (!tetrahedra.Evaluate(
         points, normals, internals.Points, internals.Normals, internals.Determinants, this, 0.5, 1.0))
@@ -374,8 +453,13 @@ bool vtkFFDDeform::DeformByTetrahedra(vtkPoints* points, vtkDataArray* normals)
 void vtkFFDDeform::FillOutput(vtkPointSet* input, vtkPointSet* output)
 {
   vtkInternals& internals = *this->Internals;
-  vtkNew<vtkPoints> outPoints;
-  outPoints->SetData(internals.Points);
+  vtkSmartPointer<vtkPoints> outPoints = internals.OnDevice ? internals.PointsOfCopy : nullptr;
+  if (!outPoints || outPoints->GetData() != internals.Points)
+  {
+    outPoints = vtkSmartPointer<vtkPoints>::New();
+    outPoints->SetData(internals.Points);
+  }
+  internals.PointsOfCopy = internals.OnDevice ? outPoints : nullptr;
   output->CopyStructure(input);
   output->SetPoints(outPoints);
   output->GetPointData()->PassData(input->GetPointData());
@@ -391,6 +475,13 @@ void vtkFFDDeform::FillOutput(vtkPointSet* input, vtkPointSet* output)
   if (internals.Determinants)
   {
     output->GetPointData()->AddArray(internals.Determinants);
+  }
+  if (internals.OnDevice)
+  {
+    output->GetInformation()->Set(DEVICE_OUTPUT(), internals.DeviceOutput);
+    internals.Points = internals.Normals = nullptr;
+    internals.DeviceOutput = nullptr;
+    return;
   }
   internals.KeptPoints.Keep(internals.Points);
   internals.KeptNormals.Keep(internals.Normals);

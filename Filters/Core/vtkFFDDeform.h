@@ -36,6 +36,16 @@
  * launch error), falls back to the CPU with a warning, never to a wrong or partial output.
  * GetLastBackendUsed() tells which ran. On the device the points, normals and binding stay resident across
  * updates; an update uploads only the lattice and downloads the deformed points into the output array.
+ *
+ * GPU–GL interop: a renderer that draws from the device (vtkFFDInteropPolyDataMapper) sets the request key
+ * KEEP_OUTPUT_ON_DEVICE() around its updates; when the CUDA backend deforms, the deformed points (and normals)
+ * then stay on the device, where the renderer writes them into its vertex buffers, and nothing is downloaded.
+ * Such an output carries a handle under DEVICE_OUTPUT() in its information, and its points and normals are
+ * the input's (copies made once per input, so that nothing else draws them): not the deformed ones. Any update
+ * without the key (another consumer's, or Update() called by the caller) executes the filter again and
+ * downloads them (vtkFFDDeformExecutive), so that the pipeline never hands out undeformed points as deformed
+ * ones. The output is downloaded as usual where ComputeJacobianDeterminant is on, where the CPU deforms, and
+ * where tetrahedral points are clamped (they are moved on the host).
  * Progress is reported between chunks of points on the CPU, and the filter stops early when aborted.
  * The output announces the times of both inputs (the union of their ranges; of their time steps where both have
  * steps), so that a lattice that varies in time, such as vtkFFDSimulateLattice's, re-executes the deformation at
@@ -70,6 +80,8 @@
 #include <string>     // For std::string
 
 class vtkDataArray;
+class vtkInformationIntegerKey;
+class vtkInformationObjectBaseKey;
 class vtkPoints;
 
 class VTKFFDFILTERSCORE_EXPORT vtkFFDDeform : public vtkPointSetAlgorithm
@@ -149,16 +161,35 @@ public:
   /// Number of times input points have been bound to a lattice (the binding cache's misses), on either backend.
   vtkGetMacro(NumberOfBindings, vtkIdType);
 
+  ///@{
+  /// What crossed the bus to and from the CUDA device since this filter was made: the lattices' displacements
+  /// uploaded, and the bytes downloaded (deformed points, normals, determinants; an output kept on the device
+  /// downloads its bounds only, 24 or 48 bytes). 0 where CUDA never ran.
+  vtkTypeUInt64 GetLatticeBytesUploaded() const;
+  vtkTypeUInt64 GetBytesDownloaded() const;
+  ///@}
+
+  /// Request key (on this filter's output information, set by a consumer around its update): keep the output
+  /// on the CUDA device when CUDA deforms it (see the class description).
+  static vtkInformationIntegerKey* KEEP_OUTPUT_ON_DEVICE();
+
+  /// Key of the output data object's information: the vtkFFDDeviceOutput handle of the deformed points kept on
+  /// the device; absent when the output's points are the deformed ones.
+  static vtkInformationObjectBaseKey* DEVICE_OUTPUT();
+
 protected:
   vtkFFDDeform();
   ~vtkFFDDeform() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
+  /// vtkFFDDeformExecutive: re-executes for host points when the output was kept on the device.
+  vtkExecutive* CreateDefaultExecutive() override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   /// An allocation that fails becomes an error and an empty output, never an exception out of Update().
   vtkTypeBool ProcessRequest(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  /// Gives the output the input's structure and data, the deformed points and the transformed normals and det J.
+  /// Gives the output the input's structure and data, the deformed points and the transformed normals and det J
+  /// (or, kept on the device, the input's copies and the device's handle).
   void FillOutput(vtkPointSet* input, vtkPointSet* output);
 
   int OutsidePolicy;
@@ -175,7 +206,8 @@ private:
 
   // The steps of RequestData().
   vtkDataArray* GetNormalsToTransform(vtkPointSet* input);
-  void MakeOutputArrays(vtkPoints* points, vtkDataArray* normals);
+  /// The arrays to deform into; `onDevice`: the input's copies, for an output kept on the device.
+  void MakeOutputArrays(vtkPoints* points, vtkDataArray* normals, bool onDevice);
   bool DeformByGrid(vtkPoints* points, vtkDataArray* normals);
   bool DeformByTetrahedra(vtkPoints* points, vtkDataArray* normals);
   /// True when `deform` deformed on the GPU, where the Backend setting and a device allow it; false when the

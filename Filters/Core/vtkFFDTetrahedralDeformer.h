@@ -102,6 +102,9 @@ public:
   void ApplyClampedPoints(vtkPoints* points, vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals,
     vtkDataArray* outDeterminants) const;
 
+  /// Whether the binding clamps any point, which ApplyClampedPoints() then moves on the host.
+  bool HasClampedPoints() const { return !this->Clamped.empty(); }
+
   ///@{
   /// The binding: per point its tetrahedron (-1: keeps its position, or clamped, see above); per tetrahedron its
   /// rest frame (zero for tetrahedra without volume, which nothing is bound to) and its 4 nodes; when it was
