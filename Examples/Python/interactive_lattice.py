@@ -29,7 +29,7 @@ from vtkmodules.vtkCommonCore import vtkCommand
 from vtkmodules.vtkCommonDataModel import vtkStructuredGrid
 from vtkmodules.vtkInteractionStyle import vtkInteractorStyleTrackballCamera
 from vtkmodules.vtkIOImage import vtkPNGWriter
-from vtkmodules.vtkRenderingCore import (vtkActor, vtkInteractorObserver, vtkPolyDataMapper, vtkRenderer,
+from vtkmodules.vtkRenderingCore import (vtkActor, vtkInteractorObserver, vtkRenderer,
                                          vtkRenderWindow, vtkRenderWindowInteractor, vtkWindowToImageFilter)
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
 
@@ -66,7 +66,8 @@ def build_scene(mesh, basis):
     deform = vtkffd.vtkFFDDeform()
     deform.SetInputData(mesh)
     deform.SetLatticeData(lattice)
-    mapper = vtkPolyDataMapper()
+    # Draws from the CUDA device where the window's OpenGL context is on it (GPU-GL interop), else from the host.
+    mapper = vtkffd.vtkFFDInteropPolyDataMapper()
     mapper.SetInputConnection(deform.GetOutputPort())
     actor = vtkActor()
     actor.SetMapper(mapper)
