@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // GPU–GL interop keeps the pipeline honest (vtkFFDDeform drawn by vtkFFDInteropPolyDataMapper). After lattice
 // moves, a downstream filter's update, the caller's Update(), a mesh change, det J asked for, a backend change, a
-// window resize and a switch to a tetrahedral lattice, the vertex buffers that are drawn, read back from OpenGL,
+// window resize, a switch to a tetrahedral lattice and a mesh far from the origin (the buffers shifted and
+// scaled), the vertex buffers that are drawn, read back from OpenGL,
 // hold the points and normals of an independent float64 deformation on the CPU, within 1e-5 of the mesh's size
 // (points) and 1e-5 (unit normals): the float32 evaluation's agreement with float64 that the other tests hold it
 // to, plus the buffers' float rounding (2^-24 relative). A stale buffer is off by a move, 5-10 % of the size.
@@ -18,6 +19,7 @@
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
@@ -51,23 +53,29 @@ void MoveFront(vtkUnstructuredGrid* lattice, const double bounds[6], double amou
   lattice->GetPoints()->Modified();
 }
 
-/// A copy of `mesh` (cells and normals shared) shrunk by 10 % about its centre: a mesh change.
-vtkSmartPointer<vtkPolyData> Shrunk(vtkPolyData* mesh)
+/// A copy of `mesh` (cells and normals shared) with its points x -> c + scale (x - c) + offset, c its centre, in
+/// double precision: a mesh change.
+vtkSmartPointer<vtkPolyData> Moved(vtkPolyData* mesh, double scale, double offset)
 {
   double c[3];
   mesh->GetCenter(c);
   vtkNew<vtkPoints> points;
-  points->DeepCopy(mesh->GetPoints());
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(mesh->GetNumberOfPoints());
   for (vtkIdType p = 0; p < points->GetNumberOfPoints(); ++p)
   {
     double x[3];
-    points->GetPoint(p, x);
-    points->SetPoint(p, c[0] + 0.9 * (x[0] - c[0]), c[1] + 0.9 * (x[1] - c[1]), c[2] + 0.9 * (x[2] - c[2]));
+    mesh->GetPoint(p, x);
+    for (int a = 0; a < 3; ++a)
+    {
+      x[a] = c[a] + scale * (x[a] - c[a]) + offset;
+    }
+    points->SetPoint(p, x);
   }
-  auto shrunk = vtkSmartPointer<vtkPolyData>::New();
-  shrunk->ShallowCopy(mesh);
-  shrunk->SetPoints(points);
-  return shrunk;
+  auto moved = vtkSmartPointer<vtkPolyData>::New();
+  moved->ShallowCopy(mesh);
+  moved->SetPoints(points);
+  return moved;
 }
 } // namespace
 
@@ -152,7 +160,7 @@ int TestFFDInteropPipeline(int, char*[])
   lattice.Move(2, 2, 2, 0.1, 0.1, 0.1);
   frame("move after the caller's Update()", device);
 
-  vtkSmartPointer<vtkPolyData> shrunk = Shrunk(bear);
+  vtkSmartPointer<vtkPolyData> shrunk = Moved(bear, 0.9, 0.0);
   mesh = shrunk;
   scene.Deform->SetInputData(shrunk);
   frame("mesh change", device);
@@ -179,6 +187,29 @@ int TestFFDInteropPipeline(int, char*[])
   frame("tetrahedral lattice", device);
   MoveFront(tetrahedra, bounds, 0.05 * size);
   frame("tetrahedral lattice moved", device);
+
+  // Far from the origin (2000 sizes away, in float64), where vtkOpenGLPolyDataMapper stores the points shifted and
+  // scaled (AUTO_SHIFT_SCALE: more than 1000 diagonals away): the device must write them with the same shift and
+  // scale. The float64 evaluation and the buffers' shift keep the bound of 1e-5 of the size.
+  vtkSmartPointer<vtkPolyData> far = Moved(bear, 1.0, 2000.0 * size);
+  FFDTestLattice farLattice;
+  if (!BuildTestLattice(far, divisions, vtkFFDBuildLattice::TRILINEAR, std::array<int, 3>{ 5, 5, 5 }.data(), farLattice))
+  {
+    return EXIT_FAILURE;
+  }
+  mesh = far;
+  latticeData = farLattice.Grid;
+  scene.Deform->SetInputData(far);
+  scene.Deform->SetLatticeData(farLattice.Grid);
+  renderer->ResetCamera();
+  frame("far from the origin", false); // a new lattice and mesh: the first bounds come from the host
+  farLattice.Move(2, 4, 2, 0.1, 0.1, 0.0);
+  frame("far from the origin, moved", device);
+  if (!scene.Mapper->GetVBOs()->GetVBO("vertexMC")->GetCoordShiftAndScaleEnabled())
+  {
+    std::cerr << "Expected the points' buffer shifted and scaled far from the origin\n";
+    ++failures;
+  }
 
   const std::string status = scene.Mapper->GetInteropStatus();
   std::cout << "interop lines logged: " << interopLines << "; status: " << (status.empty() ? "on" : status) << "\n";
