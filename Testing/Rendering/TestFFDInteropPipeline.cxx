@@ -202,7 +202,7 @@ int TestFFDInteropPipeline(int, char*[])
   scene.Deform->SetInputData(far);
   scene.Deform->SetLatticeData(farLattice.Grid);
   renderer->ResetCamera();
-  frame("far from the origin", false); // a new lattice and mesh: the first bounds come from the host
+  frame("far from the origin", device); // a new mesh and lattice: bound again, on the device
   farLattice.Move(2, 4, 2, 0.1, 0.1, 0.0);
   frame("far from the origin, moved", device);
   if (!scene.Mapper->GetVBOs()->GetVBO("vertexMC")->GetCoordShiftAndScaleEnabled())
