@@ -189,7 +189,7 @@ vtkFFDInteropPolyDataMapper::~vtkFFDInteropPolyDataMapper()
 //------------------------------------------------------------------------------------------------------------
 void vtkFFDInteropPolyDataMapper::RenderPiece(vtkRenderer* ren, vtkActor* act)
 {
-  this->DecideInterop(ren);
+  this->DecideInterop();
   this->LastFrameFromDevice = false;
   this->Internals->Renderer = ren;
   this->Internals->Actor = act;
@@ -224,7 +224,7 @@ void vtkFFDInteropPolyDataMapper::ComputeBounds()
 }
 
 //------------------------------------------------------------------------------------------------------------
-void vtkFFDInteropPolyDataMapper::DecideInterop(vtkRenderer*)
+void vtkFFDInteropPolyDataMapper::DecideInterop()
 {
   if (!this->Interop || this->Internals->State != Decision::Undecided)
   {

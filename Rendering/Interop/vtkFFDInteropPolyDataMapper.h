@@ -77,7 +77,7 @@ private:
   void operator=(const vtkFFDInteropPolyDataMapper&) = delete;
 
   // The steps of RenderPiece() and UpdateBufferObjects().
-  void DecideInterop(vtkRenderer* ren);
+  void DecideInterop(); // once, at the first render, with the context current
   bool WriteDeviceOutput();
   void TurnInteropOff(const std::string& why);
 
