@@ -1,0 +1,296 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkFFDSensitivity.h"
+
+#include "vtkFFDGridDeformer.h"
+#include "vtkFFDInputChecks.h"
+#include "vtkFFDLatticeQueries.h"
+#include "vtkFFDTetrahedralDeformer.h"
+
+#include "vtkDataArray.h"
+#include "vtkDataArrayRange.h"
+#include "vtkDoubleArray.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPointSet.h"
+#include "vtkPoints.h"
+#include "vtkSMPTools.h"
+#include "vtkNew.h"
+#include "vtkSmartPointer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+vtkStandardNewMacro(vtkFFDSensitivity);
+
+namespace
+{
+// The 3-component values of an array as float64, point after point.
+std::vector<double> AsDoubles(vtkDataArray* array)
+{
+  std::vector<double> values(3 * static_cast<std::size_t>(array->GetNumberOfTuples()));
+  const auto range = vtk::DataArrayValueRange<3>(array);
+  std::copy(range.begin(), range.end(), values.begin());
+  return values;
+}
+
+// The bound points grouped by cell, in increasing id within each: the points of cell c are
+// Order[Start[c]] .. Order[Start[c + 1] - 1]. A counting sort: the same grouping for any number of threads.
+struct PointsByCell
+{
+  std::vector<vtkIdType> Start, Order;
+
+  explicit PointsByCell(const std::vector<int>& cellOf)
+  {
+    const int cells = cellOf.empty() ? 0 : 1 + *std::max_element(cellOf.begin(), cellOf.end());
+    this->Start.assign(std::size_t(cells) + 1, 0);
+    for (int c : cellOf)
+    {
+      this->Start[std::size_t(c) + 1] += c >= 0 ? 1 : 0;
+    }
+    for (int c = 0; c < cells; ++c)
+    {
+      this->Start[c + 1] += this->Start[c];
+    }
+    this->Order.resize(this->Start[cells]);
+    std::vector<vtkIdType> next(this->Start.begin(), this->Start.end() - 1);
+    for (std::size_t p = 0; p < cellOf.size(); ++p)
+    {
+      if (cellOf[p] >= 0)
+      {
+        this->Order[next[cellOf[p]]++] = vtkIdType(p);
+      }
+    }
+  }
+  int Cells() const { return int(this->Start.size()) - 1; }
+};
+
+// W^T g for a local basis: the cells coloured by their indices modulo `period` along each axis (cells of one colour
+// share no control point: a support spans `period` cells or fewer), colours one after the other, the cells of one
+// colour in parallel, each adding its points' terms in increasing id. Every control point so receives its terms
+// in one order, whatever the threads.
+template <typename Deformation>
+void ColouredSums(const Deformation& deformation, const PointsByCell& byCell, int period,
+  const std::vector<double>& x, const std::vector<double>& g, std::vector<double>& out)
+{
+  std::vector<std::vector<int>> byColour(std::size_t(period * period * period));
+  for (int cell = 0; cell < byCell.Cells(); ++cell)
+  {
+    if (byCell.Start[cell + 1] > byCell.Start[cell])
+    {
+      int c[3];
+      deformation.CellIndices(cell, c);
+      byColour[c[0] % period + period * (c[1] % period + period * (c[2] % period))].push_back(cell);
+    }
+  }
+  for (const std::vector<int>& cells : byColour)
+  {
+    vtkSMPTools::For(0, vtkIdType(cells.size()),
+      [&](vtkIdType begin, vtkIdType end)
+      {
+        for (vtkIdType k = begin; k < end; ++k)
+        {
+          const int cell = cells[k];
+          for (vtkIdType o = byCell.Start[cell]; o < byCell.Start[cell + 1]; ++o)
+          {
+            const std::size_t p = std::size_t(byCell.Order[o]);
+            const double* gp = &g[3 * p];
+            deformation.ForEachWeight({ x[3 * p], x[3 * p + 1], x[3 * p + 2] }, cell,
+              [&](int controlPoint, double w)
+              {
+                double* target = &out[3 * std::size_t(controlPoint)];
+                target[0] += w * gp[0];
+                target[1] += w * gp[1];
+                target[2] += w * gp[2];
+              });
+          }
+        }
+      });
+  }
+}
+
+// W^T g for the global basis (one cell): fixed chunks of points, their number set by the point count alone, each
+// summed in increasing id into a partial gradient, then the partials added in chunk order.
+template <typename Deformation>
+void ChunkedSums(const Deformation& deformation, const std::vector<int>& cellOf, const std::vector<double>& x,
+  const std::vector<double>& g, std::vector<double>& out)
+{
+  const vtkIdType n = vtkIdType(cellOf.size());
+  const vtkIdType chunks = std::max<vtkIdType>(1, std::min<vtkIdType>(256, (n + 4095) / 4096));
+  const vtkIdType size = (n + chunks - 1) / chunks;
+  const std::size_t values = out.size();
+  std::vector<double> partial(std::size_t(chunks) * values, 0.0);
+  vtkSMPTools::For(0, chunks,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType chunk = begin; chunk < end; ++chunk)
+      {
+        double* sums = &partial[std::size_t(chunk) * values];
+        for (vtkIdType p = chunk * size; p < std::min(n, (chunk + 1) * size); ++p)
+        {
+          if (cellOf[p] < 0)
+          {
+            continue;
+          }
+          const double* gp = &g[3 * std::size_t(p)];
+          deformation.ForEachWeight({ x[3 * p], x[3 * p + 1], x[3 * p + 2] }, cellOf[p],
+            [&](int controlPoint, double w)
+            {
+              double* target = sums + 3 * std::size_t(controlPoint);
+              target[0] += w * gp[0];
+              target[1] += w * gp[1];
+              target[2] += w * gp[2];
+            });
+        }
+      }
+    });
+  vtkSMPTools::For(0, vtkIdType(values),
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType v = begin; v < end; ++v)
+      {
+        double sum = 0.0;
+        for (vtkIdType chunk = 0; chunk < chunks; ++chunk)
+        {
+          sum += partial[std::size_t(chunk) * values + std::size_t(v)];
+        }
+        out[v] = sum;
+      }
+    });
+}
+} // namespace
+
+//------------------------------------------------------------------------------------------------------------
+struct vtkFFDSensitivity::vtkInternals
+{
+  vtkFFDGridDeformer Grid; // keeps the displacements: ForEachWeight reads its lattice view
+};
+
+vtkFFDSensitivity::vtkFFDSensitivity()
+  : OutsidePolicy(0)
+  , SensitivityArrayName(nullptr)
+  , NumberOfBindings(0)
+  , Internals(new vtkInternals)
+{
+  this->SetNumberOfInputPorts(2);
+  this->SetSensitivityArrayName("Sensitivity");
+}
+
+vtkFFDSensitivity::~vtkFFDSensitivity()
+{
+  this->SetSensitivityArrayName(nullptr);
+}
+
+int vtkFFDSensitivity::FillInputPortInformation(int port, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPointSet");
+  return port <= 1 ? 1 : 0;
+}
+
+// The output is a lattice: of input 1's type.
+int vtkFFDSensitivity::RequestDataObject(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (!(vtkFFDCheckInput(this, inputVector[0], 0, "vtkPointSet", "the mesh",
+          "SetInputConnection() to the mesh at rest (vtkFFDDeform's input 0), with the gradient as a point array.") &&
+        vtkFFDCheckInput(this, inputVector[1], 1, "vtkPointSet", "the lattice",
+          "SetLatticeConnection() to the lattice that vtkFFDDeform deforms the mesh with.")))
+  {
+    return vtkFFDEmptyOutputs(outputVector);
+  }
+  vtkDataObject* lattice = vtkDataObject::GetData(inputVector[1]);
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  vtkDataObject* output = outInfo->Get(vtkDataObject::DATA_OBJECT());
+  if (!output || !output->IsA(lattice->GetClassName()))
+  {
+    auto made = vtk::TakeSmartPointer(lattice->NewInstance());
+    outInfo->Set(vtkDataObject::DATA_OBJECT(), made);
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+int vtkFFDSensitivity::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPointSet* mesh = vtkPointSet::GetData(inputVector[0]);
+  vtkPointSet* lattice = vtkPointSet::GetData(inputVector[1]);
+  vtkPointSet* output = vtkPointSet::GetData(outputVector);
+  if (!mesh || !lattice || !output)
+  {
+    vtkErrorMacro("Input 0 (the mesh) and input 1 (the lattice) must be vtkPointSets.");
+    return 0;
+  }
+  output->ShallowCopy(lattice);
+  const vtkIdType count = mesh->GetNumberOfPoints();
+  vtkDataArray* gradient = this->GetInputArrayToProcess(0, inputVector);
+  if (count > 0 && (!gradient || gradient->GetNumberOfComponents() != 3 || gradient->GetNumberOfTuples() != count))
+  {
+    vtkErrorMacro("The mesh needs the objective's gradient as a point array of 3 components, one tuple per point ("
+      << count << "), named by SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, name); "
+      << (gradient ? "the one named has " + std::to_string(gradient->GetNumberOfTuples()) + " tuples of " +
+            std::to_string(gradient->GetNumberOfComponents()) + " components."
+                   : std::string("none is named or found.")));
+    output->Initialize();
+    return 0;
+  }
+  if (vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice))
+  {
+    vtkErrorMacro("Tetrahedral lattices are not handled by vtkFFDSensitivity yet; grid lattices are.");
+    output->Initialize();
+    return 0;
+  }
+  vtkFFDGridDeformer& grid = this->Internals->Grid;
+  const std::string problem = grid.SetLattice(lattice);
+  if (!problem.empty())
+  {
+    vtkErrorMacro(<< problem);
+    output->Initialize();
+    return 0;
+  }
+  std::vector<double> sums(3 * std::size_t(lattice->GetNumberOfPoints()), 0.0);
+  if (count > 0)
+  {
+    bool rebound = false;
+    if (!grid.Bind(mesh->GetPoints(), this->OutsidePolicy, this, 0.0, 0.5, rebound))
+    {
+      output->Initialize();
+      return 1; // aborted
+    }
+    this->NumberOfBindings += rebound ? 1 : 0;
+    const std::vector<double> x = AsDoubles(mesh->GetPoints()->GetData());
+    const std::vector<double> g = AsDoubles(gradient);
+    const ffd::GridBasis basis = grid.GetLattice().Basis;
+    vtkFFDWithGridDeformation(grid,
+      [&](const auto& deformation)
+      {
+        if (basis == ffd::GridBasis::Bernstein)
+        {
+          ChunkedSums(deformation, grid.GetCellOfPoint(), x, g, sums);
+          return;
+        }
+        ColouredSums(deformation, PointsByCell(grid.GetCellOfPoint()),
+          basis == ffd::GridBasis::CubicBSpline ? 4 : 2, x, g, sums);
+      });
+  }
+  vtkNew<vtkDoubleArray> sensitivity;
+  sensitivity->SetName(this->SensitivityArrayName ? this->SensitivityArrayName : "Sensitivity");
+  sensitivity->SetNumberOfComponents(3);
+  sensitivity->SetNumberOfTuples(lattice->GetNumberOfPoints());
+  std::copy(sums.begin(), sums.end(), sensitivity->GetPointer(0));
+  output->GetPointData()->AddArray(sensitivity);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+void vtkFFDSensitivity::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "OutsidePolicy: " << this->OutsidePolicy << "\n";
+  os << indent << "SensitivityArrayName: " << (this->SensitivityArrayName ? this->SensitivityArrayName : "(none)")
+     << "\n";
+  os << indent << "NumberOfBindings: " << this->NumberOfBindings << "\n";
+}
