@@ -125,7 +125,6 @@ public:
   vtkIdType GetFirstDegenerateTetrahedron() const { return this->FirstDegenerate; }
   ///@}
 
-private:
   /// A point outside the control mesh clamped to it: it moves by the displacement of its nearest point there.
   struct ClampedPoint
   {
@@ -134,6 +133,11 @@ private:
     ffd::Vec3<double> Closest;  ///< the nearest point of the control mesh
     ffd::Mat3<double> Gradient; ///< d(Closest)/dX (ffd::ClosestPointGradient)
   };
+
+  /// The points of the binding clamped to the control mesh, in increasing point id (their CellOfPoint is -1).
+  const std::vector<ClampedPoint>& GetClampedPoints() const { return this->Clamped; }
+
+private:
 
   /// The map of a tetrahedron from its nodes' displacements (double precision).
   ffd::TetrahedronMap<double> Map(vtkIdType tetrahedron) const;

@@ -18,6 +18,7 @@
 #include "vtkSMPTools.h"
 #include "vtkNew.h"
 #include "vtkSmartPointer.h"
+#include "vtkUnstructuredGrid.h"
 
 #include <algorithm>
 #include <cmath>
@@ -160,12 +161,88 @@ void ChunkedSums(const Deformation& deformation, const std::vector<int>& cellOf,
       }
     });
 }
+// W^T g for a tetrahedral lattice. A point moves by its tetrahedron's barycentric weights at the point, or, clamped
+// to the control mesh, at its nearest point there (as ApplyClampedPoints()). Each tetrahedron sums its points'
+// terms in increasing id (in parallel over tetrahedra), then each node adds its tetrahedra's sums in increasing
+// tetrahedron order (in parallel over nodes): one order whatever the threads.
+void TetrahedralSums(const vtkFFDTetrahedralDeformer& tetrahedra, const std::vector<double>& x,
+  const std::vector<double>& g, std::vector<double>& out)
+{
+  // Each weighted point, with where its weights are taken (the point, or its nearest point of the mesh).
+  std::vector<int> cellOf = tetrahedra.GetCellOfPoint();
+  std::vector<ffd::Vec3<double>> at(cellOf.size());
+  for (std::size_t p = 0; p < cellOf.size(); ++p)
+  {
+    at[p] = { x[3 * p], x[3 * p + 1], x[3 * p + 2] };
+  }
+  for (const vtkFFDTetrahedralDeformer::ClampedPoint& clamped : tetrahedra.GetClampedPoints())
+  {
+    cellOf[clamped.Point] = clamped.Tetrahedron;
+    at[clamped.Point] = clamped.Closest;
+  }
+  const PointsByCell byTetrahedron(cellOf);
+  const vtkIdType count = tetrahedra.GetNumberOfTetrahedra();
+  std::vector<double> corners(12 * std::size_t(count), 0.0); // per tetrahedron, 3 per node
+  vtkSMPTools::For(0, std::min<vtkIdType>(count, byTetrahedron.Cells()),
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType t = begin; t < end; ++t)
+      {
+        double* sums = &corners[12 * std::size_t(t)];
+        for (vtkIdType o = byTetrahedron.Start[t]; o < byTetrahedron.Start[t + 1]; ++o)
+        {
+          const std::size_t p = std::size_t(byTetrahedron.Order[o]);
+          const ffd::Vec3<double> stu = tetrahedra.GetFrames()[t].ToParametric(at[p]);
+          const double w[4] = { 1.0 - stu.x - stu.y - stu.z, stu.x, stu.y, stu.z };
+          for (int k = 0; k < 4; ++k)
+          {
+            for (int c = 0; c < 3; ++c)
+            {
+              sums[3 * k + c] += w[k] * g[3 * p + c];
+            }
+          }
+        }
+      }
+    });
+  // The node's corners, in increasing tetrahedron order: a counting sort of the tetrahedra's nodes.
+  const std::vector<vtkIdType>& nodes = tetrahedra.GetNodes();
+  const std::size_t nodeCount = out.size() / 3;
+  std::vector<vtkIdType> start(nodeCount + 1, 0), corner(nodes.size());
+  for (vtkIdType node : nodes)
+  {
+    ++start[std::size_t(node) + 1];
+  }
+  for (std::size_t n = 0; n < nodeCount; ++n)
+  {
+    start[n + 1] += start[n];
+  }
+  std::vector<vtkIdType> next(start.begin(), start.end() - 1);
+  for (std::size_t k = 0; k < nodes.size(); ++k)
+  {
+    corner[next[nodes[k]]++] = vtkIdType(k); // the corner 4 t + i, in increasing t
+  }
+  vtkSMPTools::For(0, vtkIdType(nodeCount),
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType n = begin; n < end; ++n)
+      {
+        for (vtkIdType k = start[n]; k < start[n + 1]; ++k)
+        {
+          for (int c = 0; c < 3; ++c)
+          {
+            out[3 * std::size_t(n) + c] += corners[3 * std::size_t(corner[k]) + c];
+          }
+        }
+      }
+    });
+}
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
 struct vtkFFDSensitivity::vtkInternals
 {
   vtkFFDGridDeformer Grid; // keeps the displacements: ForEachWeight reads its lattice view
+  vtkFFDTetrahedralDeformer Tetrahedra;
 };
 
 vtkFFDSensitivity::vtkFFDSensitivity()
@@ -236,44 +313,14 @@ int vtkFFDSensitivity::RequestData(
     output->Initialize();
     return 0;
   }
-  if (vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice))
-  {
-    vtkErrorMacro("Tetrahedral lattices are not handled by vtkFFDSensitivity yet; grid lattices are.");
-    output->Initialize();
-    return 0;
-  }
-  vtkFFDGridDeformer& grid = this->Internals->Grid;
-  const std::string problem = grid.SetLattice(lattice);
-  if (!problem.empty())
-  {
-    vtkErrorMacro(<< problem);
-    output->Initialize();
-    return 0;
-  }
   std::vector<double> sums(3 * std::size_t(lattice->GetNumberOfPoints()), 0.0);
-  if (count > 0)
+  const bool completed = vtkFFDTetrahedralDeformer::IsTetrahedralLattice(lattice)
+    ? this->SumTetrahedral(mesh, vtkUnstructuredGrid::SafeDownCast(lattice), gradient, sums)
+    : this->SumGrid(mesh, lattice, gradient, sums);
+  if (!completed) // an error, or aborted
   {
-    bool rebound = false;
-    if (!grid.Bind(mesh->GetPoints(), this->OutsidePolicy, this, 0.0, 0.5, rebound))
-    {
-      output->Initialize();
-      return 1; // aborted
-    }
-    this->NumberOfBindings += rebound ? 1 : 0;
-    const std::vector<double> x = AsDoubles(mesh->GetPoints()->GetData());
-    const std::vector<double> g = AsDoubles(gradient);
-    const ffd::GridBasis basis = grid.GetLattice().Basis;
-    vtkFFDWithGridDeformation(grid,
-      [&](const auto& deformation)
-      {
-        if (basis == ffd::GridBasis::Bernstein)
-        {
-          ChunkedSums(deformation, grid.GetCellOfPoint(), x, g, sums);
-          return;
-        }
-        ColouredSums(deformation, PointsByCell(grid.GetCellOfPoint()),
-          basis == ffd::GridBasis::CubicBSpline ? 4 : 2, x, g, sums);
-      });
+    output->Initialize();
+    return 1;
   }
   vtkNew<vtkDoubleArray> sensitivity;
   sensitivity->SetName(this->SensitivityArrayName ? this->SensitivityArrayName : "Sensitivity");
@@ -283,6 +330,67 @@ int vtkFFDSensitivity::RequestData(
   output->GetPointData()->AddArray(sensitivity);
   this->UpdateProgress(1.0);
   return 1;
+}
+
+//------------------------------------------------------------------------------------------------------------
+bool vtkFFDSensitivity::SumGrid(vtkPointSet* mesh, vtkPointSet* lattice, vtkDataArray* gradient, std::vector<double>& sums)
+{
+  vtkFFDGridDeformer& grid = this->Internals->Grid;
+  const std::string problem = grid.SetLattice(lattice);
+  if (!problem.empty() || this->OutsidePolicy == EXTRAPOLATE)
+  {
+    vtkErrorMacro(<< (problem.empty() ? "The outside policy EXTRAPOLATE needs a tetrahedral lattice." : problem));
+    return false;
+  }
+  if (mesh->GetNumberOfPoints() == 0)
+  {
+    return true;
+  }
+  bool rebound = false;
+  if (!grid.Bind(mesh->GetPoints(), this->OutsidePolicy, this, 0.0, 0.5, rebound))
+  {
+    return false;
+  }
+  this->NumberOfBindings += rebound ? 1 : 0;
+  const std::vector<double> x = AsDoubles(mesh->GetPoints()->GetData());
+  const std::vector<double> g = AsDoubles(gradient);
+  const ffd::GridBasis basis = grid.GetLattice().Basis;
+  vtkFFDWithGridDeformation(grid,
+    [&](const auto& deformation)
+    {
+      if (basis == ffd::GridBasis::Bernstein)
+      {
+        ChunkedSums(deformation, grid.GetCellOfPoint(), x, g, sums);
+        return;
+      }
+      ColouredSums(
+        deformation, PointsByCell(grid.GetCellOfPoint()), basis == ffd::GridBasis::CubicBSpline ? 4 : 2, x, g, sums);
+    });
+  return true;
+}
+
+bool vtkFFDSensitivity::SumTetrahedral(
+  vtkPointSet* mesh, vtkUnstructuredGrid* lattice, vtkDataArray* gradient, std::vector<double>& sums)
+{
+  vtkFFDTetrahedralDeformer& tetrahedra = this->Internals->Tetrahedra;
+  const std::string problem = tetrahedra.SetLattice(lattice);
+  if (!problem.empty())
+  {
+    vtkErrorMacro(<< problem);
+    return false;
+  }
+  if (mesh->GetNumberOfPoints() == 0)
+  {
+    return true;
+  }
+  bool rebound = false;
+  if (!tetrahedra.Bind(mesh->GetPoints(), this->OutsidePolicy, this, 0.0, 0.5, rebound))
+  {
+    return false;
+  }
+  this->NumberOfBindings += rebound ? 1 : 0;
+  TetrahedralSums(tetrahedra, AsDoubles(mesh->GetPoints()->GetData()), AsDoubles(gradient), sums);
+  return true;
 }
 
 //------------------------------------------------------------------------------------------------------------

@@ -9,10 +9,12 @@
  * dJ/dP = W^T g, exactly, for every lattice (the chain rule, no finite difference). Input 0 is the mesh at rest
  * (vtkFFDDeform's input 0) with g as a 3-component point array, chosen with SetInputArrayToProcess(0, 0, 0,
  * vtkDataObject::FIELD_ASSOCIATION_POINTS, name); input 1 the lattice (any lattice vtkFFDDeform takes: every grid
- * basis, dense and sparse). The output is the lattice with a point array `Sensitivity` (SensitivityArrayName):
+ * basis, dense and sparse, and tetrahedral lattices, whose points move by their tetrahedron's barycentric
+ * weights). The output is the lattice with a point array `Sensitivity` (SensitivityArrayName):
  * dJ/dP, 3 float64 components per control point, 0 for control points that move no point. Points follow the
  * outside policy as vtkFFDDeform's (OutsidePolicy, the same values): a point kept outside has no weights, a
- * clamped one the weights of its clamped parameters.
+ * clamped one those of its clamped parameters (grids) or of its nearest point of the control mesh (tetrahedra),
+ * an extrapolated one its nearest tetrahedron's.
  *
  * Forward mode (the Jacobian-vector product) needs no filter: the points' motion under a control-point direction
  * dP is W dP, which is vtkFFDDeform's displacement of the mesh by a lattice whose points are RestPosition + dP.
@@ -22,10 +24,10 @@
  * no control point (2^3 colours for the Bezier bases, 4^3 for the cubic B-spline); colours are summed one after
  * the other, the cells of a colour in parallel, so each control point receives its terms in one fixed order. The
  * global Bernstein basis, one cell, sums fixed chunks of points (their number set by the point count, not by the
- * threads) into partial gradients, then adds the partials in chunk order. All sums are in float64.
+ * threads) into partial gradients, then adds the partials in chunk order. A tetrahedral lattice sums each
+ * tetrahedron's points, then each node's tetrahedra in increasing order. All sums are in float64.
  *
- * Tetrahedral lattices are not handled yet (an error says so); neither is the CUDA backend: the sums run on the
- * CPU with vtkSMPTools.
+ * The sums run on the CPU with vtkSMPTools; the CUDA backend does not compute them yet.
  *
  * @sa vtkFFDDeform
  */
@@ -36,6 +38,10 @@
 #include "vtkPointSetAlgorithm.h"
 
 #include <memory> // For std::unique_ptr
+#include <vector> // For std::vector
+
+class vtkDataArray;
+class vtkUnstructuredGrid;
 
 class VTKFFDFILTERSSENSITIVITY_EXPORT vtkFFDSensitivity : public vtkPointSetAlgorithm
 {
@@ -50,10 +56,18 @@ public:
   void SetLatticeData(vtkDataObject* lattice) { this->SetInputData(1, lattice); }
   ///@}
 
+  /// vtkFFDDeform's outside policies.
+  enum OutsidePolicies
+  {
+    KEEP_POSITION = 0,
+    CLAMP_TO_EDGE = 1,
+    EXTRAPOLATE = 2
+  };
+
   ///@{
-  /// What points outside the lattice do, as vtkFFDDeform's OutsidePolicy (default KEEP_POSITION, 0;
-  /// CLAMP_TO_EDGE, 1).
-  vtkSetClampMacro(OutsidePolicy, int, 0, 1);
+  /// What points outside the lattice do, as vtkFFDDeform's OutsidePolicy (default KEEP_POSITION; EXTRAPOLATE
+  /// for tetrahedral lattices only).
+  vtkSetClampMacro(OutsidePolicy, int, KEEP_POSITION, EXTRAPOLATE);
   vtkGetMacro(OutsidePolicy, int);
   ///@}
 
@@ -82,6 +96,10 @@ protected:
 private:
   vtkFFDSensitivity(const vtkFFDSensitivity&) = delete;
   void operator=(const vtkFFDSensitivity&) = delete;
+
+  // The steps of RequestData(): W^T g into `sums` (3 per control point); false on an error (reported) or abort.
+  bool SumGrid(vtkPointSet* mesh, vtkPointSet* lattice, vtkDataArray* gradient, std::vector<double>& sums);
+  bool SumTetrahedral(vtkPointSet* mesh, vtkUnstructuredGrid* lattice, vtkDataArray* gradient, std::vector<double>& sums);
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

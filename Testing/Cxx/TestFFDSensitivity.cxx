@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // vtkFFDSensitivity: dJ/dP = W^T g against central differences of vtkFFDDeform in float64, for every grid basis,
-// dense and sparse, points kept outside and clamped; the same bits for 1, 2 and 3 threads; bad input.
+// dense and sparse, and tetrahedral lattices, points kept outside, clamped and extrapolated; the same bits for any
+// number of threads; bad input.
 //
 // The reference: J(P) = sum_i g_i . X_i(P), X from vtkFFDDeform on the CPU in float64. X is affine in the control
 // points, so the central difference (J(P + h e) - J(P - h e)) / 2h equals dJ/dP . e exactly, for any step; with
@@ -177,6 +178,40 @@ TEST(vtkFFDSensitivity, MatchesCentralDifferencesForEveryGridBasis)
   }
 }
 
+/// The bear's tetrahedral control mesh (its hull and centroid, subdivided once), its nodes moved at random by up to
+/// 5 % of the bear's size.
+vtkSmartPointer<vtkUnstructuredGrid> MovedTetrahedra(vtkPolyData* bear, std::mt19937& rng)
+{
+  vtkNew<vtkFFDBuildTetrahedralLattice> build;
+  build->SetInputData(bear);
+  build->SetSubdivisionLevels(1);
+  build->Update();
+  auto lattice = vtkSmartPointer<vtkUnstructuredGrid>::New();
+  lattice->DeepCopy(build->GetOutput());
+  const double size = bear->GetLength();
+  std::uniform_real_distribution<double> move(-0.05 * size, 0.05 * size);
+  for (vtkIdType p = 0; p < lattice->GetNumberOfPoints(); ++p)
+  {
+    double x[3];
+    lattice->GetPoint(p, x);
+    lattice->GetPoints()->SetPoint(p, x[0] + move(rng), x[1] + move(rng), x[2] + move(rng));
+  }
+  return lattice;
+}
+
+TEST(vtkFFDSensitivity, MatchesCentralDifferencesForTetrahedralLattices)
+{
+  vtkSmartPointer<vtkPolyData> bear = ReadTestMesh("bear");
+  std::mt19937 rng(1129);
+  vtkSmartPointer<vtkPolyData> cloud = CloudWithGradient(bear, 400, rng);
+  vtkSmartPointer<vtkUnstructuredGrid> lattice = MovedTetrahedra(bear, rng);
+  for (int policy : { vtkFFDDeform::KEEP_POSITION, vtkFFDDeform::CLAMP_TO_EDGE, vtkFFDDeform::EXTRAPOLATE })
+  {
+    const std::string what = "tetrahedra, policy " + std::to_string(policy);
+    ExpectMatchesCentralDifferences(cloud, lattice, policy, 30, rng, what.c_str());
+  }
+}
+
 // The same bits for 3, 2 and 1 threads, and again on 1: no atomics, one order of the terms of each control
 // point. (Descending: TBB ignores a request for more workers than an earlier limit allowed.)
 TEST(vtkFFDSensitivity, SameBitsForAnyNumberOfThreads)
@@ -206,6 +241,21 @@ TEST(vtkFFDSensitivity, SameBitsForAnyNumberOfThreads)
         << vtkFFDBuildLattice::GetBasisAsString(basis);
     }
   }
+  vtkSmartPointer<vtkUnstructuredGrid> tetrahedra = MovedTetrahedra(bear, rng);
+  std::vector<std::vector<double>> runs;
+  for (int threads : { 3, 2, 1, 1 })
+  {
+    vtkSMPTools::Initialize(threads);
+    vtkSmartPointer<vtkDataArray> s = Sensitivity(cloud, tetrahedra, vtkFFDDeform::CLAMP_TO_EDGE);
+    ASSERT_TRUE(s);
+    auto* values = vtkDoubleArray::SafeDownCast(s);
+    runs.emplace_back(values->GetPointer(0), values->GetPointer(0) + 3 * values->GetNumberOfTuples());
+  }
+  vtkSMPTools::Initialize();
+  for (const std::vector<double>& run : runs)
+  {
+    EXPECT_EQ(std::memcmp(run.data(), runs[0].data(), run.size() * sizeof(double)), 0) << "tetrahedra";
+  }
 }
 
 TEST(vtkFFDSensitivity, BadInputIsAnErrorAndAnEmptyOutput)
@@ -222,23 +272,21 @@ TEST(vtkFFDSensitivity, BadInputIsAnErrorAndAnEmptyOutput)
   twoComponents->SetNumberOfTuples(cloud->GetNumberOfPoints());
   twoComponents->Fill(0.0);
   cloud->GetPointData()->AddArray(twoComponents);
-  vtkNew<vtkFFDBuildTetrahedralLattice> tetrahedra;
-  tetrahedra->SetInputData(bear);
-  tetrahedra->Update();
   struct Case
   {
     const char* Array;
-    vtkDataObject* Lattice;
+    int Policy;
     const char* Expected;
   };
-  for (const Case& c : { Case{ nullptr, lattice, "gradient" }, Case{ "flat", lattice, "3 components" },
-         Case{ "missing", lattice, "gradient" }, Case{ "g", tetrahedra->GetOutput(), "Tetrahedral" } })
+  for (const Case& c : { Case{ nullptr, 0, "gradient" }, Case{ "flat", 0, "3 components" },
+         Case{ "missing", 0, "gradient" }, Case{ "g", vtkFFDSensitivity::EXTRAPOLATE, "EXTRAPOLATE" } })
   {
     vtkNew<vtkFFDSensitivity> sensitivity;
     vtkNew<FFDTestErrorObserver> errors;
     errors->WatchWithExecutive(sensitivity);
     sensitivity->SetInputData(cloud);
-    sensitivity->SetLatticeData(c.Lattice);
+    sensitivity->SetLatticeData(lattice);
+    sensitivity->SetOutsidePolicy(c.Policy);
     if (c.Array)
     {
       sensitivity->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, c.Array);
