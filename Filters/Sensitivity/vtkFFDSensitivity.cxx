@@ -4,6 +4,7 @@
 #include "vtkFFDGridDeformer.h"
 #include "vtkFFDInputChecks.h"
 #include "vtkFFDLatticeQueries.h"
+#include "vtkFFDMemory.h"
 #include "vtkFFDTetrahedralDeformer.h"
 
 #include "vtkDataArray.h"
@@ -35,6 +36,15 @@ std::vector<double> AsDoubles(vtkDataArray* array)
   const auto range = vtk::DataArrayValueRange<3>(array);
   std::copy(range.begin(), range.end(), values.begin());
   return values;
+}
+
+// sums[3 c ..] += w g: a point's term for control point c.
+inline void AddTerm(double* sums, int controlPoint, double w, const double* g)
+{
+  double* target = sums + 3 * std::size_t(controlPoint);
+  target[0] += w * g[0];
+  target[1] += w * g[1];
+  target[2] += w * g[2];
 }
 
 // The bound points grouped by cell, in increasing id within each: the points of cell c are
@@ -99,13 +109,7 @@ void ColouredSums(const Deformation& deformation, const PointsByCell& byCell, in
             const std::size_t p = std::size_t(byCell.Order[o]);
             const double* gp = &g[3 * p];
             deformation.ForEachWeight({ x[3 * p], x[3 * p + 1], x[3 * p + 2] }, cell,
-              [&](int controlPoint, double w)
-              {
-                double* target = &out[3 * std::size_t(controlPoint)];
-                target[0] += w * gp[0];
-                target[1] += w * gp[1];
-                target[2] += w * gp[2];
-              });
+              [&](int controlPoint, double w) { AddTerm(out.data(), controlPoint, w, gp); });
           }
         }
       });
@@ -137,13 +141,7 @@ void ChunkedSums(const Deformation& deformation, const std::vector<int>& cellOf,
           }
           const double* gp = &g[3 * std::size_t(p)];
           deformation.ForEachWeight({ x[3 * p], x[3 * p + 1], x[3 * p + 2] }, cellOf[p],
-            [&](int controlPoint, double w)
-            {
-              double* target = sums + 3 * std::size_t(controlPoint);
-              target[0] += w * gp[0];
-              target[1] += w * gp[1];
-              target[2] += w * gp[2];
-            });
+            [&](int controlPoint, double w) { AddTerm(sums, controlPoint, w, gp); });
         }
       }
     });
@@ -196,10 +194,7 @@ void TetrahedralSums(const vtkFFDTetrahedralDeformer& tetrahedra, const std::vec
           const double w[4] = { 1.0 - stu.x - stu.y - stu.z, stu.x, stu.y, stu.z };
           for (int k = 0; k < 4; ++k)
           {
-            for (int c = 0; c < 3; ++c)
-            {
-              sums[3 * k + c] += w[k] * g[3 * p + c];
-            }
+            AddTerm(sums, k, w[k], &g[3 * p]);
           }
         }
       }
@@ -246,7 +241,7 @@ struct vtkFFDSensitivity::vtkInternals
 };
 
 vtkFFDSensitivity::vtkFFDSensitivity()
-  : OutsidePolicy(0)
+  : OutsidePolicy(vtkFFDDeform::KEEP_POSITION)
   , SensitivityArrayName(nullptr)
   , NumberOfBindings(0)
   , Internals(new vtkInternals)
@@ -264,6 +259,13 @@ int vtkFFDSensitivity::FillInputPortInformation(int port, vtkInformation* info)
 {
   info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPointSet");
   return port <= 1 ? 1 : 0;
+}
+
+vtkTypeBool vtkFFDSensitivity::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  return vtkFFDCatchAllocationFailure(
+    this, outputVector, [&] { return this->Superclass::ProcessRequest(request, inputVector, outputVector); });
 }
 
 // The output is a lattice: of input 1's type.
@@ -337,7 +339,7 @@ bool vtkFFDSensitivity::SumGrid(vtkPointSet* mesh, vtkPointSet* lattice, vtkData
 {
   vtkFFDGridDeformer& grid = this->Internals->Grid;
   const std::string problem = grid.SetLattice(lattice);
-  if (!problem.empty() || this->OutsidePolicy == EXTRAPOLATE)
+  if (!problem.empty() || this->OutsidePolicy == vtkFFDDeform::EXTRAPOLATE)
   {
     vtkErrorMacro(<< (problem.empty() ? "The outside policy EXTRAPOLATE needs a tetrahedral lattice." : problem));
     return false;

@@ -34,6 +34,7 @@
 #ifndef vtkFFDSensitivity_h
 #define vtkFFDSensitivity_h
 
+#include "vtkFFDDeform.h"                    // For the outside policies
 #include "vtkFFDFiltersSensitivityModule.h" // For export macro
 #include "vtkPointSetAlgorithm.h"
 
@@ -56,18 +57,10 @@ public:
   void SetLatticeData(vtkDataObject* lattice) { this->SetInputData(1, lattice); }
   ///@}
 
-  /// vtkFFDDeform's outside policies.
-  enum OutsidePolicies
-  {
-    KEEP_POSITION = 0,
-    CLAMP_TO_EDGE = 1,
-    EXTRAPOLATE = 2
-  };
-
   ///@{
-  /// What points outside the lattice do, as vtkFFDDeform's OutsidePolicy (default KEEP_POSITION; EXTRAPOLATE
-  /// for tetrahedral lattices only).
-  vtkSetClampMacro(OutsidePolicy, int, KEEP_POSITION, EXTRAPOLATE);
+  /// What points outside the lattice do: vtkFFDDeform's OutsidePolicy, with its values (default
+  /// vtkFFDDeform::KEEP_POSITION; EXTRAPOLATE for tetrahedral lattices only).
+  vtkSetClampMacro(OutsidePolicy, int, vtkFFDDeform::KEEP_POSITION, vtkFFDDeform::EXTRAPOLATE);
   vtkGetMacro(OutsidePolicy, int);
   ///@}
 
@@ -86,6 +79,8 @@ protected:
   ~vtkFFDSensitivity() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
+  /// An allocation that fails becomes an error and an empty output, never an exception out of Update().
+  vtkTypeBool ProcessRequest(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestDataObject(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 

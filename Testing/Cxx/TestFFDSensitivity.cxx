@@ -279,7 +279,7 @@ TEST(vtkFFDSensitivity, BadInputIsAnErrorAndAnEmptyOutput)
     const char* Expected;
   };
   for (const Case& c : { Case{ nullptr, 0, "gradient" }, Case{ "flat", 0, "3 components" },
-         Case{ "missing", 0, "gradient" }, Case{ "g", vtkFFDSensitivity::EXTRAPOLATE, "EXTRAPOLATE" } })
+         Case{ "missing", 0, "gradient" }, Case{ "g", vtkFFDDeform::EXTRAPOLATE, "EXTRAPOLATE" } })
   {
     vtkNew<vtkFFDSensitivity> sensitivity;
     vtkNew<FFDTestErrorObserver> errors;
