@@ -47,35 +47,41 @@ inline void AddTerm(double* sums, int controlPoint, double w, const double* g)
   target[2] += w * g[2];
 }
 
-// The bound points grouped by cell, in increasing id within each: the points of cell c are
-// Order[Start[c]] .. Order[Start[c + 1] - 1]. A counting sort: the same grouping for any number of threads.
-struct PointsByCell
+// Ids grouped by key, in increasing id within each group: the ids of key k are Order[Start[k]] ..
+// Order[Start[k + 1] - 1]; negative keys are left out. A counting sort: the same grouping for any number of
+// threads. `keys` is at least 1 + the largest key. (Points by cell, a lattice's corners by node.)
+struct GroupedIds
 {
   std::vector<vtkIdType> Start, Order;
 
-  explicit PointsByCell(const std::vector<int>& cellOf)
+  template <typename Key>
+  GroupedIds(const std::vector<Key>& keyOf, std::size_t keys)
+    : Start(keys + 1, 0)
   {
-    const int cells = cellOf.empty() ? 0 : 1 + *std::max_element(cellOf.begin(), cellOf.end());
-    this->Start.assign(std::size_t(cells) + 1, 0);
-    for (int c : cellOf)
+    for (Key k : keyOf)
     {
-      this->Start[std::size_t(c) + 1] += c >= 0 ? 1 : 0;
+      this->Start[std::size_t(k) + 1] += k >= 0 ? 1 : 0;
     }
-    for (int c = 0; c < cells; ++c)
+    for (std::size_t k = 0; k < keys; ++k)
     {
-      this->Start[c + 1] += this->Start[c];
+      this->Start[k + 1] += this->Start[k];
     }
-    this->Order.resize(this->Start[cells]);
+    this->Order.resize(this->Start[keys]);
     std::vector<vtkIdType> next(this->Start.begin(), this->Start.end() - 1);
-    for (std::size_t p = 0; p < cellOf.size(); ++p)
+    for (std::size_t id = 0; id < keyOf.size(); ++id)
     {
-      if (cellOf[p] >= 0)
+      if (keyOf[id] >= 0)
       {
-        this->Order[next[cellOf[p]]++] = vtkIdType(p);
+        this->Order[next[keyOf[id]]++] = vtkIdType(id);
       }
     }
   }
-  int Cells() const { return int(this->Start.size()) - 1; }
+  /// The ids bound to a cell (keys 0 .. largest).
+  explicit GroupedIds(const std::vector<int>& cellOf)
+    : GroupedIds(cellOf, cellOf.empty() ? 0 : 1 + std::size_t(std::max(0, *std::max_element(cellOf.begin(), cellOf.end()))))
+  {
+  }
+  int Groups() const { return int(this->Start.size()) - 1; }
 };
 
 // W^T g for a local basis: the cells coloured by their indices modulo `period` along each axis (cells of one colour
@@ -83,11 +89,11 @@ struct PointsByCell
 // colour in parallel, each adding its points' terms in increasing id. Every control point so receives its terms
 // in one order, whatever the threads.
 template <typename Deformation>
-void ColouredSums(const Deformation& deformation, const PointsByCell& byCell, int period,
+void ColouredSums(const Deformation& deformation, const GroupedIds& byCell, int period,
   const std::vector<double>& x, const std::vector<double>& g, std::vector<double>& out)
 {
   std::vector<std::vector<int>> byColour(std::size_t(period * period * period));
-  for (int cell = 0; cell < byCell.Cells(); ++cell)
+  for (int cell = 0; cell < byCell.Groups(); ++cell)
   {
     if (byCell.Start[cell + 1] > byCell.Start[cell])
     {
@@ -178,10 +184,10 @@ void TetrahedralSums(const vtkFFDTetrahedralDeformer& tetrahedra, const std::vec
     cellOf[clamped.Point] = clamped.Tetrahedron;
     at[clamped.Point] = clamped.Closest;
   }
-  const PointsByCell byTetrahedron(cellOf);
+  const GroupedIds byTetrahedron(cellOf);
   const vtkIdType count = tetrahedra.GetNumberOfTetrahedra();
   std::vector<double> corners(12 * std::size_t(count), 0.0); // per tetrahedron, 3 per node
-  vtkSMPTools::For(0, std::min<vtkIdType>(count, byTetrahedron.Cells()),
+  vtkSMPTools::For(0, std::min<vtkIdType>(count, byTetrahedron.Groups()),
     [&](vtkIdType begin, vtkIdType end)
     {
       for (vtkIdType t = begin; t < end; ++t)
@@ -199,33 +205,19 @@ void TetrahedralSums(const vtkFFDTetrahedralDeformer& tetrahedra, const std::vec
         }
       }
     });
-  // The node's corners, in increasing tetrahedron order: a counting sort of the tetrahedra's nodes.
-  const std::vector<vtkIdType>& nodes = tetrahedra.GetNodes();
+  // The node's corners (4 t + i), in increasing tetrahedron order.
   const std::size_t nodeCount = out.size() / 3;
-  std::vector<vtkIdType> start(nodeCount + 1, 0), corner(nodes.size());
-  for (vtkIdType node : nodes)
-  {
-    ++start[std::size_t(node) + 1];
-  }
-  for (std::size_t n = 0; n < nodeCount; ++n)
-  {
-    start[n + 1] += start[n];
-  }
-  std::vector<vtkIdType> next(start.begin(), start.end() - 1);
-  for (std::size_t k = 0; k < nodes.size(); ++k)
-  {
-    corner[next[nodes[k]]++] = vtkIdType(k); // the corner 4 t + i, in increasing t
-  }
+  const GroupedIds byNode(tetrahedra.GetNodes(), nodeCount);
   vtkSMPTools::For(0, vtkIdType(nodeCount),
     [&](vtkIdType begin, vtkIdType end)
     {
       for (vtkIdType n = begin; n < end; ++n)
       {
-        for (vtkIdType k = start[n]; k < start[n + 1]; ++k)
+        for (vtkIdType k = byNode.Start[n]; k < byNode.Start[n + 1]; ++k)
         {
           for (int c = 0; c < 3; ++c)
           {
-            out[3 * std::size_t(n) + c] += corners[3 * std::size_t(corner[k]) + c];
+            out[3 * std::size_t(n) + c] += corners[3 * std::size_t(byNode.Order[k]) + c];
           }
         }
       }
@@ -366,7 +358,7 @@ bool vtkFFDSensitivity::SumGrid(vtkPointSet* mesh, vtkPointSet* lattice, vtkData
         return;
       }
       ColouredSums(
-        deformation, PointsByCell(grid.GetCellOfPoint()), basis == ffd::GridBasis::CubicBSpline ? 4 : 2, x, g, sums);
+        deformation, GroupedIds(grid.GetCellOfPoint()), basis == ffd::GridBasis::CubicBSpline ? 4 : 2, x, g, sums);
     });
   return true;
 }
