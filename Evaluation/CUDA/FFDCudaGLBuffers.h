@@ -56,7 +56,8 @@ public:
    * `reregister` (its storage was re-specified since, as glBufferData does). The write is ordered before the
    * OpenGL commands issued after it returns.
    */
-  bool Write(const ResidentPoints& source, const GLVertexBuffer& points, const GLVertexBuffer* normals, bool reregister);
+  bool Write(
+    const ResidentPoints& source, const GLVertexBuffer& points, const GLVertexBuffer* normals, bool reregister);
 
   /// Unregisters every buffer; call while their context is current, before they are deleted.
   void Release();

@@ -249,8 +249,8 @@ void ResidentPoints::State::RunComputeBounds(double bounds[6])
   const Real* points = this->OutPoints.As<Real>();
   BoundsKernel<Real><<<blocks, detail::ThreadsPerBlock, 0, this->Stream>>>(
     points, points, this->Count, partial, partial + 3 * std::size_t(blocks));
-  BoundsKernel<Real>
-    <<<1, detail::ThreadsPerBlock, 0, this->Stream>>>(partial, partial + 3 * std::size_t(blocks), blocks, result, result + 3);
+  BoundsKernel<Real><<<1, detail::ThreadsPerBlock, 0, this->Stream>>>(
+    partial, partial + 3 * std::size_t(blocks), blocks, result, result + 3);
   Check(cudaGetLastError(), "launching the bounds' reduction");
   Real lowsHighs[6];
   Check(cudaMemcpyAsync(lowsHighs, result, sizeof lowsHighs, cudaMemcpyDeviceToHost, this->Stream),

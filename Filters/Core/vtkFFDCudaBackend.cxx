@@ -180,8 +180,8 @@ struct vtkFFDCudaBackend::vtkState : std::enable_shared_from_this<vtkFFDCudaBack
     };
     auto evaluate = [&](bool withNormals, bool withDeterminants)
     { return this->Tetrahedra.Evaluate(tetrahedra.GetDisplacements().data(), nodes, withNormals, withDeterminants); };
-    if (!Run(this->Tetrahedra, this->shared_from_this(), this->TetrahedraNormals, uploadPoints, rebind, points,
-          normals, outPoints, outNormals, outDeterminants, keptOnDevice, bind, evaluate))
+    if (!Run(this->Tetrahedra, this->shared_from_this(), this->TetrahedraNormals, uploadPoints, rebind, points, normals,
+          outPoints, outNormals, outDeterminants, keptOnDevice, bind, evaluate))
     {
       return false;
     }

@@ -84,7 +84,8 @@ public:
     bool reregister, std::string& why) const;
 
   /// Set by the CUDA backend: the device state that holds the last evaluation, and what it holds.
-  void SetDevice(std::shared_ptr<ffd::cuda::ResidentPoints> device, vtkIdType points, bool normals, const double bounds[6]);
+  void SetDevice(
+    std::shared_ptr<ffd::cuda::ResidentPoints> device, vtkIdType points, bool normals, const double bounds[6]);
 
 protected:
   vtkFFDDeviceOutput() = default;

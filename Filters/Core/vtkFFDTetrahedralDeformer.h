@@ -138,7 +138,6 @@ public:
   const std::vector<ClampedPoint>& GetClampedPoints() const { return this->Clamped; }
 
 private:
-
   /// The map of a tetrahedron from its nodes' displacements (double precision).
   ffd::TetrahedronMap<double> Map(vtkIdType tetrahedron) const;
   /// Every tetrahedron's map, in the evaluation's precision.

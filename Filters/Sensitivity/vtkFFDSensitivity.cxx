@@ -12,12 +12,12 @@
 #include "vtkDoubleArray.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
 #include "vtkSMPTools.h"
-#include "vtkNew.h"
 #include "vtkSmartPointer.h"
 #include "vtkUnstructuredGrid.h"
 
@@ -78,7 +78,8 @@ struct GroupedIds
   }
   /// The ids bound to a cell (keys 0 .. largest).
   explicit GroupedIds(const std::vector<int>& cellOf)
-    : GroupedIds(cellOf, cellOf.empty() ? 0 : 1 + std::size_t(std::max(0, *std::max_element(cellOf.begin(), cellOf.end()))))
+    : GroupedIds(
+        cellOf, cellOf.empty() ? 0 : 1 + std::size_t(std::max(0, *std::max_element(cellOf.begin(), cellOf.end()))))
   {
   }
   int Groups() const { return int(this->Start.size()) - 1; }
@@ -89,8 +90,8 @@ struct GroupedIds
 // colour in parallel, each adding its points' terms in increasing id. Every control point so receives its terms
 // in one order, whatever the threads.
 template <typename Deformation>
-void ColouredSums(const Deformation& deformation, const GroupedIds& byCell, int period,
-  const std::vector<double>& x, const std::vector<double>& g, std::vector<double>& out)
+void ColouredSums(const Deformation& deformation, const GroupedIds& byCell, int period, const std::vector<double>& x,
+  const std::vector<double>& g, std::vector<double>& out)
 {
   std::vector<std::vector<int>> byColour(std::size_t(period * period * period));
   for (int cell = 0; cell < byCell.Groups(); ++cell)
@@ -302,7 +303,7 @@ int vtkFFDSensitivity::RequestData(
     vtkErrorMacro("The mesh needs the objective's gradient as a point array of 3 components, one tuple per point ("
       << count << "), named by SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, name); "
       << (gradient ? "the one named has " + std::to_string(gradient->GetNumberOfTuples()) + " tuples of " +
-            std::to_string(gradient->GetNumberOfComponents()) + " components."
+               std::to_string(gradient->GetNumberOfComponents()) + " components."
                    : std::string("none is named or found.")));
     output->Initialize();
     return 0;
@@ -327,7 +328,8 @@ int vtkFFDSensitivity::RequestData(
 }
 
 //------------------------------------------------------------------------------------------------------------
-bool vtkFFDSensitivity::SumGrid(vtkPointSet* mesh, vtkPointSet* lattice, vtkDataArray* gradient, std::vector<double>& sums)
+bool vtkFFDSensitivity::SumGrid(
+  vtkPointSet* mesh, vtkPointSet* lattice, vtkDataArray* gradient, std::vector<double>& sums)
 {
   vtkFFDGridDeformer& grid = this->Internals->Grid;
   const std::string problem = grid.SetLattice(lattice);

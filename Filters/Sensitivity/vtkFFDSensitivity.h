@@ -34,7 +34,7 @@
 #ifndef vtkFFDSensitivity_h
 #define vtkFFDSensitivity_h
 
-#include "vtkFFDDeform.h"                    // For the outside policies
+#include "vtkFFDDeform.h"                   // For the outside policies
 #include "vtkFFDFiltersSensitivityModule.h" // For export macro
 #include "vtkPointSetAlgorithm.h"
 
@@ -94,7 +94,8 @@ private:
 
   // The steps of RequestData(): W^T g into `sums` (3 per control point); false on an error (reported) or abort.
   bool SumGrid(vtkPointSet* mesh, vtkPointSet* lattice, vtkDataArray* gradient, std::vector<double>& sums);
-  bool SumTetrahedral(vtkPointSet* mesh, vtkUnstructuredGrid* lattice, vtkDataArray* gradient, std::vector<double>& sums);
+  bool SumTetrahedral(
+    vtkPointSet* mesh, vtkUnstructuredGrid* lattice, vtkDataArray* gradient, std::vector<double>& sums);
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

@@ -53,8 +53,8 @@ struct Written
 
   bool SameBuffers(const Written& other) const
   {
-    return this->Points == other.Points && this->Normals == other.Normals &&
-      this->PointsUpload == other.PointsUpload && this->NormalsUpload == other.NormalsUpload;
+    return this->Points == other.Points && this->Normals == other.Normals && this->PointsUpload == other.PointsUpload &&
+      this->NormalsUpload == other.NormalsUpload;
   }
   bool operator==(const Written& other) const
   {
@@ -110,8 +110,8 @@ std::vector<vtkMTimeType> StructureOf(vtkPolyData* input, vtkOpenGLPolyDataMappe
   {
     add(cells);
   }
-  for (vtkFieldData* data : { static_cast<vtkFieldData*>(input->GetPointData()),
-         static_cast<vtkFieldData*>(input->GetCellData()) })
+  for (vtkFieldData* data :
+    { static_cast<vtkFieldData*>(input->GetPointData()), static_cast<vtkFieldData*>(input->GetCellData()) })
   {
     for (int a = 0; a < data->GetNumberOfArrays(); ++a)
     {
@@ -160,7 +160,7 @@ struct vtkFFDInteropPolyDataMapper::vtkInternals
   vtkFFDGLRegistrations Registrations;
   Written Last;
   std::vector<vtkMTimeType> BuiltStructure; // StructureOf() the input when the buffers were last built
-  vtkRenderer* Renderer = nullptr; // of the render under way: a failure draws that frame from the host
+  vtkRenderer* Renderer = nullptr;          // of the render under way: a failure draws that frame from the host
   vtkActor* Actor = nullptr;
   vtkWeakPointer<vtkOpenGLRenderWindow> Window; // whose context the registered buffers belong to
 };

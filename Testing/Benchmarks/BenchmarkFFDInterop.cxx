@@ -13,7 +13,8 @@
  * displacements up and what vtkFFDDeform downloaded (vtkFFDDeform's counters), plus, on the host path, the
  * vertex buffers uploaded (points and normals, 12 bytes each a point). Each frame is split into its pipeline
  * part (vtkFFDDeform's update, which the mapper's bounds trigger, as the renderer's first request does) and the
- * rest (buffers and draw). It also times an unchanged frame (the draw alone). It prints a table and asserts nothing about time; BENCHMARKS.md holds the results.
+ * rest (buffers and draw). It also times an unchanged frame (the draw alone). It prints a table and asserts nothing
+ * about time; BENCHMARKS.md holds the results.
  *
  * On the GPU machine (no X display): bash Utilities/gpu-rendering.sh --benchmark (vtkFFDEGLRenderWindow through
  * VOXELFFD_RENDER_WINDOW=egl). Here, in an X display with small sizes:
@@ -72,7 +73,8 @@ vtkSmartPointer<vtkPolyData> WavySheet(double millions, bool withNormals)
         {
           const double x = 2.0 * i / (nx - 1), y = double(j) / (ny - 1);
           const double z = 0.05 * std::sin(6.0 * x) * std::cos(5.0 * y);
-          const double zx = 0.3 * std::cos(6.0 * x) * std::cos(5.0 * y), zy = -0.25 * std::sin(6.0 * x) * std::sin(5.0 * y);
+          const double zx = 0.3 * std::cos(6.0 * x) * std::cos(5.0 * y),
+                       zy = -0.25 * std::sin(6.0 * x) * std::sin(5.0 * y);
           const vtkIdType p = j * nx + i;
           xyz->SetTypedTuple(p, std::array<float, 3>{ float(x), float(y), float(z) }.data());
           if (withNormals)
@@ -244,15 +246,15 @@ int main(int argc, char* argv[])
   std::string sizes = "1,10,50";
   int frames = 8;
   int status = 0;
-  if (!ParseArguments(argc, argv, { { "--points", &sizes }, { "--frames", &frames } },
-        "[--points M[,M...]] [--frames N]", status))
+  if (!ParseArguments(
+        argc, argv, { { "--points", &sizes }, { "--frames", &frames } }, "[--points M[,M...]] [--frames N]", status))
   {
     return status;
   }
   FFDSelectRenderWindow(&argc, &argv);
   frames = std::max(2, frames);
-  std::printf("%d frames a path in two blocks, each frame: move one control point, Render(), glFinish; ms\n\n",
-    2 * frames);
+  std::printf(
+    "%d frames a path in two blocks, each frame: move one control point, Render(), glFinish; ms\n\n", 2 * frames);
   std::printf("| points | basis | normals | host frame (pipeline) | interop frame (pipeline) | interop / host | "
               "interop fps | unchanged frame | bus per frame, host | bus per frame, interop | device-written frames "
               "|\n|---:|---|---|---:|---:|---:|---:|---:|---|---|---|\n");
@@ -275,13 +277,15 @@ int main(int argc, char* argv[])
         }
         const double unchanged = scene.UnchangedFrame(frames);
         const double h = Median(host.Frames), i = Median(interop.Frames);
-        std::printf("| %.2f M | %s | %s | %.2f (%.2f) | %.2f (%.2f) | %.3f | %.0f | %.2f | %s up, %s down, %s to GL | %s up, %s "
-                    "down, %s to GL | %d of %zu |\n",
+        std::printf(
+          "| %.2f M | %s | %s | %.2f (%.2f) | %.2f (%.2f) | %.3f | %.0f | %.2f | %s up, %s down, %s to GL | %s up, %s "
+          "down, %s to GL | %d of %zu |\n",
           sheet->GetNumberOfPoints() / 1e6, vtkFFDBuildLattice::GetBasisAsString(basis), withNormals ? "yes" : "no",
-          1e3 * h, 1e3 * Median(host.Pipelines), 1e3 * i, 1e3 * Median(interop.Pipelines), i / h, 1.0 / i, 1e3 * unchanged, Megabytes(host.LatticeBytes).c_str(),
-          Megabytes(host.DownloadedBytes).c_str(), Megabytes(host.BufferBytes).c_str(),
-          Megabytes(interop.LatticeBytes).c_str(), Megabytes(interop.DownloadedBytes).c_str(),
-          Megabytes(interop.BufferBytes).c_str(), interop.DeviceFrames, interop.Frames.size());
+          1e3 * h, 1e3 * Median(host.Pipelines), 1e3 * i, 1e3 * Median(interop.Pipelines), i / h, 1.0 / i,
+          1e3 * unchanged, Megabytes(host.LatticeBytes).c_str(), Megabytes(host.DownloadedBytes).c_str(),
+          Megabytes(host.BufferBytes).c_str(), Megabytes(interop.LatticeBytes).c_str(),
+          Megabytes(interop.DownloadedBytes).c_str(), Megabytes(interop.BufferBytes).c_str(), interop.DeviceFrames,
+          interop.Frames.size());
         std::fflush(stdout);
       }
     }

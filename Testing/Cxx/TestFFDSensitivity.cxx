@@ -105,8 +105,8 @@ vtkSmartPointer<vtkDataArray> Sensitivity(vtkPolyData* cloud, vtkPointSet* latti
 
 /// Central differences of `picks` random control points of `lattice` against vtkFFDSensitivity; the count of
 /// components beyond the tolerance, and the largest difference relative to it.
-void ExpectMatchesCentralDifferences(vtkPolyData* cloud, vtkPointSet* lattice, int policy, int picks,
-  std::mt19937& rng, const char* what)
+void ExpectMatchesCentralDifferences(
+  vtkPolyData* cloud, vtkPointSet* lattice, int policy, int picks, std::mt19937& rng, const char* what)
 {
   vtkSmartPointer<vtkDataArray> dJdP = Sensitivity(cloud, lattice, policy);
   ASSERT_TRUE(dJdP) << what;
@@ -219,8 +219,8 @@ TEST(vtkFFDSensitivity, SameBitsForAnyNumberOfThreads)
   vtkSmartPointer<vtkPolyData> bear = ReadTestMesh("bear");
   std::mt19937 rng(7);
   vtkSmartPointer<vtkPolyData> cloud = CloudWithGradient(bear, 1000, rng);
-  for (int basis : { vtkFFDBuildLattice::BERNSTEIN, vtkFFDBuildLattice::TRILINEAR,
-         vtkFFDBuildLattice::TRICUBIC_BEZIER, vtkFFDBuildLattice::CUBIC_BSPLINE })
+  for (int basis : { vtkFFDBuildLattice::BERNSTEIN, vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::TRICUBIC_BEZIER,
+         vtkFFDBuildLattice::CUBIC_BSPLINE })
   {
     const int n[3] = { 5, 6, 4 };
     vtkSmartPointer<vtkPointSet> lattice = ffdtest::MovedLattice(bear, basis, n, vtkFFDBuildLattice::DENSE, rng);

@@ -193,7 +193,8 @@ int TestFFDInteropPipeline(int, char*[])
   // scale. The float64 evaluation and the buffers' shift keep the bound of 1e-5 of the size.
   vtkSmartPointer<vtkPolyData> far = Moved(bear, 1.0, 2000.0 * size);
   FFDTestLattice farLattice;
-  if (!BuildTestLattice(far, divisions, vtkFFDBuildLattice::TRILINEAR, std::array<int, 3>{ 5, 5, 5 }.data(), farLattice))
+  if (!BuildTestLattice(
+        far, divisions, vtkFFDBuildLattice::TRILINEAR, std::array<int, 3>{ 5, 5, 5 }.data(), farLattice))
   {
     return EXIT_FAILURE;
   }
