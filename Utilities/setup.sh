@@ -53,6 +53,9 @@ packages=(build-essential cmake ninja-build libvtk9-dev python3-vtk9 libopenvdb-
   libinsighttoolkit5-dev openmpi-bin python3-mpi4py) # ITK: tests only; Open MPI and mpi4py: the MPI tests
 if [[ $action == test ]]; then
   packages+=(paraview paraview-dev) # the plugin and its tests (ParaView/, Testing/ParaView)
+  # vtkffd.torch and vtkffd.sparse are optional for users; their tests (Python.test_torch, test_weight_matrix) and
+  # the shape-optimisation example need them: PyTorch 1.13 CPU (48 packages, 70 MB, about 10 s to install)
+  packages+=(python3-torch python3-scipy)
 fi
 step "Debian packages"
 missing=()
