@@ -2,10 +2,13 @@
 #include "FFDCudaGridDeformer.h"
 
 #include "FFDCudaDevice.cuh"
+#include "FFDCudaGridAdjoint.cuh"
 #include "FFDGridDeformation.h"
 
 #include <algorithm>
+#include <memory>
 #include <type_traits>
+#include <vector>
 
 namespace ffd
 {
@@ -420,6 +423,13 @@ struct GridDeformer::Impl : ResidentPoints::State
   // A sparse lattice's cells (BindSparse()); SparseControlPoints is 0 for a dense lattice.
   Buffer CellVoxels, CellSupports;
   std::int64_t SparseControlPoints = 0;
+  std::unique_ptr<detail::AdjointPlan> Plan; // the adjoint's, made for the binding it names
+
+  void Release() override
+  {
+    this->Plan.reset();
+    this->State::Release();
+  }
 
   // Calls f(storage) with the ffd::GridStorage of the bound lattice (a std::integral_constant): the kernels are
   // instantiated for dense and sparse lattices apart. The global basis is always dense.
@@ -498,19 +508,27 @@ struct GridDeformer::Impl : ResidentPoints::State
     Check(cudaStreamSynchronize(this->Stream), "binding the points");
   }
 
-  template <typename Real>
-  void RunEvaluate(const double* displacements, std::int64_t controlPoints, bool withNormals, bool withDeterminants)
+  // Throws unless `controlPoints` is the bound lattice's count; dims: its control points along each axis.
+  void RequireControlPoints(std::int64_t controlPoints, int dims[3]) const
   {
-    this->RequireBound<Real>(withNormals);
-    const int dims[3] = { ffd::ControlPointsAlongAxis(this->Basis, this->Divisions[0]),
-      ffd::ControlPointsAlongAxis(this->Basis, this->Divisions[1]),
-      ffd::ControlPointsAlongAxis(this->Basis, this->Divisions[2]) };
+    for (int a = 0; a < 3; ++a)
+    {
+      dims[a] = ffd::ControlPointsAlongAxis(this->Basis, this->Divisions[a]);
+    }
     const std::int64_t expected =
       this->SparseControlPoints > 0 ? this->SparseControlPoints : std::int64_t(dims[0]) * dims[1] * dims[2];
     if (controlPoints != expected)
     {
       throw CudaError{ cudaErrorInvalidValue, "evaluating: the lattice does not match the binding's basis" };
     }
+  }
+
+  template <typename Real>
+  void RunEvaluate(const double* displacements, std::int64_t controlPoints, bool withNormals, bool withDeterminants)
+  {
+    this->RequireBound<Real>(withNormals);
+    int dims[3];
+    this->RequireControlPoints(controlPoints, dims);
     // The lattice: the only upload of an update. Float32 without the Jacobian on the trilinear and global bases
     // takes it as float4 (their kernels read one 16-byte word per control point), the others as 3 numbers per
     // control point (the float4 lattice made the gathers of the other local bases slower).
@@ -552,6 +570,96 @@ struct GridDeformer::Impl : ResidentPoints::State
       this->LaunchGeneric<Real>(this->Lattice.As<Real>(), dims, normalsOut, determinantsOut);
     }
     this->FinishEvaluation(withNormals, withDeterminants, false);
+  }
+
+  // W^T g (FFDCudaGridAdjoint.cuh): the plan made once per binding, then the chunks' partials and their gather.
+  template <typename Real>
+  void RunAdjoint(const double* gradient, std::int64_t controlPoints, double* sums)
+  {
+    this->RequireBound<Real>(false);
+    int dims[3];
+    this->RequireControlPoints(controlPoints, dims);
+    const ffd::Frame<Real> frame = ffd::Frame<Real>::FromArray(this->Frame);
+    ffd::WithStaticBasis(this->Basis,
+      [&](auto maxCount, auto basis)
+      {
+        this->WithStorage<decltype(basis)::value>(
+          [&](auto storage)
+          {
+            constexpr int MaxCount = decltype(maxCount)::value;
+            using Deformation =
+              ffd::GridDeformation<MaxCount, Real, decltype(basis)::value, Real, false, decltype(storage)::value>;
+            const Deformation deformation =
+              this->WithCells(Deformation{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
+                { dims[0], dims[1], dims[2] }, nullptr, frame });
+            this->EnsureAdjointPlan<Real, MaxCount>(deformation, controlPoints);
+            this->LaunchAdjoint<Real, MaxCount>(deformation, gradient, controlPoints);
+          });
+      });
+    const std::size_t bytes = std::size_t(controlPoints) * 3 * sizeof(double);
+    Check(cudaMemcpy(sums, this->Plan->Sums.Data, bytes, cudaMemcpyDeviceToHost), "downloading the sensitivities");
+    this->Counts.BytesDownloaded += bytes;
+  }
+
+  // The adjoint's plan for the current binding, made where there is none.
+  template <typename Real, int MaxCount, typename Deformation>
+  void EnsureAdjointPlan(const Deformation& deformation, std::int64_t controlPoints)
+  {
+    if (this->Plan && this->Plan->ForBinding == this->Counts.Bindings)
+    {
+      return;
+    }
+    this->Plan.reset(new detail::AdjointPlan);
+    detail::AdjointPlan& plan = *this->Plan;
+    for (int a = 0; a < 3; ++a)
+    {
+      plan.Counts[a] = ffd::SupportSize(this->Basis, this->Divisions[a]);
+    }
+    plan.Terms = plan.Counts[0] * plan.Counts[1] * plan.Counts[2];
+    plan.ChunkPoints = detail::AdjointChunkPoints(this->Count, plan.Terms);
+    detail::SortAdjointPoints(plan, this->Cells.As<int>(), this->Count, this->Stream);
+    const std::int64_t terms = plan.Chunks * plan.Terms;
+    plan.Keys.Reserve(std::size_t(terms) * sizeof(int), "allocating the adjoint's plan");
+    plan.Values.Reserve(std::size_t(terms) * sizeof(int), "allocating the adjoint's plan");
+    if (terms > 0)
+    {
+      detail::AdjointTermKernel<Deformation, Real, MaxCount><<<BlocksFor(terms), ThreadsPerBlock, 0, this->Stream>>>(
+        this->Points.As<Real>(), plan.Order.As<int>(), plan.ChunkStart.As<std::int64_t>(), plan.ChunkCell.As<int>(),
+        terms, plan.Counts[0], plan.Counts[1], plan.Counts[2], deformation, plan.Keys.As<int>(), plan.Values.As<int>());
+      Check(cudaGetLastError(), "launching the adjoint's plan");
+    }
+    detail::FinishAdjointPlan(plan, controlPoints, this->Stream);
+    plan.Partials.Reserve(std::size_t(terms) * 3 * sizeof(double), "allocating the adjoint's partials");
+    plan.Sums.Reserve(std::size_t(controlPoints) * 3 * sizeof(double), "allocating the sensitivities");
+    plan.Gradient.Reserve(std::size_t(this->Count) * 3 * sizeof(Real), "allocating the gradient");
+    plan.ForBinding = this->Counts.Bindings;
+    ++this->Counts.AdjointPlans;
+  }
+
+  // Uploads the gradient (in the points' precision), sums the chunks and gathers them, timed by the events.
+  template <typename Real, int MaxCount, typename Deformation>
+  void LaunchAdjoint(const Deformation& deformation, const double* gradient, std::int64_t controlPoints)
+  {
+    detail::AdjointPlan& plan = *this->Plan;
+    const std::vector<Real> g(gradient, gradient + 3 * this->Count);
+    Check(cudaMemcpy(plan.Gradient.Data, g.data(), g.size() * sizeof(Real), cudaMemcpyHostToDevice),
+      "uploading the gradient");
+    Check(cudaEventRecord(this->KernelStart, this->Stream), "recording an event");
+    const int slots = std::min(plan.Terms, detail::AdjointThreads);
+    if (plan.Chunks > 0)
+    {
+      const dim3 blocks(unsigned(plan.Chunks), unsigned((plan.Terms + slots - 1) / slots));
+      detail::AdjointChunkKernel<Deformation, Real, MaxCount><<<blocks, detail::AdjointThreads, 0, this->Stream>>>(
+        this->Points.As<Real>(), plan.Order.As<int>(), plan.ChunkStart.As<std::int64_t>(), plan.ChunkCell.As<int>(),
+        plan.Gradient.As<Real>(), plan.Counts[0], plan.Counts[1], plan.Counts[2], slots, detail::AdjointThreads / slots,
+        deformation, plan.Partials.As<double>());
+      Check(cudaGetLastError(), "launching the adjoint");
+    }
+    detail::GatherAdjoint(plan, controlPoints, this->Stream);
+    Check(cudaEventRecord(this->KernelStop, this->Stream), "recording an event");
+    Check(cudaEventSynchronize(this->KernelStop), "computing the adjoint");
+    Check(cudaEventElapsedTime(&this->Counts.LastKernelMilliseconds, this->KernelStart, this->KernelStop),
+      "timing the adjoint");
   }
 
   // DeformKernel on a lattice of 3 numbers per control point: with the Jacobian, float64 points, and float32
@@ -767,6 +875,23 @@ bool GridDeformer::BindSparse(const double frame[12], int basis, const int divis
       p.Bound = true;
       p.Evaluated = false;
       ++p.Counts.Bindings;
+    });
+}
+
+bool GridDeformer::Adjoint(const double* gradient, std::int64_t controlPoints, double* sums)
+{
+  Impl& p = static_cast<Impl&>(*this->S);
+  return p.Guard(
+    [&]
+    {
+      if (p.IsDouble)
+      {
+        p.RunAdjoint<double>(gradient, controlPoints, sums);
+      }
+      else
+      {
+        p.RunAdjoint<float>(gradient, controlPoints, sums);
+      }
     });
 }
 

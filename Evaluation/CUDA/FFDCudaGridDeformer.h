@@ -42,6 +42,16 @@ public:
   /// device until Download().
   bool Evaluate(const double* displacements, std::int64_t controlPoints, bool withNormals, bool withDeterminants);
 
+  /**
+   * W^T g, the adjoint of Evaluate() (its transpose in the control points): for the gradient g of an objective at
+   * the deformed points (3 doubles per point, in the points' order), the gradient at the control points into
+   * `sums` (3 doubles per control point, `controlPoints` as Evaluate()). Points that keep their position add
+   * nothing. Computed in the points' precision, summed in float64 without atomics, in one order set by the
+   * binding (FFDCudaGridAdjoint.cuh): the same bits at every run. Its plan is made at the first call after a
+   * binding (Counters::AdjointPlans).
+   */
+  bool Adjoint(const double* gradient, std::int64_t controlPoints, double* sums);
+
 private:
   struct Impl;
 };

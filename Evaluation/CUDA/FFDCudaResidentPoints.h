@@ -41,8 +41,9 @@ struct Counters
   std::uint64_t LatticeUploads = 0;
   std::uint64_t LatticeBytes = 0; ///< bytes of displacements uploaded, in all
   std::uint64_t Evaluations = 0;
+  std::uint64_t AdjointPlans = 0; ///< plans of GridDeformer::Adjoint() made (one per binding)
   std::uint64_t BytesDownloaded = 0;
-  float LastKernelMilliseconds = 0; ///< device time of the last evaluation kernel (CUDA events)
+  float LastKernelMilliseconds = 0; ///< device time of the last evaluation's (or adjoint's) kernels (CUDA events)
   /// Device time of the last update's work on the lattice before the points' kernel (the tetrahedra's maps;
   /// 0 for grids, which have none).
   float LastLatticeKernelMilliseconds = 0;

@@ -339,25 +339,39 @@ struct GridDeformation
   template <typename F>
   void ForEachWeight(const Vec3<Lane>& x, int cell, F&& f) const
   {
-    int c[3];
-    this->CellIndices(cell, c);
     AxisWeights<MaxCount, Lane> axes[3];
-    this->Weights(this->Frame.ToParametric(x), c, false, axes);
-    const int n = this->SupportCount();
-    const int* support = this->IsSparse() ? this->CellSupports + std::size_t(cell) * std::size_t(n * n * n) : nullptr;
+    this->WeightsAt(x, cell, axes);
     for (int k = 0; k < axes[2].Count; ++k)
     {
       for (int j = 0; j < axes[1].Count; ++j)
       {
         for (int i = 0; i < axes[0].Count; ++i)
         {
-          const int index = support
-            ? support[i + n * (j + n * k)]
-            : axes[0].First + i + this->Dims[0] * (axes[1].First + j + this->Dims[1] * (axes[2].First + k));
-          f(index, axes[0].W[i] * axes[1].W[j] * axes[2].W[k]);
+          f(this->ControlPointOf(cell, axes, i, j, k), axes[0].W[i] * axes[1].W[j] * axes[2].W[k]);
         }
       }
     }
+  }
+
+  /// The weights along each axis of a point x bound to `cell` (not -1), as Deform() takes them: the weight of the
+  /// support's control point (i, j, k) is axes[0].W[i] * axes[1].W[j] * axes[2].W[k] (ForEachWeight()).
+  FFD_INLINE void WeightsAt(const Vec3<Lane>& x, int cell, AxisWeights<MaxCount, Lane>* axes) const
+  {
+    int c[3];
+    this->CellIndices(cell, c);
+    this->Weights(this->Frame.ToParametric(x), c, false, axes);
+  }
+
+  /// The index into Displacements of the control point (i, j, k) of the support of `cell`, whose WeightsAt() gave
+  /// `axes` (their First: the same for every point of the cell).
+  FFD_INLINE int ControlPointOf(int cell, const AxisWeights<MaxCount, Lane>* axes, int i, int j, int k) const
+  {
+    if (this->IsSparse())
+    {
+      const int n = this->SupportCount();
+      return this->CellSupports[std::size_t(cell) * std::size_t(n * n * n) + std::size_t(i + n * (j + n * k))];
+    }
+    return axes[0].First + i + this->Dims[0] * (axes[1].First + j + this->Dims[1] * (axes[2].First + k));
   }
 
   // The building blocks of Deform(), public for the CPU's lanes in several cells (Evaluation/CPU/FFDLaneCells.h).

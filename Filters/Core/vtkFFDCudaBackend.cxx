@@ -15,6 +15,7 @@
 #endif
 
 #include <algorithm>
+#include <type_traits>
 #include <vector>
 
 #ifdef VOXELFFD_HAS_CUDA
@@ -42,16 +43,11 @@ struct NormalsOnDevice
   vtkMTimeType MTime = 0;
 };
 
-// The steps both lattices share, in the evaluation's precision Real: the input's points uploaded when
-// `uploadPoints` (which drops the device's binding and normals), bind() when `rebind`, the normals uploaded when
-// they changed, evaluate(withNormals, withDeterminants), the download into the output arrays unless the results
-// are `keptOnDevice` (a handle sharing `owner`, the device's state). False on any failure, after which the device
-// holds nothing.
-template <typename Real, typename Bind, typename Evaluate>
-bool Run(ffd::cuda::ResidentPoints& device, const std::shared_ptr<void>& owner, NormalsOnDevice& normalsOnDevice,
-  bool uploadPoints, bool rebind, vtkPoints* points, vtkDataArray* normals, vtkAOSDataArrayTemplate<Real>* outPoints,
-  vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outDeterminants,
-  vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice, Bind&& bind, Evaluate&& evaluate)
+// The input's points uploaded in the precision Real when `uploadPoints` (which drops the device's binding and
+// normals), then bind() when `rebind`. False on any failure, after which the device holds nothing.
+template <typename Real, typename Bind>
+bool UploadAndBind(ffd::cuda::ResidentPoints& device, NormalsOnDevice& normalsOnDevice, bool uploadPoints, bool rebind,
+  vtkPoints* points, Bind&& bind)
 {
   if (uploadPoints)
   {
@@ -62,7 +58,20 @@ bool Run(ffd::cuda::ResidentPoints& device, const std::shared_ptr<void>& owner, 
       return false;
     }
   }
-  if (rebind && !bind())
+  return !rebind || bind();
+}
+
+// The steps both lattices share, in the evaluation's precision Real: UploadAndBind(), the normals uploaded when
+// they changed, evaluate(withNormals, withDeterminants), the download into the output arrays unless the results
+// are `keptOnDevice` (a handle sharing `owner`, the device's state). False on any failure, after which the device
+// holds nothing.
+template <typename Real, typename Bind, typename Evaluate>
+bool Run(ffd::cuda::ResidentPoints& device, const std::shared_ptr<void>& owner, NormalsOnDevice& normalsOnDevice,
+  bool uploadPoints, bool rebind, vtkPoints* points, vtkDataArray* normals, vtkAOSDataArrayTemplate<Real>* outPoints,
+  vtkDataArray* outNormals, vtkAOSDataArrayTemplate<Real>* outDeterminants,
+  vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice, Bind&& bind, Evaluate&& evaluate)
+{
+  if (!UploadAndBind<Real>(device, normalsOnDevice, uploadPoints, rebind, points, bind))
   {
     return false;
   }
@@ -137,20 +146,43 @@ struct vtkFFDCudaBackend::vtkState : std::enable_shared_from_this<vtkFFDCudaBack
     this->GridKey = vtkFFDBindingKey(); // valid again once everything succeeded
     if (!Run(
           this->Grid, this->shared_from_this(), this->GridNormals, rebind, rebind, points, normals, outPoints,
-          outNormals, outDeterminants, keptOnDevice,
-          [&]
-          {
-            if (!sparse)
-            {
-              return this->Grid.Bind(key.Frame.data(), key.Basis, key.Divisions.data(), key.ClampsOutside());
-            }
-            const vtkFFDSparseCells& cells = *sparse->GetSparseCells();
-            return this->Grid.BindSparse(key.Frame.data(), key.Basis, key.Divisions.data(),
-              sparse->GetCellOfPoint().data(), cells.GetVoxels().data(), cells.GetSupports(), cells.GetNumberOfCells(),
-              controlPoints);
-          },
+          outNormals, outDeterminants, keptOnDevice, [&] { return this->BindGrid(key, sparse, controlPoints); },
           [&](bool withNormals, bool withDeterminants)
           { return this->Grid.Evaluate(displacements, controlPoints, withNormals, withDeterminants); }))
+    {
+      return false;
+    }
+    this->GridKey = key;
+    this->GridType = type;
+    bound = rebind;
+    return true;
+  }
+
+  // Binds the device's points per `key`: on the device for a dense lattice, the host's binding uploaded for a
+  // sparse one (`sparse`).
+  bool BindGrid(const vtkFFDBindingKey& key, const vtkFFDGridDeformer* sparse, vtkIdType controlPoints)
+  {
+    if (!sparse)
+    {
+      return this->Grid.Bind(key.Frame.data(), key.Basis, key.Divisions.data(), key.ClampsOutside());
+    }
+    const vtkFFDSparseCells& cells = *sparse->GetSparseCells();
+    return this->Grid.BindSparse(key.Frame.data(), key.Basis, key.Divisions.data(), sparse->GetCellOfPoint().data(),
+      cells.GetVoxels().data(), cells.GetSupports(), cells.GetNumberOfCells(), controlPoints);
+  }
+
+  // W^T g on the device's binding for `key`, made (with the points uploaded in the precision Real) where the
+  // device's is for something else.
+  template <typename Real>
+  bool AdjointGrid(const vtkFFDBindingKey& key, const vtkFFDGridDeformer* sparse, vtkPoints* points,
+    vtkIdType controlPoints, const double* gradient, double* sums, bool& bound)
+  {
+    const int type = std::is_same<Real, double>::value ? VTK_DOUBLE : VTK_FLOAT;
+    const bool rebind = key != this->GridKey || type != this->GridType;
+    this->GridKey = vtkFFDBindingKey(); // valid again once everything succeeded
+    if (!UploadAndBind<Real>(this->Grid, this->GridNormals, rebind, rebind, points,
+          [&] { return this->BindGrid(key, sparse, controlPoints); }) ||
+      !this->Grid.Adjoint(gradient, controlPoints, sums))
     {
       return false;
     }
@@ -253,6 +285,24 @@ bool vtkFFDCudaBackend::DeformGrid(const vtkFFDGridDeformer& grid, const vtkFFDB
   return ok;
 }
 
+bool vtkFFDCudaBackend::AdjointGrid(const vtkFFDGridDeformer& grid, const vtkFFDBindingKey& key, vtkPoints* points,
+  int precision, const double* gradient, double* sums, bool& bound, std::string& why)
+{
+  bound = false;
+  vtkState& state = *this->State;
+  const int type = key == state.GridKey ? state.GridType : precision;
+  const vtkFFDGridDeformer* sparse = grid.GetSparseCells() ? &grid : nullptr;
+  const vtkIdType controlPoints = grid.GetLattice().Points->GetNumberOfTuples();
+  const bool ok = type == VTK_DOUBLE
+    ? state.AdjointGrid<double>(key, sparse, points, controlPoints, gradient, sums, bound)
+    : state.AdjointGrid<float>(key, sparse, points, controlPoints, gradient, sums, bound);
+  if (!ok)
+  {
+    why = state.Grid.GetLastError();
+  }
+  return ok;
+}
+
 bool vtkFFDCudaBackend::DeformTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points,
   vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
   vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice, std::string& why)
@@ -286,6 +336,13 @@ bool vtkFFDCudaBackend::IsAvailable(std::string& why)
 
 bool vtkFFDCudaBackend::DeformGrid(const vtkFFDGridDeformer&, const vtkFFDBindingKey&, vtkPoints*, vtkDataArray*,
   vtkDataArray*, vtkDataArray*, vtkDataArray*, vtkSmartPointer<vtkFFDDeviceOutput>*, bool& bound, std::string& why)
+{
+  bound = false;
+  return vtkFFDCudaBackend::IsAvailable(why);
+}
+
+bool vtkFFDCudaBackend::AdjointGrid(const vtkFFDGridDeformer&, const vtkFFDBindingKey&, vtkPoints*, int, const double*,
+  double*, bool& bound, std::string& why)
 {
   bound = false;
   return vtkFFDCudaBackend::IsAvailable(why);

@@ -58,6 +58,16 @@ public:
     vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice, bool& bound, std::string& why);
 
   /**
+   * W^T g on the device (ffd::cuda::GridDeformer::Adjoint()): the gradient g (3 doubles per point) of an objective
+   * at the points deformed by the grid lattice of `grid`, taken to its control points (`sums`, 3 doubles each).
+   * The device's binding is used where it is for `key` (DeformGrid()'s, in its precision), else made as
+   * DeformGrid() makes it with the points uploaded in `precision` (VTK_FLOAT or VTK_DOUBLE). Failures as
+   * DeformGrid().
+   */
+  bool AdjointGrid(const vtkFFDGridDeformer& grid, const vtkFFDBindingKey& key, vtkPoints* points, int precision,
+    const double* gradient, double* sums, bool& bound, std::string& why);
+
+  /**
    * Deforms on the device the input's points bound by `tetrahedra` (whose Bind() ran for them; its binding is
    * uploaded when the device does not hold it) by the nodes' displacements of its last SetLattice(), then moves
    * the points clamped to the control mesh on the host with its ApplyClampedPoints(), as the CPU does. Outputs

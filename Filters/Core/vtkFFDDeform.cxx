@@ -188,6 +188,11 @@ vtkExecutive* vtkFFDDeform::CreateDefaultExecutive()
   return vtkFFDDeformExecutive::New();
 }
 
+vtkFFDDeform::vtkBinding vtkFFDDeform::GetBinding()
+{
+  return { this->Internals->Grid, this->Internals->Tetrahedra, this->Internals->Cuda };
+}
+
 vtkTypeUInt64 vtkFFDDeform::GetLatticeBytesUploaded() const
 {
   return this->Internals->Cuda.GetLatticeBytesUploaded();

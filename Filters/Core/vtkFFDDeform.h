@@ -80,6 +80,9 @@
 #include <string>     // For std::string
 
 class vtkDataArray;
+class vtkFFDCudaBackend;
+class vtkFFDGridDeformer;
+class vtkFFDTetrahedralDeformer;
 class vtkInformationIntegerKey;
 class vtkInformationObjectBaseKey;
 class vtkPoints;
@@ -203,6 +206,17 @@ protected:
 private:
   vtkFFDDeform(const vtkFFDDeform&) = delete;
   void operator=(const vtkFFDDeform&) = delete;
+
+  /// What holds this filter's binding, on the host and on the device: vtkFFDSensitivity runs the adjoint on it, so
+  /// that a mesh deformed and differentiated by the same lattice is bound once.
+  friend class vtkFFDSensitivity;
+  struct vtkBinding
+  {
+    vtkFFDGridDeformer& Grid;
+    vtkFFDTetrahedralDeformer& Tetrahedra;
+    vtkFFDCudaBackend& Cuda;
+  };
+  vtkBinding GetBinding();
 
   // The steps of RequestData().
   vtkDataArray* GetNormalsToTransform(vtkPointSet* input);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkFFDSensitivity.h"
 
+#include "vtkFFDCudaBackend.h"
 #include "vtkFFDGridDeformer.h"
 #include "vtkFFDInputChecks.h"
 #include "vtkFFDLatticeQueries.h"
@@ -229,13 +230,15 @@ void TetrahedralSums(const vtkFFDTetrahedralDeformer& tetrahedra, const std::vec
 //------------------------------------------------------------------------------------------------------------
 struct vtkFFDSensitivity::vtkInternals
 {
-  vtkFFDGridDeformer Grid; // keeps the displacements: ForEachWeight reads its lattice view
-  vtkFFDTetrahedralDeformer Tetrahedra;
+  vtkNew<vtkFFDDeform> Own; // whose binding the sums use without a Deform
 };
 
 vtkFFDSensitivity::vtkFFDSensitivity()
   : OutsidePolicy(vtkFFDDeform::KEEP_POSITION)
+  , Backend(vtkFFDDeform::AUTOMATIC)
+  , LastBackendUsed("None")
   , SensitivityArrayName(nullptr)
+  , Deform(nullptr)
   , NumberOfBindings(0)
   , Internals(new vtkInternals)
 {
@@ -246,6 +249,19 @@ vtkFFDSensitivity::vtkFFDSensitivity()
 vtkFFDSensitivity::~vtkFFDSensitivity()
 {
   this->SetSensitivityArrayName(nullptr);
+  this->SetDeform(nullptr);
+}
+
+vtkCxxSetObjectMacro(vtkFFDSensitivity, Deform, vtkFFDDeform);
+
+vtkFFDDeform* vtkFFDSensitivity::Engine()
+{
+  return this->Deform ? this->Deform : this->Internals->Own.Get();
+}
+
+int vtkFFDSensitivity::EngineOutsidePolicy() const
+{
+  return this->Deform ? this->Deform->GetOutsidePolicy() : this->OutsidePolicy;
 }
 
 int vtkFFDSensitivity::FillInputPortInformation(int port, vtkInformation* info)
@@ -331,9 +347,10 @@ int vtkFFDSensitivity::RequestData(
 bool vtkFFDSensitivity::SumGrid(
   vtkPointSet* mesh, vtkPointSet* lattice, vtkDataArray* gradient, std::vector<double>& sums)
 {
-  vtkFFDGridDeformer& grid = this->Internals->Grid;
+  vtkFFDGridDeformer& grid = this->Engine()->GetBinding().Grid;
+  const int policy = this->EngineOutsidePolicy();
   const std::string problem = grid.SetLattice(lattice);
-  if (!problem.empty() || this->OutsidePolicy == vtkFFDDeform::EXTRAPOLATE)
+  if (!problem.empty() || policy == vtkFFDDeform::EXTRAPOLATE)
   {
     vtkErrorMacro(<< (problem.empty() ? "The outside policy EXTRAPOLATE needs a tetrahedral lattice." : problem));
     return false;
@@ -342,15 +359,20 @@ bool vtkFFDSensitivity::SumGrid(
   {
     return true;
   }
+  const std::vector<double> g = AsDoubles(gradient);
+  if (this->SumGridOnCuda(mesh->GetPoints(), g, sums))
+  {
+    return true;
+  }
   bool rebound = false;
-  if (!grid.Bind(mesh->GetPoints(), this->OutsidePolicy, this, 0.0, 0.5, rebound))
+  if (!grid.Bind(mesh->GetPoints(), policy, this, 0.0, 0.5, rebound))
   {
     return false;
   }
   this->NumberOfBindings += rebound ? 1 : 0;
   const std::vector<double> x = AsDoubles(mesh->GetPoints()->GetData());
-  const std::vector<double> g = AsDoubles(gradient);
   const ffd::GridBasis basis = grid.GetLattice().Basis;
+  std::fill(sums.begin(), sums.end(), 0.0);
   vtkFFDWithGridDeformation(grid,
     [&](const auto& deformation)
     {
@@ -362,13 +384,50 @@ bool vtkFFDSensitivity::SumGrid(
       ColouredSums(
         deformation, GroupedIds(grid.GetCellOfPoint()), basis == ffd::GridBasis::CubicBSpline ? 4 : 2, x, g, sums);
     });
+  this->LastBackendUsed = "CPU";
+  return true;
+}
+
+bool vtkFFDSensitivity::SumGridOnCuda(vtkPoints* points, const std::vector<double>& g, std::vector<double>& sums)
+{
+  const int backend = this->Deform ? this->Deform->GetBackend() : this->Backend;
+  std::string why;
+  if (backend == vtkFFDDeform::CPU || !vtkFFDCudaBackend::IsAvailable(why))
+  {
+    if (backend == vtkFFDDeform::CUDA)
+    {
+      vtkWarningMacro("The CUDA backend cannot run (" << why << "); summing on the CPU.");
+    }
+    return false;
+  }
+  vtkFFDDeform::vtkBinding binding = this->Engine()->GetBinding();
+  const int policy = this->EngineOutsidePolicy();
+  bool rebound = false;
+  // A sparse lattice's voxels are looked up on the host: its binding is the host's, uploaded.
+  if (binding.Grid.GetLattice().Sparse && !binding.Grid.Bind(points, policy, this, 0.0, 0.5, rebound))
+  {
+    return false;
+  }
+  const int precision = this->Deform ? this->Deform->GetOutputPointsPrecision() : vtkAlgorithm::DEFAULT_PRECISION;
+  const bool useDouble = precision == vtkAlgorithm::DOUBLE_PRECISION ||
+    (precision == vtkAlgorithm::DEFAULT_PRECISION && points->GetDataType() == VTK_DOUBLE);
+  bool bound = false;
+  const bool summed = binding.Cuda.AdjointGrid(binding.Grid, binding.Grid.KeyOf(points, policy), points,
+    useDouble ? VTK_DOUBLE : VTK_FLOAT, g.data(), sums.data(), bound, why);
+  this->NumberOfBindings += (rebound || (bound && !binding.Grid.GetLattice().Sparse)) ? 1 : 0;
+  if (!summed)
+  {
+    vtkWarningMacro("The CUDA backend failed (" << why << "); summing on the CPU.");
+    return false;
+  }
+  this->LastBackendUsed = "CUDA";
   return true;
 }
 
 bool vtkFFDSensitivity::SumTetrahedral(
   vtkPointSet* mesh, vtkUnstructuredGrid* lattice, vtkDataArray* gradient, std::vector<double>& sums)
 {
-  vtkFFDTetrahedralDeformer& tetrahedra = this->Internals->Tetrahedra;
+  vtkFFDTetrahedralDeformer& tetrahedra = this->Engine()->GetBinding().Tetrahedra;
   const std::string problem = tetrahedra.SetLattice(lattice);
   if (!problem.empty())
   {
@@ -380,12 +439,13 @@ bool vtkFFDSensitivity::SumTetrahedral(
     return true;
   }
   bool rebound = false;
-  if (!tetrahedra.Bind(mesh->GetPoints(), this->OutsidePolicy, this, 0.0, 0.5, rebound))
+  if (!tetrahedra.Bind(mesh->GetPoints(), this->EngineOutsidePolicy(), this, 0.0, 0.5, rebound))
   {
     return false;
   }
   this->NumberOfBindings += rebound ? 1 : 0;
   TetrahedralSums(tetrahedra, AsDoubles(mesh->GetPoints()->GetData()), AsDoubles(gradient), sums);
+  this->LastBackendUsed = "CPU";
   return true;
 }
 
@@ -396,5 +456,8 @@ void vtkFFDSensitivity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "OutsidePolicy: " << this->OutsidePolicy << "\n";
   os << indent << "SensitivityArrayName: " << (this->SensitivityArrayName ? this->SensitivityArrayName : "(none)")
      << "\n";
+  os << indent << "Backend: " << this->Backend << "\n";
+  os << indent << "LastBackendUsed: " << this->LastBackendUsed << "\n";
+  os << indent << "Deform: " << static_cast<void*>(this->Deform) << "\n";
   os << indent << "NumberOfBindings: " << this->NumberOfBindings << "\n";
 }

@@ -27,7 +27,17 @@
  * threads) into partial gradients, then adds the partials in chunk order. A tetrahedral lattice sums each
  * tetrahedron's points, then each node's tetrahedra in increasing order. All sums are in float64.
  *
- * The sums run on the CPU with vtkSMPTools; the CUDA backend does not compute them yet.
+ * Binding: SetDeform() names the vtkFFDDeform that deforms the same mesh by the same lattice; its binding (on the
+ * host, or on the CUDA device) is then the one used, and so are its OutsidePolicy, Backend and precision: the mesh
+ * is bound once for both. Without it the filter keeps a binding of its own (OutsidePolicy, Backend here).
+ *
+ * Backends: the sums run on the CPU with vtkSMPTools or, for grid lattices, on a CUDA device (Backend, as
+ * vtkFFDDeform's: AUTOMATIC takes CUDA where a device is present; any CUDA failure falls back to the CPU with a
+ * warning). The device computes the weights in the precision of the points it holds (vtkFFDDeform's output
+ * precision; the mesh's points' without SetDeform()) and sums in float64 without atomics: each cell's points in
+ * chunks, then each control point's chunks, in an order set by the binding alone, so the same bits at every run;
+ * in float64 it agrees with the CPU to the rounding of the sums. Tetrahedral lattices, bound on the host, are
+ * summed on the CPU. GetLastBackendUsed() tells which ran.
  *
  * @sa vtkFFDDeform
  */
@@ -42,6 +52,7 @@
 #include <vector> // For std::vector
 
 class vtkDataArray;
+class vtkPoints;
 class vtkUnstructuredGrid;
 
 class VTKFFDFILTERSSENSITIVITY_EXPORT vtkFFDSensitivity : public vtkPointSetAlgorithm
@@ -70,8 +81,28 @@ public:
   vtkGetStringMacro(SensitivityArrayName);
   ///@}
 
-  /// Number of times the input points have been bound to a lattice (the binding is kept while they, the lattice's
-  /// rest state and the policy stay the same).
+  ///@{
+  /// Where the sums run (vtkFFDDeform's values; default AUTOMATIC). Ignored where SetDeform() names a filter: its
+  /// Backend applies.
+  vtkSetClampMacro(Backend, int, vtkFFDDeform::AUTOMATIC, vtkFFDDeform::CUDA);
+  vtkGetMacro(Backend, int);
+  void SetBackendToAutomatic() { this->SetBackend(vtkFFDDeform::AUTOMATIC); }
+  void SetBackendToCPU() { this->SetBackend(vtkFFDDeform::CPU); }
+  void SetBackendToCUDA() { this->SetBackend(vtkFFDDeform::CUDA); }
+  ///@}
+
+  /// The backend that computed the last output: "CPU" or "CUDA" ("None" before the first execution).
+  const char* GetLastBackendUsed() const { return this->LastBackendUsed; }
+
+  ///@{
+  /// The vtkFFDDeform that deforms input 0 by input 1, whose binding, OutsidePolicy, Backend and precision the sums
+  /// then use (default none: a binding of this filter's own).
+  virtual void SetDeform(vtkFFDDeform* deform);
+  vtkGetObjectMacro(Deform, vtkFFDDeform);
+  ///@}
+
+  /// Number of times this filter bound the input points to a lattice, on the host or the device (none while the
+  /// binding it uses, its own or the Deform's, is for these points, the lattice's rest state and the policy).
   vtkGetMacro(NumberOfBindings, vtkIdType);
 
 protected:
@@ -85,7 +116,10 @@ protected:
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   int OutsidePolicy;
+  int Backend;
+  const char* LastBackendUsed;
   char* SensitivityArrayName;
+  vtkFFDDeform* Deform;
   vtkIdType NumberOfBindings;
 
 private:
@@ -96,6 +130,13 @@ private:
   bool SumGrid(vtkPointSet* mesh, vtkPointSet* lattice, vtkDataArray* gradient, std::vector<double>& sums);
   bool SumTetrahedral(
     vtkPointSet* mesh, vtkUnstructuredGrid* lattice, vtkDataArray* gradient, std::vector<double>& sums);
+  /// SumGrid() on the device, where the backend allows it; false where the CPU must sum (with a warning where
+  /// CUDA was asked for or failed).
+  bool SumGridOnCuda(vtkPoints* points, const std::vector<double>& g, std::vector<double>& sums);
+
+  // Whose binding and settings the sums use: the Deform's, else this filter's own.
+  vtkFFDDeform* Engine();
+  int EngineOutsidePolicy() const;
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

@@ -7,7 +7,9 @@
 // tetrahedral lattices' evaluation (ffd::cuda::TetrahedralDeformer) for 1 M and 16 M points in about 10 k and
 // 100 k tetrahedra, float32 and float64, beside the trilinear grid's in the same run, with what an update would
 // cost if it uploaded the tetrahedra's maps instead of the nodes' displacements.
-// It prints tables and asserts nothing. Options: --quick (1 M points only), --tetrahedra (that section alone).
+// Last, the adjoint (W^T g) of every basis beside its forward evaluation, for 1 M and 16 M points.
+// It prints tables and asserts nothing. Options: --quick (1 M points only), --tetrahedra, --adjoint (that section
+// alone).
 #include "FFDBenchmarkUtilities.h"
 #include "FFDCudaGridDeformer.h"
 #include "FFDCudaTestSupport.h"
@@ -19,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -333,12 +336,60 @@ void Tetrahedra(const std::vector<std::int64_t>& sizes, double bandwidth, std::m
 }
 } // namespace
 
+// The adjoint W^T g (GridDeformer::Adjoint()) beside the forward evaluation of the same basis, points and device,
+// in one run: kernel times (median of 20; CUDA events: the chunks' sums and the gather for the adjoint), the
+// whole Adjoint() call (the gradient's upload from pageable memory and the sensitivities' download included),
+// and the plan, made once per binding (the first call's extra time).
+void AdjointSection(const Case* cases, std::size_t caseCount, const std::vector<std::int64_t>& sizes, std::mt19937& rng)
+{
+  std::printf("\nAdjoint (W^T g) beside the forward evaluation, float32 points in voxel order, median of 20; rates "
+              "from the kernel times\n");
+  std::printf("| basis | points | forward kernel ms | forward G points/s | adjoint kernels ms | adjoint G points/s | "
+              "adjoint / forward | Adjoint() call ms | plan ms |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (std::int64_t n : sizes)
+  {
+    const std::vector<double> points64 = RandomPoints(n, rng);
+    const std::vector<float> points(points64.begin(), points64.end());
+    std::vector<double> gradient(points64.size());
+    for (double& v : gradient)
+    {
+      v = unit(rng);
+    }
+    for (std::size_t k = 0; k < caseCount; ++k)
+    {
+      const Case& c = cases[k];
+      const std::vector<double> displacements = RandomDisplacements(c, rng);
+      const std::int64_t controlPoints = std::int64_t(displacements.size() / 3);
+      std::vector<double> sums(displacements.size());
+      const int divisions[3] = { c.Divisions, c.Divisions, c.Divisions };
+      ffd::cuda::GridDeformer gpu;
+      Require(gpu.SetPoints(points.data(), n) && gpu.Bind(Frame, int(c.Basis), divisions, false), gpu, "Bind");
+      const Times forward = TimeGridEvaluation(gpu, displacements);
+      auto adjoint = [&] { Require(gpu.Adjoint(gradient.data(), controlPoints, sums.data()), gpu, "Adjoint"); };
+      const double first = MedianSeconds(1, adjoint);
+      std::vector<double> kernels;
+      const double call = MedianSeconds(20,
+        [&]
+        {
+          adjoint();
+          kernels.push_back(gpu.GetCounters().LastKernelMilliseconds * 1e-3);
+        });
+      const double kernel = Median(kernels);
+      std::printf("| %s | %lld | %.3f | %.2f | %.3f | %.2f | %.2f | %.3f | %.3f |\n", c.Name, static_cast<long long>(n),
+        forward.Points * 1e3, n / forward.Points * 1e-9, kernel * 1e3, n / kernel * 1e-9, forward.Points / kernel,
+        call * 1e3, (first - call) * 1e3);
+    }
+  }
+}
+
 int main(int argc, char* argv[])
 {
-  bool quick = false, tetrahedraOnly = false;
+  bool quick = false, tetrahedraOnly = false, adjointOnly = false;
   int status = 0;
-  if (!ParseArguments(
-        argc, argv, { { "--quick", &quick }, { "--tetrahedra", &tetrahedraOnly } }, "[--quick] [--tetrahedra]", status))
+  if (!ParseArguments(argc, argv,
+        { { "--quick", &quick }, { "--tetrahedra", &tetrahedraOnly }, { "--adjoint", &adjointOnly } },
+        "[--quick] [--tetrahedra] [--adjoint]", status))
   {
     return status;
   }
@@ -373,6 +424,11 @@ int main(int argc, char* argv[])
   if (tetrahedraOnly)
   {
     Tetrahedra(tetrahedraSizes, bandwidth, rng);
+    return 0;
+  }
+  if (adjointOnly)
+  {
+    AdjointSection(cases, std::size(cases), tetrahedraSizes, rng);
     return 0;
   }
   std::printf("Evaluation of float32 points in voxel order, median of 20: the whole Evaluate() call (lattice "
@@ -463,5 +519,6 @@ int main(int argc, char* argv[])
     std::printf("BERNSTEIN 11^3 float32 vs float64: max error %.2e relative to the frame's scale\n", worst / 3.0);
   }
   Tetrahedra(tetrahedraSizes, bandwidth, rng);
+  AdjointSection(cases, std::size(cases), tetrahedraSizes, rng);
   return 0;
 }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The CUDA backend against the CPU path (the same Evaluation/Kernels functions run on the host) for every grid
-// basis, on fresh random inputs with fixed seeds; device residency (what is uploaded on an update); failures.
+// basis, on fresh random inputs with fixed seeds, the deformation and its adjoint; device residency (what is
+// uploaded on an update); failures.
 // Without a CUDA device every test skips.
 #include "FFDCudaGridDeformer.h"
 #include "FFDCudaTestSupport.h"
@@ -12,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <string>
@@ -368,6 +370,135 @@ TEST(CudaGridDeformer, BoundsAreReducedOnTheDevice)
     ExpectDeviceBoundsMatchHost<float>(count, rng);
     ExpectDeviceBoundsMatchHost<double>(count, rng);
   }
+}
+
+// W^T g on the host: the CPU path's weights (GridDeformation::ForEachWeight, in float64), summed in point order,
+// and per control point the size of its terms, S_c = sum_p |w_c(p)| |g_p|, to which its rounding is relative.
+template <int MaxCount>
+void HostAdjoint(const Problem& p, bool clampOutside, const std::vector<double>& g, std::vector<double>& sums,
+  std::vector<double>& sizes)
+{
+  const ffd::Frame<double> frame = ffd::Frame<double>::FromArray(p.Frame);
+  const ffd::GridDeformation<MaxCount, double> deformation{ ffd::GridBasis(p.Basis),
+    { p.Divisions[0], p.Divisions[1], p.Divisions[2] }, { p.Dims[0], p.Dims[1], p.Dims[2] }, p.Displacements.data(),
+    frame };
+  sums.assign(3 * std::size_t(p.ControlPoints()), 0.0);
+  sizes.assign(std::size_t(p.ControlPoints()), 0.0);
+  for (std::int64_t i = 0; i < p.Count(); ++i)
+  {
+    const ffd::Vec3<double> x = ffd::Vec3<double>::From(&p.Points[3 * i]);
+    const int cell = ffd::BindToGrid(frame, ffd::GridBasis(p.Basis), p.Divisions, x, clampOutside);
+    if (cell < 0)
+    {
+      continue;
+    }
+    deformation.ForEachWeight(x, cell,
+      [&](int c, double w)
+      {
+        for (int k = 0; k < 3; ++k)
+        {
+          sums[3 * c + k] += w * g[3 * i + k];
+          sizes[c] += std::fabs(w * g[3 * i + k]);
+        }
+      });
+  }
+}
+
+// The device's W^T g in the precision Real, for a fresh deformer.
+template <typename Real>
+std::vector<double> DeviceAdjoint(
+  const Problem& p, bool clamp, const std::vector<double>& g, std::uint64_t* plans = nullptr, int calls = 1)
+{
+  const std::vector<Real> points(p.Points.begin(), p.Points.end());
+  ffd::cuda::GridDeformer gpu;
+  std::vector<double> sums(3 * std::size_t(p.ControlPoints()), -12345.0); // poisoned: unwritten values show
+  EXPECT_TRUE(gpu.SetPoints(points.data(), p.Count())) << gpu.GetLastError();
+  EXPECT_TRUE(gpu.Bind(p.Frame, p.Basis, p.Divisions, clamp)) << gpu.GetLastError();
+  for (int call = 0; call < calls; ++call)
+  {
+    EXPECT_TRUE(gpu.Adjoint(g.data(), p.ControlPoints(), sums.data())) << gpu.GetLastError();
+  }
+  if (plans)
+  {
+    *plans = gpu.GetCounters().AdjointPlans;
+  }
+  return sums;
+}
+
+// The adjoint on the device against the host's, for every basis and outside policy, on random problems (some
+// points outside, two non-finite). Float64: both sum the same float64 terms (the weights but for the compilers'
+// contraction into FMAs, a few eps) in different orders, each within (n - 1) eps S_c of the exact sum for n <= N
+// terms: |difference| <= (2 N + 32) eps S_c. Float32: the forward map's bound (MatchesCpuForEveryBasis: points
+// within 3e-5 where displacements reach 0.2) bounds each point's weights' errors, summed, by 1.5e-4, so the
+// control points' errors sum to at most 1.5e-4 sum_p |g_p|_1 (the transpose of that bound). Then the same bits
+// again, on a fresh deformer, with the plan made once per binding.
+TYPED_TEST(CudaGridDeformerTest, AdjointMatchesHostForEveryBasis)
+{
+  FFD_REQUIRE_DEVICE();
+  using Real = TypeParam;
+  const bool single = sizeof(Real) == sizeof(float);
+  std::mt19937 rng(3141);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int basis = 0; basis <= int(ffd::GridBasis::CubicBSpline); ++basis)
+  {
+    for (bool clamp : { false, true })
+    {
+      const Problem p(basis, 20011, rng);
+      std::vector<double> g(p.Points.size());
+      double gradientSize = 0.0;
+      for (double& v : g)
+      {
+        v = unit(rng);
+        gradientSize += std::fabs(v);
+      }
+      std::vector<double> expected, sizes;
+      if (basis == int(ffd::GridBasis::Bernstein))
+      {
+        HostAdjoint<ffd::MaxBernsteinDegree + 1>(p, clamp, g, expected, sizes);
+      }
+      else
+      {
+        HostAdjoint<4>(p, clamp, g, expected, sizes);
+      }
+      std::uint64_t plans = 0;
+      const std::vector<double> got = DeviceAdjoint<Real>(p, clamp, g, &plans, 2);
+      EXPECT_EQ(plans, 1u) << "one plan for two calls on one binding";
+      double l1 = 0.0;
+      ffdtest::Mismatches wrong;
+      for (std::int64_t c = 0; c < p.ControlPoints(); ++c)
+      {
+        for (int k = 0; k < 3; ++k)
+        {
+          l1 += std::fabs(got[3 * c + k] - expected[3 * c + k]);
+          if (!single)
+          {
+            const double tolerance = (2.0 * double(p.Count()) + 32.0) * 1.1102230246251565e-16 * sizes[c];
+            wrong.Check("sensitivity", c, got[3 * c + k], expected[3 * c + k], tolerance);
+          }
+        }
+      }
+      EXPECT_EQ(wrong.Count, 0) << "basis " << basis << (clamp ? " clamped" : " kept") << ": " << wrong.First;
+      EXPECT_LE(l1, (single ? 1.5e-4 : 1e-12) * gradientSize) << "basis " << basis;
+      const std::vector<double> again = DeviceAdjoint<Real>(p, clamp, g);
+      EXPECT_EQ(std::memcmp(got.data(), again.data(), got.size() * sizeof(double)), 0)
+        << "basis " << basis << ": not the same bits on a fresh deformer";
+    }
+  }
+}
+
+// No point bound (all outside, kept): every sensitivity is 0, none left unwritten.
+TEST(CudaGridDeformer, AdjointOfNoBoundPointIsZero)
+{
+  FFD_REQUIRE_DEVICE();
+  std::mt19937 rng(5);
+  Problem p(int(ffd::GridBasis::CubicBSpline), 100, rng);
+  for (double& v : p.Points)
+  {
+    v += 1000.0;
+  }
+  const std::vector<double> g(p.Points.size(), 1.0);
+  const std::vector<double> sums = DeviceAdjoint<float>(p, false, g);
+  EXPECT_EQ(std::count(sums.begin(), sums.end(), 0.0), std::ptrdiff_t(sums.size()));
 }
 
 // Failures are reported, leave no device state behind, and a later use starts clean.

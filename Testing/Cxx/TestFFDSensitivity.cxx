@@ -258,6 +258,52 @@ TEST(vtkFFDSensitivity, SameBitsForAnyNumberOfThreads)
   }
 }
 
+// With SetDeform(), the sums use the vtkFFDDeform's binding (on the host, or on the device where CUDA deforms) and
+// its outside policy: no second binding, the same bits as a binding of the filter's own under that policy, and the
+// deformation's next update binds nothing either.
+TEST(vtkFFDSensitivity, ReusesTheDeformsBinding)
+{
+  vtkSmartPointer<vtkPolyData> bear = ReadTestMesh("bear");
+  std::mt19937 rng(11);
+  vtkSmartPointer<vtkPolyData> cloud = CloudWithGradient(bear, 300, rng);
+  const int n[3] = { 3, 4, 3 };
+  std::vector<vtkSmartPointer<vtkPointSet>> lattices = { ffdtest::MovedLattice(bear, vtkFFDBuildLattice::CUBIC_BSPLINE,
+                                                           n, vtkFFDBuildLattice::DENSE, rng),
+    ffdtest::MovedLattice(bear, vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, n, vtkFFDBuildLattice::SPARSE, rng),
+    MovedTetrahedra(bear, rng) };
+  for (vtkPointSet* lattice : lattices)
+  {
+    vtkNew<vtkFFDDeform> deform;
+    deform->SetInputData(cloud);
+    deform->SetLatticeData(lattice);
+    deform->SetOutsidePolicy(vtkFFDDeform::CLAMP_TO_EDGE);
+    deform->Update();
+    ASSERT_EQ(deform->GetNumberOfBindings(), 1);
+    vtkNew<vtkFFDSensitivity> sensitivity;
+    sensitivity->SetInputData(cloud);
+    sensitivity->SetLatticeData(lattice);
+    sensitivity->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "g");
+    sensitivity->SetDeform(deform);
+    sensitivity->Update();
+    EXPECT_EQ(sensitivity->GetNumberOfBindings(), 0) << lattice->GetClassName();
+    vtkDataArray* shared =
+      vtkPointSet::SafeDownCast(sensitivity->GetOutputDataObject(0))->GetPointData()->GetArray("Sensitivity");
+    vtkSmartPointer<vtkDataArray> own = Sensitivity(cloud, lattice, vtkFFDDeform::CLAMP_TO_EDGE);
+    ASSERT_TRUE(shared && own);
+    EXPECT_EQ(std::memcmp(vtkDoubleArray::SafeDownCast(shared)->GetPointer(0),
+                vtkDoubleArray::SafeDownCast(own)->GetPointer(0), 3 * own->GetNumberOfTuples() * sizeof(double)),
+      0)
+      << lattice->GetClassName() << ": not the sums of the filter's own binding";
+    lattice->GetPoints()->Modified(); // a moved lattice: the deformation evaluates again, without binding
+    deform->Update();
+    EXPECT_EQ(deform->GetNumberOfBindings(), 1) << lattice->GetClassName();
+    if (!vtkUnstructuredGrid::SafeDownCast(lattice))
+    {
+      EXPECT_STREQ(sensitivity->GetLastBackendUsed(), deform->GetLastBackendUsed());
+    }
+  }
+}
+
 TEST(vtkFFDSensitivity, BadInputIsAnErrorAndAnEmptyOutput)
 {
   vtkSmartPointer<vtkPolyData> bear = ReadTestMesh("bear");
