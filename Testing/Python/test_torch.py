@@ -15,7 +15,8 @@ float32 bounds (u32 = 2^-24, u = 2^-53), per mesh point i with m weights: the fo
 control points rounded to float32 (|P - fl32(P)| <= u32 |P|), so it differs from float64 by at most
 (m + 8) u32 (max|x_i| + sum_c |W_ic| max|D_c|) + u32 sum_c |W_ic| max|P_c| (the first term as the float64 grid
 bound of test_weight_matrix). The backward sums W.T fl32(g) in float64, then rounds to float32: within
-(2 u32 + 2 k u) |W|.T |g| of W.T g, k the column's entries. Fixed seeds.
+(2 u32 + 2 (k + 8) u) |W|.T |g| of W.T g, k the column's entries (+ 8: the weights of a CUDA device may differ
+from the host's by a few u, as in test_weight_matrix). Fixed seeds.
 
 Run with Debian's /usr/bin/python3 (with python3-torch), PYTHONPATH=<build>/lib/python3/dist-packages and
 VOXELFFD_MESH_DIR set (ctest does both). Exits non-zero when a test fails.
@@ -143,7 +144,7 @@ class TorchTest(unittest.TestCase):
                 Pt = torch.tensor(P, requires_grad=True)
                 vtkffd.torch.deform(mesh, lattice, Pt).backward(torch.from_numpy(g))
                 k = np.diff(W.tocsc().indptr)[:, None]
-                bound = 2 * k * U * (abs(W).T @ np.abs(g))
+                bound = 2 * (k + 8) * U * (abs(W).T @ np.abs(g))
                 self.assertTrue(np.all(np.abs(Pt.grad.numpy() - W.T @ g) <= bound))
 
     def test_float32_agrees_with_float64(self):
@@ -173,7 +174,7 @@ class TorchTest(unittest.TestCase):
                 X32.backward(g.float())
                 self.assertEqual(P32.grad.dtype, torch.float32)
                 k = np.diff(W.tocsc().indptr)[:, None]
-                bound = (2 * U32 + 2 * k * U) * (abs(W).T @ np.abs(g.numpy()))
+                bound = (2 * U32 + 2 * (k + 8) * U) * (abs(W).T @ np.abs(g.numpy()))
                 error = np.abs(P32.grad.numpy().astype(np.float64) - P64.grad.numpy())
                 self.assertTrue(np.all(error <= bound), f"backward: {(error / np.maximum(bound, 1e-300)).max():.3g} "
                                 "times the bound")

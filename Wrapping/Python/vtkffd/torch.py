@@ -79,7 +79,14 @@ class Deformation:
         self._deform.SetLatticeData(self._lattice)
         self._deform.SetOutsidePolicy(outside_policy)
 
+        # The adjoint's mesh: float64 points, so that its weights are float64 on every backend (vtkFFDSensitivity
+        # computes them on a CUDA device in the precision of the points it binds).
         self._mesh = _copy_structure(mesh)
+        if self.point_count:
+            rest = vtkPoints()
+            rest.SetDataTypeToDouble()
+            rest.DeepCopy(mesh.GetPoints())
+            self._mesh.SetPoints(rest)
         gradient = vtkDoubleArray()
         gradient.SetName(GRADIENT_NAME)
         gradient.SetNumberOfComponents(3)
