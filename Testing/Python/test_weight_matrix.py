@@ -6,7 +6,8 @@ reference, on the bear and on random points around its frame (so that the outsid
 - W @ (P - P_rest) is vtkFFDDeform's displacement of the mesh, in float64, for every grid basis, dense and sparse,
   and tetrahedral lattices, under every outside policy;
 - W.T @ g is vtkFFDSensitivity's dJ/dP;
-- a row's weights sum to 1 (partition of unity) for every point with weights; a point kept outside has none;
+- a row's weights sum to 1 (partition of unity) for every point with weights; a point kept outside, or not
+  finite, has none;
 - the sparse form's W is the dense form's, its columns renumbered, bit for bit (the data contract's promise);
 - the trilinear W is the tensor product of linear weights computed here in numpy (an independent reference);
 - bad input raises, naming what is wrong.
@@ -218,6 +219,22 @@ class WeightMatrixTest(unittest.TestCase):
                     self.assertLess(W.data.min(), 0.0)
                 else:
                     self.assertGreaterEqual(W.data.min(), -1e-12)
+
+    def test_points_not_finite_have_empty_rows(self):
+        x = points_of(self.bear)
+        x[5] = np.nan
+        x[7, 1] = np.inf
+        mesh = point_set(x)
+        build = vtkffd.vtkFFDBuildTetrahedralLattice()
+        build.SetInputData(self.bear)
+        build.Update()
+        for lattice, policies in ((build_lattice(self.bear, DIVISIONS, Build.CUBIC_BSPLINE)[2], GRID_POLICIES),
+                                  (build.GetOutput(), TETRAHEDRAL_POLICIES)):
+            for policy in policies:
+                with self.subTest(lattice=lattice.GetClassName(), policy=policy):
+                    W = vtkffd.sparse.weight_matrix(mesh, lattice, policy)
+                    self.assertEqual(np.diff(W.indptr)[[4, 5, 6, 7]].tolist(), [W.indptr[1], 0, W.indptr[1], 0])
+                    self.assertTrue(np.isfinite(W.data).all())
 
     def test_empty_mesh_gives_an_empty_matrix(self):
         voxelize, build, lattice = build_lattice(self.bear, DIVISIONS, Build.CUBIC_BSPLINE)
