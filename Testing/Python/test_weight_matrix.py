@@ -19,8 +19,8 @@ power form), each product carrying the roundings of its weight (the parameters t
 basis polynomials), its multiplications and the sum; the filter's X - x adds u |X| more. Grids are allowed
 (m + 8) u s_i (measured: at most 17 u s_i, triquadratic cells, 5 u s_i for the others). A tetrahedron's weights and
 the filter's affine map of it both go through the inverse of its rest edge matrix, whose rounding grows with its
-condition number kappa: allowed 8 (1 + kappa) u s_i (measured: at most kappa u s_i). For W.T @ g, a column of k entries summed in
-two orders differs by at most 2 k u sum |w| |g|; allowed 2 (k + 8) u sum |w| |g|, as the weights agree bit for
+condition number kappa: allowed 8 (1 + kappa) u s_i (measured: at most kappa u s_i). For W.T @ g, a column of k
+entries summed in two orders differs by at most 2 k u sum |w| |g|; allowed 2 (k + 8) u sum |w| |g|, as the weights agree bit for
 bit on the CPU but may differ by a few u where vtkFFDSensitivity sums on a CUDA device. Row sums: m terms of
 magnitude |w|, within m u sum |w| + u of 1. Fixed seeds.
 
