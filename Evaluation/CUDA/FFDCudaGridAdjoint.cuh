@@ -27,7 +27,6 @@ namespace cuda
 namespace detail
 {
 constexpr int AdjointThreads = 128; // a chunk's block
-constexpr int AdjointTile = 32;     // points whose weights a block holds in shared memory at once
 
 /// The plan of the adjoint of one binding (see the file's description), on the device.
 struct AdjointPlan
@@ -47,11 +46,11 @@ struct AdjointPlan
   Buffer Keys, Values, Flags, Scratch;
 };
 
-/// Points per chunk: 256, more where the partials (chunks x K terms) would pass 2^22 terms (the global basis).
+/// Points per chunk: 1024, more where the partials (chunks x K terms) would pass 2^22 terms (the global basis).
 inline std::int64_t AdjointChunkPoints(std::int64_t points, int terms)
 {
   const std::int64_t byTerms = (points * terms + (std::int64_t(1) << 22) - 1) >> 22;
-  return byTerms > 256 ? byTerms : 256;
+  return byTerms > 1024 ? byTerms : 1024;
 }
 
 /**
@@ -89,75 +88,156 @@ __global__ void AdjointTermKernel(const Real* __restrict__ points, const int* __
 }
 
 /**
- * Partials[3 (chunk K + k) + c] = sum over the chunk's points p of w_k(p) g_p[c], in float64. A block per chunk
- * (blockIdx.x) and per slice of `slots` terms (blockIdx.y; more than one for the global basis only). Where the
- * terms are fewer than the threads, `groups` threads share a term: group g sums the tile's points g, g + groups,
- * ..., and the groups' sums are added in group order: an order set by K alone. Each tile's weights are computed
- * once (WeightsAt(), as the evaluation's) into shared memory; a term's weight is W0[i] W1[j] W2[l], the product
- * in ForEachWeight()'s order.
+ * How AdjointChunkKernel shares a chunk's terms (i, j, l), K = c0 c1 c2 of them, among blocks and threads: the
+ * pairs (j, l), numbered jl = j + c1 l, go by `Columns` consecutive ones to a block (all c1 c2 of a local basis's
+ * in one; blockIdx.y numbers them), a term a thread, `Slots` = c0 Columns of them; where those are fewer than the
+ * threads, `Groups` threads share a term, each summing every Groups-th point of a tile. A tile is `Tile` points
+ * (one a thread, fewer where their products would pass 40 KiB of shared memory). All are set by the basis's
+ * counts and the precision alone, and so is the order of the sums.
+ */
+struct AdjointLayout
+{
+  int C[3], Columns, Slots, Groups, Tile, WsgStride, WtuStride;
+
+  AdjointLayout(const int counts[3], std::size_t realBytes)
+    : C{ counts[0], counts[1], counts[2] }
+  {
+    const int columns = AdjointThreads / counts[0], pairs = counts[1] * counts[2];
+    this->Columns = columns < 1 ? 1 : (columns > pairs ? pairs : columns);
+    this->Slots = counts[0] * this->Columns;
+    this->Groups = this->Slots >= AdjointThreads ? 1 : AdjointThreads / this->Slots;
+    // Odd strides: the threads of a warp write their points' products to distinct banks.
+    this->WsgStride = 3 * counts[0] | 1;
+    this->WtuStride = this->Columns | 1;
+    const std::size_t fit = (std::size_t(40) << 10) / (std::size_t(this->WsgStride + this->WtuStride) * realBytes);
+    this->Tile = int(fit < 1 ? 1 : (fit > std::size_t(AdjointThreads) ? std::size_t(AdjointThreads) : fit));
+  }
+  int ColumnBlocks() const { return (this->C[1] * this->C[2] + this->Columns - 1) / this->Columns; }
+  std::size_t SharedBytes(std::size_t realBytes) const
+  {
+    return std::size_t(this->Tile) * std::size_t(this->WsgStride + this->WtuStride) * realBytes;
+  }
+};
+
+/// A point's products for AdjointChunkKernel: wsg[3 i + c] = W0[i] g[c], wtu[m] = W1[j] W2[l] for the block's
+/// pairs jl = jl0 + m. Unrolled for the local bases (every index of the weights a constant: they stay in
+/// registers).
+template <int MaxCount, typename Real>
+__device__ __forceinline__ void StoreTermProducts(const ffd::AxisWeights<MaxCount, Real>* axes, const Real g[3],
+  const AdjointLayout& layout, int jl0, Real* wsg, Real* wtu)
+{
+  const int c0 = layout.C[0], c1 = layout.C[1], c2 = layout.C[2];
+  if constexpr (MaxCount <= 4)
+  {
+    FFD_UNROLL
+    for (int n = 0; n < MaxCount; ++n)
+    {
+      if (n < c0)
+      {
+        wsg[3 * n] = axes[0].W[n] * g[0];
+        wsg[3 * n + 1] = axes[0].W[n] * g[1];
+        wsg[3 * n + 2] = axes[0].W[n] * g[2];
+      }
+    }
+    FFD_UNROLL
+    for (int l = 0; l < MaxCount; ++l)
+    {
+      FFD_UNROLL
+      for (int j = 0; j < MaxCount; ++j)
+      {
+        const int m = j + c1 * l - jl0;
+        if (j < c1 && l < c2 && m >= 0 && m < layout.Columns)
+        {
+          wtu[m] = axes[1].W[j] * axes[2].W[l];
+        }
+      }
+    }
+  }
+  else
+  {
+    for (int n = 0; n < c0; ++n)
+    {
+      wsg[3 * n] = axes[0].W[n] * g[0];
+      wsg[3 * n + 1] = axes[0].W[n] * g[1];
+      wsg[3 * n + 2] = axes[0].W[n] * g[2];
+    }
+    for (int m = 0; m < layout.Columns && jl0 + m < c1 * c2; ++m)
+    {
+      wtu[m] = axes[1].W[(jl0 + m) % c1] * axes[2].W[(jl0 + m) / c1];
+    }
+  }
+}
+
+/**
+ * Partials[3 (chunk K + k) + c] = sum over the chunk's points p of w_k(p) g_p[c], the sum in float64: a block per
+ * chunk (blockIdx.x) and block of columns (blockIdx.y), threads as AdjointLayout says. For a tile of points, a
+ * thread a point computes its weights (WeightsAt(), as the evaluation's) and the products W0[i] g[c] and
+ * W1[j] W2[l] into shared memory, so that a term costs its thread four loads and three multiply-adds a point:
+ * w_k g = (W1[j] W2[l]) (W0[i] g). A thread sums its group's points of a tile in the points' precision Real and
+ * adds that to its float64 sum; the groups' sums are added in group order.
  */
 template <typename Deformation, typename Real, int MaxCount>
-__global__ void __launch_bounds__(AdjointThreads)
-  AdjointChunkKernel(const Real* __restrict__ points, const int* __restrict__ order,
-    const std::int64_t* __restrict__ chunkStart, const int* __restrict__ chunkCell, const Real* __restrict__ gradient,
-    int c0, int c1, int c2, int slots, int groups, Deformation deformation, double* __restrict__ partials)
+__global__ void __launch_bounds__(AdjointThreads) AdjointChunkKernel(const Real* __restrict__ points,
+  const int* __restrict__ order, const std::int64_t* __restrict__ chunkStart, const int* __restrict__ chunkCell,
+  const Real* __restrict__ gradient, AdjointLayout layout, Deformation deformation, double* __restrict__ partials)
 {
-  __shared__ Real weights[3][AdjointTile][MaxCount];
-  __shared__ Real g[AdjointTile][3];
-  __shared__ double sums[AdjointThreads][3];
+  extern __shared__ double shared[];
+  Real* wsg = reinterpret_cast<Real*>(shared);
+  Real* wtu = wsg + layout.WsgStride * layout.Tile;
+  __shared__ double groupSums[AdjointThreads][3];
   const std::int64_t chunk = blockIdx.x;
   const int cell = chunkCell[chunk];
   const std::int64_t begin = chunkStart[chunk], end = chunkStart[chunk + 1];
-  const int terms = c0 * c1 * c2, slot = threadIdx.x % slots, group = threadIdx.x / slots;
-  const int k = blockIdx.y * slots + slot;
-  const bool active = group < groups && k < terms;
-  const int i = k % c0, j = (k / c0) % c1, l = k / (c0 * c1);
+  const int c0 = layout.C[0], jl0 = blockIdx.y * layout.Columns;
+  const int slot = threadIdx.x % layout.Slots, group = threadIdx.x / layout.Slots;
+  const int i = slot % c0, m = slot / c0;
+  const bool active = group < layout.Groups && jl0 + m < layout.C[1] * layout.C[2];
   double sum[3] = { 0.0, 0.0, 0.0 };
-  for (std::int64_t tile = begin; tile < end; tile += AdjointTile)
+  for (std::int64_t first = begin; first < end; first += layout.Tile)
   {
-    const int inTile = int(end - tile < AdjointTile ? end - tile : AdjointTile);
+    const int inTile = int(end - first < layout.Tile ? end - first : layout.Tile);
     if (threadIdx.x < inTile)
     {
-      const std::int64_t p = order[tile + threadIdx.x];
+      const std::int64_t p = order[first + threadIdx.x];
       ffd::AxisWeights<MaxCount, Real> axes[3];
       deformation.WeightsAt(ffd::Vec3<Real>::From(points + 3 * p), cell, axes);
-      for (int a = 0; a < 3; ++a)
-      {
-        for (int n = 0; n < axes[a].Count; ++n)
-        {
-          weights[a][threadIdx.x][n] = axes[a].W[n];
-        }
-        g[threadIdx.x][a] = gradient[3 * p + a];
-      }
+      const Real g[3] = { gradient[3 * p], gradient[3 * p + 1], gradient[3 * p + 2] };
+      StoreTermProducts(
+        axes, g, layout, jl0, wsg + threadIdx.x * layout.WsgStride, wtu + threadIdx.x * layout.WtuStride);
     }
     __syncthreads();
     if (active)
     {
-      for (int p = group; p < inTile; p += groups)
+      Real partial[3] = { Real(0), Real(0), Real(0) };
+      for (int p = group; p < inTile; p += layout.Groups)
       {
-        const double w = double(weights[0][p][i] * weights[1][p][j] * weights[2][p][l]);
-        sum[0] += w * double(g[p][0]);
-        sum[1] += w * double(g[p][1]);
-        sum[2] += w * double(g[p][2]);
+        const Real w = wtu[p * layout.WtuStride + m];
+        const Real* a = wsg + p * layout.WsgStride + 3 * i;
+        partial[0] += w * a[0];
+        partial[1] += w * a[1];
+        partial[2] += w * a[2];
       }
+      sum[0] += double(partial[0]);
+      sum[1] += double(partial[1]);
+      sum[2] += double(partial[2]);
     }
     __syncthreads();
   }
   for (int c = 0; c < 3; ++c)
   {
-    sums[threadIdx.x][c] = sum[c];
+    groupSums[threadIdx.x][c] = sum[c];
   }
   __syncthreads();
   if (active && group == 0)
   {
-    for (int other = 1; other < groups; ++other)
+    for (int other = 1; other < layout.Groups; ++other)
     {
       for (int c = 0; c < 3; ++c)
       {
-        sum[c] += sums[other * slots + slot][c];
+        sum[c] += groupSums[other * layout.Slots + slot][c];
       }
     }
-    double* out = partials + 3 * (chunk * terms + k);
+    double* out = partials + 3 * (chunk * (c0 * layout.C[1] * layout.C[2]) + i + c0 * (jl0 + m));
     out[0] = sum[0];
     out[1] = sum[1];
     out[2] = sum[2];

@@ -645,14 +645,14 @@ struct GridDeformer::Impl : ResidentPoints::State
     Check(cudaMemcpy(plan.Gradient.Data, g.data(), g.size() * sizeof(Real), cudaMemcpyHostToDevice),
       "uploading the gradient");
     Check(cudaEventRecord(this->KernelStart, this->Stream), "recording an event");
-    const int slots = std::min(plan.Terms, detail::AdjointThreads);
     if (plan.Chunks > 0)
     {
-      const dim3 blocks(unsigned(plan.Chunks), unsigned((plan.Terms + slots - 1) / slots));
-      detail::AdjointChunkKernel<Deformation, Real, MaxCount><<<blocks, detail::AdjointThreads, 0, this->Stream>>>(
-        this->Points.As<Real>(), plan.Order.As<int>(), plan.ChunkStart.As<std::int64_t>(), plan.ChunkCell.As<int>(),
-        plan.Gradient.As<Real>(), plan.Counts[0], plan.Counts[1], plan.Counts[2], slots, detail::AdjointThreads / slots,
-        deformation, plan.Partials.As<double>());
+      const detail::AdjointLayout layout(plan.Counts, sizeof(Real));
+      const dim3 blocks(unsigned(plan.Chunks), unsigned(layout.ColumnBlocks()));
+      detail::AdjointChunkKernel<Deformation, Real, MaxCount>
+        <<<blocks, detail::AdjointThreads, layout.SharedBytes(sizeof(Real)), this->Stream>>>(this->Points.As<Real>(),
+          plan.Order.As<int>(), plan.ChunkStart.As<std::int64_t>(), plan.ChunkCell.As<int>(), plan.Gradient.As<Real>(),
+          layout, deformation, plan.Partials.As<double>());
       Check(cudaGetLastError(), "launching the adjoint");
     }
     detail::GatherAdjoint(plan, controlPoints, this->Stream);
