@@ -179,8 +179,7 @@ const Basis Bases[] = { Basis::Bernstein, Basis::Trilinear, Basis::TriquadraticB
 // certificate's corners are among the samples; 1e-9 relative covers the reference's rounding, ~1e-14, and the
 // B-spline's last sample a hair inside the face, ~1e-12). Each basis sees certified, folded and (over all
 // bases) undecided cells, so that every claim is exercised; cells clearly unfolded (sampled minimum above 0.2)
-// are certified at least 85 % of the time (87 % to 99 % here, depending on the basis), so the certificate is not
-// vacuous.
+// are certified at least 99 % of the time (all of them here), so the certificate is not vacuous.
 TEST(FoldCertificate, AgreesWithDenseSampling)
 {
   std::mt19937 rng(20261129);
@@ -217,7 +216,7 @@ TEST(FoldCertificate, AgreesWithDenseSampling)
               << " clearly unfolded, " << clearCertified << " of them certified\n";
     EXPECT_GT(certified, Trials / 10) << "basis " << int(basis);
     EXPECT_GT(folded, Trials / 10) << "basis " << int(basis);
-    EXPECT_GE(clearCertified, 0.85 * clear) << "basis " << int(basis);
+    EXPECT_GE(clearCertified, 0.99 * clear) << "basis " << int(basis);
   }
   std::cout << undecided << " undecided\n";
   EXPECT_GT(undecided, 0);
