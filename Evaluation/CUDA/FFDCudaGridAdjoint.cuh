@@ -15,6 +15,7 @@
 #ifndef FFDCudaGridAdjoint_cuh
 #define FFDCudaGridAdjoint_cuh
 
+#include "FFDAdjoint.h"
 #include "FFDCudaDevice.cuh"
 #include "FFDGridDeformation.h"
 
@@ -32,7 +33,7 @@ constexpr int AdjointThreads = 128; // a chunk's block
 struct AdjointPlan
 {
   std::uint64_t ForBinding = 0; // Counters::Bindings when made; 0: none
-  std::int64_t ChunkPoints = 0; // AdjointChunkPoints()
+  std::int64_t ChunkPoints = 0; // ffd::AdjointChunkPoints()
   std::int64_t Chunks = 0;
   int Terms = 0;         // K, control points of a cell's support
   int Counts[3] = {};    // K along each axis (i fastest)
@@ -45,13 +46,6 @@ struct AdjointPlan
   Buffer Sums, Gradient; // double, 3 per control point; the gradient, 3 per point in the points' precision
   Buffer Keys, Values, Flags, Scratch;
 };
-
-/// Points per chunk: 1024, more where the partials (chunks x K terms) would pass 2^22 terms (the global basis).
-inline std::int64_t AdjointChunkPoints(std::int64_t points, int terms)
-{
-  const std::int64_t byTerms = (points * terms + (std::int64_t(1) << 22) - 1) >> 22;
-  return byTerms > 1024 ? byTerms : 1024;
-}
 
 /**
  * The plan's first part, up to the chunks (Order, ChunkStart, ChunkCell, Chunks): `cells` are the binding's,

@@ -616,7 +616,7 @@ struct GridDeformer::Impl : ResidentPoints::State
       plan.Counts[a] = ffd::SupportSize(this->Basis, this->Divisions[a]);
     }
     plan.Terms = plan.Counts[0] * plan.Counts[1] * plan.Counts[2];
-    plan.ChunkPoints = detail::AdjointChunkPoints(this->Count, plan.Terms);
+    plan.ChunkPoints = ffd::AdjointChunkPoints(this->Count, plan.Terms);
     detail::SortAdjointPoints(plan, this->Cells.As<int>(), this->Count, this->Stream);
     const std::int64_t terms = plan.Chunks * plan.Terms;
     plan.Keys.Reserve(std::size_t(terms) * sizeof(int), "allocating the adjoint's plan");

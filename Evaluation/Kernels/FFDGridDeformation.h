@@ -167,6 +167,7 @@ struct GridDeformation
   static_assert(!WithCellTable || StaticBasis != int(GridBasis::Bernstein), "a cell table is for a local basis");
 
   using Value = Real; ///< the displacements' type
+  static constexpr int MaxWeights = MaxCount; ///< the size of its AxisWeights
 
   GridBasis Basis;
   int Voxels[3];             ///< the lattice's divisions

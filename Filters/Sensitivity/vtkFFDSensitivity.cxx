@@ -2,12 +2,15 @@
 #include "vtkFFDSensitivity.h"
 
 #include "vtkFFDCudaBackend.h"
+#include "vtkFFDGridAdjoint.h"
 #include "vtkFFDGridDeformer.h"
+#include "vtkFFDGroupedIds.h"
 #include "vtkFFDInputChecks.h"
 #include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDTetrahedralDeformer.h"
 
+#include "vtkArrayDispatch.h"
 #include "vtkDataArray.h"
 #include "vtkDataArrayRange.h"
 #include "vtkDoubleArray.h"
@@ -30,12 +33,21 @@ vtkStandardNewMacro(vtkFFDSensitivity);
 
 namespace
 {
-// The 3-component values of an array as float64, point after point.
+// The 3-component values of an array as float64, point after point (typed: no virtual call a value).
 std::vector<double> AsDoubles(vtkDataArray* array)
 {
   std::vector<double> values(3 * static_cast<std::size_t>(array->GetNumberOfTuples()));
-  const auto range = vtk::DataArrayValueRange<3>(array);
-  std::copy(range.begin(), range.end(), values.begin());
+  auto copy = [&](auto* typed)
+  {
+    const auto range = vtk::DataArrayValueRange<3>(typed);
+    vtkSMPTools::For(0, vtkIdType(values.size()),
+      [&](vtkIdType begin, vtkIdType end)
+      { std::copy(range.begin() + begin, range.begin() + end, values.begin() + begin); });
+  };
+  if (!vtkArrayDispatch::Dispatch::Execute(array, copy))
+  {
+    copy(array);
+  }
   return values;
 }
 
@@ -48,125 +60,6 @@ inline void AddTerm(double* sums, int controlPoint, double w, const double* g)
   target[2] += w * g[2];
 }
 
-// Ids grouped by key, in increasing id within each group: the ids of key k are Order[Start[k]] ..
-// Order[Start[k + 1] - 1]; negative keys are left out. A counting sort: the same grouping for any number of
-// threads. `keys` is at least 1 + the largest key. (Points by cell, a lattice's corners by node.)
-struct GroupedIds
-{
-  std::vector<vtkIdType> Start, Order;
-
-  template <typename Key>
-  GroupedIds(const std::vector<Key>& keyOf, std::size_t keys)
-    : Start(keys + 1, 0)
-  {
-    for (Key k : keyOf)
-    {
-      this->Start[std::size_t(k) + 1] += k >= 0 ? 1 : 0;
-    }
-    for (std::size_t k = 0; k < keys; ++k)
-    {
-      this->Start[k + 1] += this->Start[k];
-    }
-    this->Order.resize(this->Start[keys]);
-    std::vector<vtkIdType> next(this->Start.begin(), this->Start.end() - 1);
-    for (std::size_t id = 0; id < keyOf.size(); ++id)
-    {
-      if (keyOf[id] >= 0)
-      {
-        this->Order[next[keyOf[id]]++] = vtkIdType(id);
-      }
-    }
-  }
-  /// The ids bound to a cell (keys 0 .. largest).
-  explicit GroupedIds(const std::vector<int>& cellOf)
-    : GroupedIds(
-        cellOf, cellOf.empty() ? 0 : 1 + std::size_t(std::max(0, *std::max_element(cellOf.begin(), cellOf.end()))))
-  {
-  }
-  int Groups() const { return int(this->Start.size()) - 1; }
-};
-
-// W^T g for a local basis: the cells coloured by their indices modulo `period` along each axis (cells of one colour
-// share no control point: a support spans `period` cells or fewer), colours one after the other, the cells of one
-// colour in parallel, each adding its points' terms in increasing id. Every control point so receives its terms
-// in one order, whatever the threads.
-template <typename Deformation>
-void ColouredSums(const Deformation& deformation, const GroupedIds& byCell, int period, const std::vector<double>& x,
-  const std::vector<double>& g, std::vector<double>& out)
-{
-  std::vector<std::vector<int>> byColour(std::size_t(period * period * period));
-  for (int cell = 0; cell < byCell.Groups(); ++cell)
-  {
-    if (byCell.Start[cell + 1] > byCell.Start[cell])
-    {
-      int c[3];
-      deformation.CellIndices(cell, c);
-      byColour[c[0] % period + period * (c[1] % period + period * (c[2] % period))].push_back(cell);
-    }
-  }
-  for (const std::vector<int>& cells : byColour)
-  {
-    vtkSMPTools::For(0, vtkIdType(cells.size()),
-      [&](vtkIdType begin, vtkIdType end)
-      {
-        for (vtkIdType k = begin; k < end; ++k)
-        {
-          const int cell = cells[k];
-          for (vtkIdType o = byCell.Start[cell]; o < byCell.Start[cell + 1]; ++o)
-          {
-            const std::size_t p = std::size_t(byCell.Order[o]);
-            const double* gp = &g[3 * p];
-            deformation.ForEachWeight({ x[3 * p], x[3 * p + 1], x[3 * p + 2] }, cell,
-              [&](int controlPoint, double w) { AddTerm(out.data(), controlPoint, w, gp); });
-          }
-        }
-      });
-  }
-}
-
-// W^T g for the global basis (one cell): fixed chunks of points, their number set by the point count alone, each
-// summed in increasing id into a partial gradient, then the partials added in chunk order.
-template <typename Deformation>
-void ChunkedSums(const Deformation& deformation, const std::vector<int>& cellOf, const std::vector<double>& x,
-  const std::vector<double>& g, std::vector<double>& out)
-{
-  const vtkIdType n = vtkIdType(cellOf.size());
-  const vtkIdType chunks = std::max<vtkIdType>(1, std::min<vtkIdType>(256, (n + 4095) / 4096));
-  const vtkIdType size = (n + chunks - 1) / chunks;
-  const std::size_t values = out.size();
-  std::vector<double> partial(std::size_t(chunks) * values, 0.0);
-  vtkSMPTools::For(0, chunks,
-    [&](vtkIdType begin, vtkIdType end)
-    {
-      for (vtkIdType chunk = begin; chunk < end; ++chunk)
-      {
-        double* sums = &partial[std::size_t(chunk) * values];
-        for (vtkIdType p = chunk * size; p < std::min(n, (chunk + 1) * size); ++p)
-        {
-          if (cellOf[p] < 0)
-          {
-            continue;
-          }
-          const double* gp = &g[3 * std::size_t(p)];
-          deformation.ForEachWeight({ x[3 * p], x[3 * p + 1], x[3 * p + 2] }, cellOf[p],
-            [&](int controlPoint, double w) { AddTerm(sums, controlPoint, w, gp); });
-        }
-      }
-    });
-  vtkSMPTools::For(0, vtkIdType(values),
-    [&](vtkIdType begin, vtkIdType end)
-    {
-      for (vtkIdType v = begin; v < end; ++v)
-      {
-        double sum = 0.0;
-        for (vtkIdType chunk = 0; chunk < chunks; ++chunk)
-        {
-          sum += partial[std::size_t(chunk) * values + std::size_t(v)];
-        }
-        out[v] = sum;
-      }
-    });
-}
 // W^T g for a tetrahedral lattice. A point moves by its tetrahedron's barycentric weights at the point, or, clamped
 // to the control mesh, at its nearest point there (as ApplyClampedPoints()). Each tetrahedron sums its points'
 // terms in increasing id (in parallel over tetrahedra), then each node adds its tetrahedra's sums in increasing
@@ -186,7 +79,7 @@ void TetrahedralSums(const vtkFFDTetrahedralDeformer& tetrahedra, const std::vec
     cellOf[clamped.Point] = clamped.Tetrahedron;
     at[clamped.Point] = clamped.Closest;
   }
-  const GroupedIds byTetrahedron(cellOf);
+  const vtkFFDGroupedIds byTetrahedron(cellOf);
   const vtkIdType count = tetrahedra.GetNumberOfTetrahedra();
   std::vector<double> corners(12 * std::size_t(count), 0.0); // per tetrahedron, 3 per node
   vtkSMPTools::For(0, std::min<vtkIdType>(count, byTetrahedron.Groups()),
@@ -209,7 +102,7 @@ void TetrahedralSums(const vtkFFDTetrahedralDeformer& tetrahedra, const std::vec
     });
   // The node's corners (4 t + i), in increasing tetrahedron order.
   const std::size_t nodeCount = out.size() / 3;
-  const GroupedIds byNode(tetrahedra.GetNodes(), nodeCount);
+  const vtkFFDGroupedIds byNode(tetrahedra.GetNodes(), nodeCount);
   vtkSMPTools::For(0, vtkIdType(nodeCount),
     [&](vtkIdType begin, vtkIdType end)
     {
@@ -231,6 +124,7 @@ void TetrahedralSums(const vtkFFDTetrahedralDeformer& tetrahedra, const std::vec
 struct vtkFFDSensitivity::vtkInternals
 {
   vtkNew<vtkFFDDeform> Own; // whose binding the sums use without a Deform
+  vtkFFDGridAdjoint Grid;   // the CPU's plan of a grid's sums, per binding
 };
 
 vtkFFDSensitivity::vtkFFDSensitivity()
@@ -370,20 +264,11 @@ bool vtkFFDSensitivity::SumGrid(
     return false;
   }
   this->NumberOfBindings += rebound ? 1 : 0;
-  const std::vector<double> x = AsDoubles(mesh->GetPoints()->GetData());
-  const ffd::GridBasis basis = grid.GetLattice().Basis;
-  std::fill(sums.begin(), sums.end(), 0.0);
-  vtkFFDWithGridDeformation(grid,
-    [&](const auto& deformation)
-    {
-      if (basis == ffd::GridBasis::Bernstein)
-      {
-        ChunkedSums(deformation, grid.GetCellOfPoint(), x, g, sums);
-        return;
-      }
-      ColouredSums(
-        deformation, GroupedIds(grid.GetCellOfPoint()), basis == ffd::GridBasis::CubicBSpline ? 4 : 2, x, g, sums);
-    });
+  if (!this->Internals->Grid.Sum(
+        grid, grid.KeyOf(mesh->GetPoints(), policy), mesh->GetPoints(), g.data(), sums.data(), this))
+  {
+    return false;
+  }
   this->LastBackendUsed = "CPU";
   return true;
 }
