@@ -19,13 +19,13 @@
  * Forward mode (the Jacobian-vector product) needs no filter: the points' motion under a control-point direction
  * dP is W dP, which is vtkFFDDeform's displacement of the mesh by a lattice whose points are RestPosition + dP.
  *
- * Deterministic: the same bits for any number of threads and on every run. No floating-point atomics: the
- * points are grouped by their cell, in increasing id, and the cells are coloured so that cells of one colour share
- * no control point (2^3 colours for the Bezier bases, 4^3 for the cubic B-spline); colours are summed one after
- * the other, the cells of a colour in parallel, so each control point receives its terms in one fixed order. The
- * global Bernstein basis, one cell, sums fixed chunks of points (their number set by the point count, not by the
- * threads) into partial gradients, then adds the partials in chunk order. A tetrahedral lattice sums each
- * tetrahedron's points, then each node's tetrahedra in increasing order. All sums are in float64.
+ * Deterministic: the same bits for any number of threads and on every run, on the CPU and on the device. No
+ * floating-point atomics: for a grid lattice, once per binding, the bound points are grouped by cell (in
+ * increasing id) and cut into chunks of one cell (their size set by the point count and the support, not by the
+ * threads); each update sums every chunk's points into a float64 partial per control point of its cell's support
+ * (chunks in parallel), then adds each control point's partials in one fixed order (FFDAdjoint.h). A tetrahedral
+ * lattice sums each tetrahedron's points, then each node's tetrahedra in increasing order. All sums are in
+ * float64.
  *
  * Binding: SetDeform() names the vtkFFDDeform that deforms the same mesh by the same lattice; its binding (on the
  * host, or on the CUDA device) is then the one used, and so are its OutsidePolicy, Backend and precision: the mesh
