@@ -3,6 +3,7 @@
 
 #include "vtkActor.h"
 #include "vtkAlgorithmOutput.h"
+#include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkDataSet.h"
 #include "vtkFFDCellEdges.h"
@@ -16,6 +17,7 @@
 #include "vtkPolyDataMapper.h"
 #include "vtkProperty.h"
 #include "vtkSphereSource.h"
+#include "vtkThreshold.h"
 
 vtkStandardNewMacro(vtkFFDLatticeActor);
 
@@ -60,6 +62,26 @@ struct EdgePart
     this->Actor->GetProperty()->LightingOff();
   }
 };
+
+/// The lattice's cell array that vtkFFDFoldCertificate (Filters/Quality, which this module does not link) adds.
+const char* const FoldCertificateName = "FoldCertificate";
+
+/// A line part of the lattice's cells whose `FoldCertificate` is `state`.
+struct FoldPart
+{
+  vtkNew<vtkThreshold> Select;
+  EdgePart Lines;
+
+  void Initialize(int state, double r, double g, double b)
+  {
+    this->Select->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_CELLS, FoldCertificateName);
+    this->Select->SetLowerThreshold(state);
+    this->Select->SetUpperThreshold(state);
+    this->Select->SetThresholdFunction(vtkThreshold::THRESHOLD_BETWEEN);
+    this->Lines.Edges->SetInputConnection(this->Select->GetOutputPort());
+    this->Lines.Initialize(r, g, b, 4.0);
+  }
+};
 }
 
 struct vtkFFDLatticeActor::vtkInternals
@@ -69,6 +91,7 @@ struct vtkFFDLatticeActor::vtkInternals
   PointPart CulledPoints;
   EdgePart LatticeEdges;
   EdgePart Voxels;
+  FoldPart Folded, Undecided;
   vtkNew<vtkLookupTable> DisplacementColors;
   bool HasLattice = false;
   bool HasVoxelGrid = false;
@@ -85,6 +108,8 @@ vtkFFDLatticeActor::vtkFFDLatticeActor()
   in.CulledPoints.Initialize(in.Sphere, vtkFFDControlPoints::CULLED, 0.75, 0.75, 0.75);
   in.LatticeEdges.Initialize(0.25, 0.25, 0.25, 2.0);
   in.Voxels.Initialize(0.27, 0.51, 0.71, 1.0);
+  in.Folded.Initialize(1, 0.9, 0.0, 0.0);
+  in.Undecided.Initialize(2, 1.0, 0.6, 0.0);
 
   // Blue (not moved) to red (moved the most), the usual reading of a magnitude.
   in.DisplacementColors->SetHueRange(0.667, 0.0);
@@ -104,6 +129,8 @@ void vtkFFDLatticeActor::SetInputConnection(vtkAlgorithmOutput* output)
   in.ActivePoints.Points->SetInputConnection(output);
   in.CulledPoints.Points->SetInputConnection(output);
   in.LatticeEdges.Edges->SetInputConnection(output);
+  in.Folded.Select->SetInputConnection(output);
+  in.Undecided.Select->SetInputConnection(output);
   this->ShowLatticeParts(output != nullptr);
   this->Modified();
 }
@@ -115,6 +142,8 @@ void vtkFFDLatticeActor::SetInputData(vtkDataSet* lattice)
   in.ActivePoints.Points->SetInputData(lattice);
   in.CulledPoints.Points->SetInputData(lattice);
   in.LatticeEdges.Edges->SetInputData(lattice);
+  in.Folded.Select->SetInputData(lattice);
+  in.Undecided.Select->SetInputData(lattice);
   this->ShowLatticeParts(lattice != nullptr);
   this->Modified();
 }
@@ -126,7 +155,8 @@ void vtkFFDLatticeActor::ShowLatticeParts(bool hasInput)
   // render or for PrintSelf) is a pipeline error.
   vtkInternals& in = *this->Internals;
   in.HasLattice = hasInput;
-  vtkActor* parts[3] = { in.LatticeEdges.Actor, in.CulledPoints.Actor, in.ActivePoints.Actor };
+  vtkActor* parts[5] = { in.LatticeEdges.Actor, in.CulledPoints.Actor, in.ActivePoints.Actor, in.Folded.Lines.Actor,
+    in.Undecided.Lines.Actor };
   for (vtkActor* part : parts)
   {
     if (hasInput)
@@ -185,6 +215,18 @@ vtkProperty* vtkFFDLatticeActor::GetVoxelProperty()
 }
 
 //------------------------------------------------------------------------------
+vtkProperty* vtkFFDLatticeActor::GetFoldedCellProperty()
+{
+  return this->Internals->Folded.Lines.Actor->GetProperty();
+}
+
+//------------------------------------------------------------------------------
+vtkProperty* vtkFFDLatticeActor::GetUndecidedCellProperty()
+{
+  return this->Internals->Undecided.Lines.Actor->GetProperty();
+}
+
+//------------------------------------------------------------------------------
 vtkLookupTable* vtkFFDLatticeActor::GetDisplacementLookupTable()
 {
   return this->Internals->DisplacementColors;
@@ -217,6 +259,7 @@ void vtkFFDLatticeActor::UpdateParts()
     showCulled = in.CulledPoints.Points->GetOutput()->GetNumberOfPoints() > 0;
   }
   in.CulledPoints.Actor->SetVisibility(showCulled);
+  this->UpdateFoldParts();
 
   if (this->PointRadius > 0.0)
   {
@@ -252,6 +295,26 @@ void vtkFFDLatticeActor::UpdateParts()
 }
 
 //------------------------------------------------------------------------------
+void vtkFFDLatticeActor::UpdateFoldParts()
+{
+  // Shown only where the lattice has the array (vtkThreshold would complain of one it lacks) and the cells of
+  // their state exist (a part without points would report uninitialized bounds).
+  vtkInternals& in = *this->Internals;
+  vtkDataSet* lattice = vtkDataSet::SafeDownCast(in.ActivePoints.Points->GetInputDataObject(0, 0));
+  const bool colour = this->ColorByFoldCertificate && lattice && lattice->GetCellData()->GetArray(FoldCertificateName);
+  for (FoldPart* part : { &in.Folded, &in.Undecided })
+  {
+    bool show = false;
+    if (colour)
+    {
+      part->Lines.Edges->Update();
+      show = part->Lines.Edges->GetOutput()->GetNumberOfLines() > 0;
+    }
+    part->Lines.Actor->SetVisibility(show);
+  }
+}
+
+//------------------------------------------------------------------------------
 int vtkFFDLatticeActor::RenderOpaqueGeometry(vtkViewport* viewport)
 {
   this->UpdateParts();
@@ -280,6 +343,7 @@ void vtkFFDLatticeActor::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ShowCulledPoints: " << (this->ShowCulledPoints ? "On" : "Off") << "\n";
   os << indent << "ShowEdges: " << (this->ShowEdges ? "On" : "Off") << "\n";
   os << indent << "ColorByDisplacement: " << (this->ColorByDisplacement ? "On" : "Off") << "\n";
+  os << indent << "ColorByFoldCertificate: " << (this->ColorByFoldCertificate ? "On" : "Off") << "\n";
   os << indent << "DisplacementRange: " << this->DisplacementRange[0] << " " << this->DisplacementRange[1]
      << (this->DisplacementRange[1] > this->DisplacementRange[0] ? "" : " (automatic)") << "\n";
   os << indent << "PointProperty:\n";

@@ -15,7 +15,11 @@
  * - the active voxels as wireframe boxes, when a voxel grid from vtkFFDVoxelize is set (SetVoxelGridData() or
  *   SetVoxelGridConnection()): its cells are the active voxels (hidden cells of another data set are not
  *   drawn); steel blue lines of width 1 by default (GetVoxelProperty()). The boxes stay where the voxel grid
- *   is: the rest frame.
+ *   is: the rest frame;
+ * - with ColorByFoldCertificate, the cells that the lattice's `FoldCertificate` cell array (vtkFFDFoldCertificate's
+ *   output) marks folded, red lines of width 4 (GetFoldedCellProperty()), and undecided, orange
+ *   (GetUndecidedCellProperty()): a dense lattice's cells' edges, a tetrahedral one's tetrahedra, a sparse one's
+ *   cells as the control net of their supports.
  *
  * Every part reads its input through its own pipeline (vtkFFDControlPoints, vtkFFDCellEdges), so the actor
  * follows the lattice: moving its points (and marking them modified) or re-executing the upstream filter shows
@@ -105,6 +109,19 @@ public:
   ///@}
 
   ///@{
+  /**
+   * Draw the cells that the lattice's `FoldCertificate` cell array marks folded (1) and undecided (2) over the
+   * lattice edges (default off; nothing is drawn where the lattice has no such array). Connect the actor to
+   * vtkFFDFoldCertificate's output.
+   */
+  vtkSetMacro(ColorByFoldCertificate, bool);
+  vtkGetMacro(ColorByFoldCertificate, bool);
+  vtkBooleanMacro(ColorByFoldCertificate, bool);
+  vtkProperty* GetFoldedCellProperty();
+  vtkProperty* GetUndecidedCellProperty();
+  ///@}
+
+  ///@{
   /// Radius of the control-point spheres in world units; 0 (the default) picks GetAutomaticRadiusFraction()
   /// times the diagonal of the lattice's bounds at render time.
   vtkSetClampMacro(PointRadius, double, 0.0, VTK_DOUBLE_MAX);
@@ -130,6 +147,9 @@ protected:
   /// colouring from the settings.
   void UpdateParts();
 
+  /// Shows the fold parts where ColorByFoldCertificate is on and the lattice has cells of their state.
+  void UpdateFoldParts();
+
   /// Puts the lattice's parts in the assembly when there is an input, takes them out when there is none.
   void ShowLatticeParts(bool hasInput);
 
@@ -137,6 +157,7 @@ protected:
   bool ShowCulledPoints = true;
   bool ShowEdges = true;
   bool ColorByDisplacement = false;
+  bool ColorByFoldCertificate = false;
   double DisplacementRange[2] = { 0.0, 0.0 };
 
 private:
