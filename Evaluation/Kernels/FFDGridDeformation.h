@@ -166,7 +166,7 @@ struct GridDeformation
 {
   static_assert(!WithCellTable || StaticBasis != int(GridBasis::Bernstein), "a cell table is for a local basis");
 
-  using Value = Real; ///< the displacements' type
+  using Value = Real;                         ///< the displacements' type
   static constexpr int MaxWeights = MaxCount; ///< the size of its AxisWeights
 
   GridBasis Basis;
@@ -360,7 +360,14 @@ struct GridDeformation
   {
     int c[3];
     this->CellIndices(cell, c);
-    this->Weights(this->Frame.ToParametric(x), c, false, axes);
+    this->WeightsInCell(x, c, axes);
+  }
+
+  /// WeightsAt() for a point of the cell of indices `indices` along each axis (CellIndices()), for callers that
+  /// take many points of one cell.
+  FFD_INLINE void WeightsInCell(const Vec3<Lane>& x, const int indices[3], AxisWeights<MaxCount, Lane>* axes) const
+  {
+    this->Weights(this->Frame.ToParametric(x), indices, false, axes);
   }
 
   /// The index into Displacements of the control point (i, j, k) of the support of `cell`, whose WeightsAt() gave

@@ -32,7 +32,7 @@ class vtkPointSet;
 
 /**
  * Calls f(deformation) with the float64 ffd::GridDeformation of the lattice that `deformer` read (its support's
- * size as a template argument, as the evaluation has it).
+ * size and its basis as template arguments, as the evaluation has them).
  */
 template <typename F>
 void vtkFFDWithGridDeformation(const vtkFFDGridDeformer& deformer, F&& f)
@@ -40,9 +40,9 @@ void vtkFFDWithGridDeformation(const vtkFFDGridDeformer& deformer, F&& f)
   const vtkFFDGridLattice& view = deformer.GetLattice();
   const vtkFFDSparseCells* cells = deformer.GetSparseCells();
   ffd::WithStaticBasis(view.Basis,
-    [&](auto maxCount, auto)
+    [&](auto maxCount, auto basis)
     {
-      f(ffd::GridDeformation<decltype(maxCount)::value, double>{ view.Basis,
+      f(ffd::GridDeformation<decltype(maxCount)::value, double, decltype(basis)::value>{ view.Basis,
         { view.Divisions[0], view.Divisions[1], view.Divisions[2] },
         { view.ControlPointsPerAxis[0], view.ControlPointsPerAxis[1], view.ControlPointsPerAxis[2] },
         view.Displacements.data(), ffd::Frame<double>::FromArray(view.Frame), nullptr,

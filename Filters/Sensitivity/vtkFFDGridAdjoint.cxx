@@ -169,10 +169,12 @@ void vtkFFDGridAdjoint::SumChunk(
   double local[N ? 3 * N * N * N : 1] = {};
   double* sums = N ? local : partial;
   std::fill(sums, sums + 3 * std::size_t(this->Terms), 0.0);
+  int cell[3];
+  deformation.CellIndices(chunk.Cell, cell);
   for (vtkIdType o = chunk.Begin; o < chunk.End; ++o)
   {
     ffd::AxisWeights<M, double> axes[3];
-    deformation.WeightsAt(ffd::Vec3<double>::From(&this->X[3 * std::size_t(o)]), chunk.Cell, axes);
+    deformation.WeightsInCell(ffd::Vec3<double>::From(&this->X[3 * std::size_t(o)]), cell, axes);
     const double* gp = g + 3 * std::size_t(this->Order[o]);
     double wsg[3 * M];
     for (int i = 0; i < n0; ++i)
