@@ -10,20 +10,29 @@
  * 0.1, fixed seed). Each row is the median of 3 updates of the whole filter (reading and checking the lattice,
  * deciding every voxel, the cell array), on 1 and 2 threads, at MaxSubdivisionDepth 3.
  *
+ * A second table times vtkFFDMeshInversion on a tetrahedral volume mesh (the Kuhn triangulation of a box, 6 M^3
+ * tetrahedra, M = 55: 1.0 M tetrahedra) deformed by the same kind of lattice, against vtkMeshQuality's
+ * TetScaledJacobian over the same cells (it gives the scaled Jacobian only, not the comparison with the rest mesh).
+ *
  * Usage: BenchmarkFFDFoldCertificate [--quick] [--divisions N] [--noise PERCENT]
- *   --quick      N = 30 (27,000 voxels): a check of the program (a second).
+ *   --quick      N = 30 (27,000 voxels), M = 15: a check of the program (a second).
  *   --divisions  N (default 100: 1 M voxels).
  *   --noise      the random move in % of a spacing (default 10).
  */
 
 #include "vtkFFDBuildLattice.h"
+#include "vtkFFDDeform.h"
 #include "vtkFFDFoldCertificate.h"
+#include "vtkFFDMeshInversion.h"
 #include "vtkFFDVoxelize.h"
 
 #include "FFDBenchmarkUtilities.h"
+#include "FFDTestTetrahedra.h"
 
+#include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkFFDDataContract.h"
+#include "vtkMeshQuality.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
@@ -31,6 +40,7 @@
 #include "vtkPolyData.h"
 #include "vtkSMPTools.h"
 #include "vtkSmartPointer.h"
+#include "vtkUnstructuredGrid.h"
 
 #include <cmath>
 #include <cstdio>
@@ -77,6 +87,47 @@ vtkSmartPointer<vtkPointSet> MovedLattice(int n, int form, double noise)
   }
   return lattice;
 }
+
+/// vtkFFDMeshInversion against vtkMeshQuality on 6 m^3 tetrahedra deformed by a 10^3 cubic B-spline lattice.
+void MeshInversionTable(int m)
+{
+  const double bounds[6] = { 0, 1, 0, 1, 0, 1 };
+  vtkSmartPointer<vtkUnstructuredGrid> mesh = ffdtest::KuhnBoxLattice(m, bounds, 0.2);
+  mesh->GetPointData()->Initialize(); // a mesh, not a lattice: no RestPosition
+  vtkNew<vtkFFDDeform> deform;
+  deform->SetInputData(mesh);
+  deform->SetLatticeData(MovedLattice(10, vtkFFDBuildLattice::DENSE, 0.3));
+  deform->Update();
+  std::printf("\nvtkFFDMeshInversion, %lld tetrahedra deformed by a 10^3 cubic B-spline lattice; median of 3\n\n",
+    static_cast<long long>(mesh->GetNumberOfCells()));
+  std::printf("| threads | inverted | min scaled Jacobian | vtkFFDMeshInversion s | vtkMeshQuality s |\n");
+  std::printf("|---:|---:|---:|---:|---:|\n");
+  for (int threads : { 1, 2 })
+  {
+    vtkSMPTools::Initialize(threads);
+    vtkNew<vtkFFDMeshInversion> inversion;
+    inversion->SetInputConnection(deform->GetOutputPort());
+    inversion->SetRestMeshData(mesh);
+    const double ours = MedianSeconds(3,
+      [&]
+      {
+        inversion->Modified();
+        inversion->Update();
+      });
+    vtkNew<vtkMeshQuality> quality;
+    quality->SetInputConnection(deform->GetOutputPort());
+    quality->SetTetQualityMeasureToScaledJacobian();
+    const double theirs = MedianSeconds(3,
+      [&]
+      {
+        quality->Modified();
+        quality->Update();
+      });
+    std::printf("| %d | %lld | %.4f | %.3f | %.3f |\n", threads,
+      static_cast<long long>(inversion->GetNumberOfInvertedCells()), inversion->GetMinimumScaledJacobian(), ours,
+      theirs);
+  }
+}
 } // namespace
 
 int main(int argc, char* argv[])
@@ -117,5 +168,6 @@ int main(int argc, char* argv[])
         static_cast<long long>(certificate->GetNumberOfUndecidedCells()), seconds, voxels / seconds * 1e-6);
     }
   }
+  MeshInversionTable(quick ? 15 : 55);
   return 0;
 }
