@@ -11,6 +11,7 @@
 #include "FFDTestMeshes.h"
 #include "FFDTestTetrahedra.h"
 
+#include "vtkCallbackCommand.h"
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkFFDBuildLattice.h"
@@ -27,6 +28,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
@@ -304,5 +306,45 @@ TEST(vtkFFDFoldCertificate, BadInputIsAnErrorAndAnEmptyOutput)
   vtkNew<vtkUnstructuredGrid> empty;
   certificate->SetInputData(empty);
   EXPECT_EQ(ffdtest::UpdateErrors(certificate), "");
+  EXPECT_EQ(vtkPointSet::SafeDownCast(certificate->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
+}
+
+// Progress reaches 1 through the filter's own reports; an abort asked for at the start (the executive's report of 0)
+// leaves an empty output and no error.
+TEST(vtkFFDFoldCertificate, ProgressAndAbort)
+{
+  const ffdref::Frame f{ { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+  const int n[3] = { 4, 4, 4 };
+  vtkSmartPointer<vtkStructuredGrid> lattice = ffdtest::MakeLattice(f, vtkFFDBuildLattice::CUBIC_BSPLINE, n);
+  struct Seen
+  {
+    std::vector<double> Progress;
+    bool Abort = false;
+  } seen;
+  vtkNew<vtkCallbackCommand> observer;
+  observer->SetClientData(&seen);
+  observer->SetCallback(
+    [](vtkObject* caller, unsigned long, void* clientData, void* callData)
+    {
+      Seen& s = *static_cast<Seen*>(clientData);
+      s.Progress.push_back(*static_cast<double*>(callData));
+      if (s.Abort)
+      {
+        vtkAlgorithm::SafeDownCast(caller)->SetAbortExecute(1);
+      }
+    });
+  vtkNew<vtkFFDFoldCertificate> certificate;
+  certificate->AddObserver(vtkCommand::ProgressEvent, observer);
+  vtkNew<FFDTestErrorObserver> errors;
+  errors->WatchWithExecutive(certificate);
+  certificate->SetInputData(lattice);
+  certificate->Update();
+  EXPECT_TRUE(std::find_if(seen.Progress.begin(), seen.Progress.end(), [](double p) { return p > 0 && p < 1; }) !=
+    seen.Progress.end());
+  EXPECT_EQ(certificate->GetNumberOfCertifiedCells(), 64);
+  seen.Abort = true;
+  certificate->Modified();
+  certificate->Update();
+  EXPECT_EQ(errors->Errors, "");
   EXPECT_EQ(vtkPointSet::SafeDownCast(certificate->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
 }

@@ -9,6 +9,7 @@
 #include "FFDTestMeshes.h"
 #include "FFDTestTetrahedra.h"
 
+#include "vtkCallbackCommand.h"
 #include "vtkCellData.h"
 #include "vtkCellType.h"
 #include "vtkDoubleArray.h"
@@ -313,4 +314,20 @@ TEST(vtkFFDMeshInversion, BadInputIsAnErrorAndAnEmptyOutput)
     EXPECT_NE(errors->Errors.find(c.Expected), std::string::npos) << errors->Errors;
     EXPECT_EQ(vtkPointSet::SafeDownCast(filter->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
   }
+}
+
+// An abort asked for at the start (the executive's progress report of 0) leaves an empty output and no error.
+TEST(vtkFFDMeshInversion, Abort)
+{
+  vtkSmartPointer<vtkUnstructuredGrid> mesh = OneOfEach();
+  vtkNew<vtkCallbackCommand> abort;
+  abort->SetCallback(
+    [](vtkObject* caller, unsigned long, void*, void*) { vtkAlgorithm::SafeDownCast(caller)->SetAbortExecute(1); });
+  vtkNew<vtkFFDMeshInversion> inversion;
+  inversion->AddObserver(vtkCommand::ProgressEvent, abort);
+  vtkNew<FFDTestErrorObserver> errors;
+  errors->WatchWithExecutive(inversion);
+  Inspect(inversion, mesh, mesh);
+  EXPECT_EQ(errors->Errors, "");
+  EXPECT_EQ(vtkPointSet::SafeDownCast(inversion->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
 }
