@@ -10,6 +10,7 @@
 #ifndef FFDGridPassLevels_h
 #define FFDGridPassLevels_h
 
+#include "FFDAdjointPasses.h"
 #include "FFDDeformPoint.h"
 #include "FFDGridDeformation.h"
 #include "FFDGridPasses.h"
@@ -125,12 +126,14 @@ void GatheredAt(const GridLattice<Real>& lattice, const Real* listed, const Gath
   Real* staged, Real* out);
 template <SimdLevel Level>
 void InvertAt(const GridLattice<double>& lattice, const InverseLaneSearch& search, InverseLaneGroup& group);
+template <SimdLevel Level>
+void AdjointAt(const GridLattice<double>& lattice, const AdjointChunk& chunk);
 
 } // namespace detail
 } // namespace ffd
 
 // The explicit instantiations of one level's passes (each in its translation unit, so that a module links only
-// the passes it calls): the evaluation's in both precisions, the inverse's search in float64.
+// the passes it calls): the evaluation's in both precisions, the inverse's search and the adjoint's sums in float64.
 #define FFD_INSTANTIATE_GRID_PASSES_OF(Level, Real)                                                                    \
   template void ffd::detail::InPlaceAt<Level, Real>(const ffd::GridLattice<Real>&, const Real*, const int*, Real*,     \
     const ffd::BlockCells&, std::int64_t, std::int64_t, bool);                                                         \
@@ -144,5 +147,7 @@ void InvertAt(const GridLattice<double>& lattice, const InverseLaneSearch& searc
 #define FFD_INSTANTIATE_INVERSE_PASS(Level)                                                                            \
   template void ffd::detail::InvertAt<Level>(                                                                          \
     const ffd::GridLattice<double>&, const ffd::InverseLaneSearch&, ffd::InverseLaneGroup&);
+#define FFD_INSTANTIATE_ADJOINT_PASS(Level)                                                                            \
+  template void ffd::detail::AdjointAt<Level>(const ffd::GridLattice<double>&, const ffd::AdjointChunk&);
 
 #endif

@@ -10,50 +10,16 @@
 #include "vtkSMPTools.h"
 
 #include "FFDAdjoint.h"
+#include "FFDAdjointPasses.h"
+#include "FFDSimdLevel.h"
 
 #include <algorithm>
-#include <cstring>
-
-namespace
-{
-// row[v] += w wsg[v] for v < count (3 N where N > 0): for the local bases in pairs of doubles, the vector width
-// of any x86-64, which GCC does not find by itself here.
-template <int N>
-inline void AddRow(double w, const double* wsg, double* row, int count)
-{
-  if constexpr (N > 0)
-  {
-    typedef double Pair __attribute__((vector_size(16)));
-    const Pair wide = { w, w };
-    for (int v = 0; v + 1 < 3 * N; v += 2)
-    {
-      Pair r, a;
-      std::memcpy(&r, row + v, sizeof(Pair));
-      std::memcpy(&a, wsg + v, sizeof(Pair));
-      r += wide * a;
-      std::memcpy(row + v, &r, sizeof(Pair));
-    }
-    if constexpr (3 * N % 2 == 1)
-    {
-      row[3 * N - 1] += w * wsg[3 * N - 1];
-    }
-  }
-  else
-  {
-    for (int v = 0; v < count; ++v)
-    {
-      row[v] += w * wsg[v];
-    }
-  }
-}
-} // namespace
 
 //------------------------------------------------------------------------------------------------------------
 bool vtkFFDGridAdjoint::Sum(const vtkFFDGridDeformer& grid, const vtkFFDBindingKey& key, vtkPoints* points,
   const double* g, double* sums, vtkAlgorithm* self)
 {
   const vtkIdType controlPoints = grid.GetLattice().Points->GetNumberOfTuples();
-  const bool global = grid.GetLattice().Basis == ffd::GridBasis::Bernstein;
   vtkFFDWithGridDeformation(grid,
     [&](const auto& deformation)
     {
@@ -66,30 +32,25 @@ bool vtkFFDGridAdjoint::Sum(const vtkFFDGridDeformer& grid, const vtkFFDBindingK
         ++this->Plans;
       }
       self->UpdateProgress(0.5);
-      auto sumChunks = [&](auto n)
-      {
-        vtkSMPTools::For(0, vtkIdType(this->Chunks.size()),
-          [&](vtkIdType begin, vtkIdType end)
+      // The widest SIMD lanes this CPU runs (FFDAdjointPasses.h); point by point where there are none.
+      const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
+      std::vector<double> noTable;
+      const ffd::GridLattice<double> lattice = grid.PassLattice(static_cast<const double*>(nullptr), false, noTable);
+      vtkSMPTools::For(0, vtkIdType(this->Chunks.size()),
+        [&](vtkIdType begin, vtkIdType end)
+        {
+          for (vtkIdType c = begin; c < end; ++c)
           {
-            for (vtkIdType c = begin; c < end; ++c)
+            const Chunk& chunk = this->Chunks[c];
+            const ffd::AdjointChunk lanes{ chunk.Cell, chunk.End - chunk.Begin, &this->X[3 * std::size_t(chunk.Begin)],
+              &this->Order[std::size_t(chunk.Begin)], g,
+              &this->Partials[3 * std::size_t(this->Terms) * std::size_t(c)] };
+            if (!ffd::SumAdjointChunkInLanes(level, lattice, lanes))
             {
-              this->SumChunk<decltype(n)::value>(
-                deformation, this->Chunks[c], g, &this->Partials[3 * std::size_t(this->Terms) * std::size_t(c)]);
+              this->SumChunk(deformation, lanes);
             }
-          });
-      };
-      // The local bases' supports unrolled: 2, 3 or 4 control points per axis; the global basis's at run time.
-      switch (global ? 0 : this->Counts[0])
-      {
-        case 2:
-          return sumChunks(std::integral_constant<int, 2>());
-        case 3:
-          return sumChunks(std::integral_constant<int, 3>());
-        case 4:
-          return sumChunks(std::integral_constant<int, 4>());
-        default:
-          return sumChunks(std::integral_constant<int, 0>());
-      }
+          }
+        });
     });
   if (self->GetAbortExecute())
   {
@@ -106,7 +67,7 @@ template <typename Deformation>
 void vtkFFDGridAdjoint::MakePlan(const Deformation& deformation, const vtkFFDGridDeformer& grid, vtkPoints* points)
 {
   const vtkFFDGroupedIds byCell(grid.GetCellOfPoint());
-  this->Order = byCell.Order;
+  this->Order.assign(byCell.Order.begin(), byCell.Order.end());
   const vtkIdType bound = vtkIdType(this->Order.size());
   this->X.resize(3 * std::size_t(bound));
   vtkSMPTools::For(0, bound,
@@ -156,44 +117,41 @@ void vtkFFDGridAdjoint::MakePlan(const Deformation& deformation, const vtkFFDGri
 }
 
 //------------------------------------------------------------------------------------------------------------
-// A chunk's partials: for each point in order, w_k g = (W1[j] W2[l]) (W0[i] g) added to term k = i + n0 (j + n1 l).
-// N: the support's control points per axis where known at compile time (0: the global basis's, at run time).
-template <int N, typename Deformation>
-void vtkFFDGridAdjoint::SumChunk(
-  const Deformation& deformation, const Chunk& chunk, const double* g, double* partial) const
+// A chunk's partials point by point, where the CPU has no SIMD lanes: the lanes' sums (FFDAdjointPasses.h) with
+// one lane.
+template <typename Deformation>
+void vtkFFDGridAdjoint::SumChunk(const Deformation& deformation, const ffd::AdjointChunk& chunk) const
 {
   constexpr int M = Deformation::MaxWeights;
-  const int n0 = N ? N : this->Counts[0], n1 = N ? N : this->Counts[1], n2 = N ? N : this->Counts[2];
-  // The local bases sum into an array of their own (no aliasing: the compiler keeps the rows in vector
-  // registers as it can), the global basis into the partials.
-  double local[N ? 3 * N * N * N : 1] = {};
-  double* sums = N ? local : partial;
-  std::fill(sums, sums + 3 * std::size_t(this->Terms), 0.0);
+  const int* n = this->Counts;
+  std::fill(chunk.Partial, chunk.Partial + 3 * std::size_t(this->Terms), 0.0);
   int cell[3];
   deformation.CellIndices(chunk.Cell, cell);
-  for (vtkIdType o = chunk.Begin; o < chunk.End; ++o)
+  for (std::int64_t p = 0; p < chunk.Count; ++p)
   {
     ffd::AxisWeights<M, double> axes[3];
-    deformation.WeightsInCell(ffd::Vec3<double>::From(&this->X[3 * std::size_t(o)]), cell, axes);
-    const double* gp = g + 3 * std::size_t(this->Order[o]);
+    deformation.WeightsInCell(ffd::Vec3<double>::From(chunk.X + 3 * p), cell, axes);
+    const double* g = chunk.G + 3 * chunk.Ids[p];
     double wsg[3 * M];
-    for (int i = 0; i < n0; ++i)
+    for (int i = 0; i < n[0]; ++i)
     {
-      wsg[3 * i] = axes[0].W[i] * gp[0];
-      wsg[3 * i + 1] = axes[0].W[i] * gp[1];
-      wsg[3 * i + 2] = axes[0].W[i] * gp[2];
-    }
-    for (int l = 0; l < n2; ++l)
-    {
-      for (int j = 0; j < n1; ++j)
+      for (int c = 0; c < 3; ++c)
       {
-        AddRow<N>(axes[1].W[j] * axes[2].W[l], wsg, sums + 3 * std::size_t(n0) * std::size_t(j + n1 * l), 3 * n0);
+        wsg[3 * i + c] = axes[0].W[i] * g[c];
       }
     }
-  }
-  if (N)
-  {
-    std::copy(local, local + 3 * std::size_t(this->Terms), partial);
+    for (int l = 0; l < n[2]; ++l)
+    {
+      for (int j = 0; j < n[1]; ++j)
+      {
+        const double w = axes[1].W[j] * axes[2].W[l];
+        double* row = chunk.Partial + 3 * std::size_t(n[0]) * std::size_t(j + n[1] * l);
+        for (int v = 0; v < 3 * n[0]; ++v)
+        {
+          row[v] += w * wsg[v];
+        }
+      }
+    }
   }
 }
 

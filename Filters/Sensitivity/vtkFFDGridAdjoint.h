@@ -6,10 +6,10 @@
  * vtkFFDSensitivity's sums for grid lattices on vtkSMPTools threads, in the CUDA adjoint's shape
  * (FFDAdjoint.h): a plan per binding (the bound points grouped by cell, in increasing id, cut into chunks; each
  * chunk's terms, the control points of its cell's support, grouped by control point), then at each Sum() every
- * chunk's points summed into a float64 partial per term, the chunks in parallel, and every control point's
- * partials added in the plan's order. A point's term is (W1[j] W2[l]) (W0[i] g), the weights of
- * ffd::GridDeformation::WeightsAt() in float64. No atomics, no order set by the threads: the same bits for any
- * number of them.
+ * chunk's points summed into a float64 partial per term, the chunks in parallel (in SIMD lanes:
+ * FFDAdjointPasses.h), and every control point's partials added in the plan's order. A point's term is
+ * (W1[j] W2[l]) (W0[i] g), the weights of ffd::GridDeformation::WeightsInCell() in float64. No atomics, no order
+ * set by the threads: the same bits for any number of them (on one CPU: the lanes' width sets the order).
  */
 #ifndef vtkFFDGridAdjoint_h
 #define vtkFFDGridAdjoint_h
@@ -17,8 +17,13 @@
 #include "vtkFFDBindingKey.h"
 #include "vtkType.h"
 
+#include <cstdint>
 #include <vector>
 
+namespace ffd
+{
+struct AdjointChunk;
+}
 class vtkAlgorithm;
 class vtkFFDGridDeformer;
 class vtkPoints;
@@ -46,8 +51,8 @@ private:
 
   template <typename Deformation>
   void MakePlan(const Deformation& deformation, const vtkFFDGridDeformer& grid, vtkPoints* points);
-  template <int N, typename Deformation>
-  void SumChunk(const Deformation& deformation, const Chunk& chunk, const double* g, double* partial) const;
+  template <typename Deformation>
+  void SumChunk(const Deformation& deformation, const ffd::AdjointChunk& chunk) const;
   void Gather(double* sums) const;
 
   vtkFFDBindingKey For; // what the plan is for, with the lattice's count of control points
@@ -55,8 +60,8 @@ private:
   vtkIdType Plans = 0;
   int Counts[3] = { 0, 0, 0 }; // a support's control points along each axis
   int Terms = 0;
-  std::vector<vtkIdType> Order; // the bound points by cell, then id
-  std::vector<double> X;        // their coordinates in float64, in that order
+  std::vector<std::int64_t> Order; // the bound points by cell, then id
+  std::vector<double> X;           // their coordinates in float64, in that order
   std::vector<Chunk> Chunks;
   std::vector<vtkIdType> TermStart, TermOrder; // the terms (chunk Terms + k) by control point, then term
   std::vector<double> Partials;                // 3 per term

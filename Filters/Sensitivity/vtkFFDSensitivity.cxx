@@ -10,6 +10,7 @@
 #include "vtkFFDMemory.h"
 #include "vtkFFDTetrahedralDeformer.h"
 
+#include "vtkAOSDataArrayTemplate.h"
 #include "vtkArrayDispatch.h"
 #include "vtkDataArray.h"
 #include "vtkDataArrayRange.h"
@@ -49,6 +50,18 @@ std::vector<double> AsDoubles(vtkDataArray* array)
     copy(array);
   }
   return values;
+}
+
+// The gradient's values as contiguous float64 triples: the array's own where it holds them so (the usual
+// vtkDoubleArray), else AsDoubles() into `copy`.
+const double* GradientValues(vtkDataArray* array, std::vector<double>& copy)
+{
+  if (auto* doubles = vtkAOSDataArrayTemplate<double>::FastDownCast(array))
+  {
+    return doubles->GetPointer(0);
+  }
+  copy = AsDoubles(array);
+  return copy.data();
 }
 
 // sums[3 c ..] += w g: a point's term for control point c.
@@ -253,7 +266,8 @@ bool vtkFFDSensitivity::SumGrid(
   {
     return true;
   }
-  const std::vector<double> g = AsDoubles(gradient);
+  std::vector<double> copy;
+  const double* g = GradientValues(gradient, copy);
   if (this->SumGridOnCuda(mesh->GetPoints(), g, sums))
   {
     return true;
@@ -264,8 +278,7 @@ bool vtkFFDSensitivity::SumGrid(
     return false;
   }
   this->NumberOfBindings += rebound ? 1 : 0;
-  if (!this->Internals->Grid.Sum(
-        grid, grid.KeyOf(mesh->GetPoints(), policy), mesh->GetPoints(), g.data(), sums.data(), this))
+  if (!this->Internals->Grid.Sum(grid, grid.KeyOf(mesh->GetPoints(), policy), mesh->GetPoints(), g, sums.data(), this))
   {
     return false;
   }
@@ -273,7 +286,7 @@ bool vtkFFDSensitivity::SumGrid(
   return true;
 }
 
-bool vtkFFDSensitivity::SumGridOnCuda(vtkPoints* points, const std::vector<double>& g, std::vector<double>& sums)
+bool vtkFFDSensitivity::SumGridOnCuda(vtkPoints* points, const double* g, std::vector<double>& sums)
 {
   const int backend = this->Deform ? this->Deform->GetBackend() : this->Backend;
   std::string why;
@@ -298,7 +311,7 @@ bool vtkFFDSensitivity::SumGridOnCuda(vtkPoints* points, const std::vector<doubl
     (precision == vtkAlgorithm::DEFAULT_PRECISION && points->GetDataType() == VTK_DOUBLE);
   bool bound = false;
   const bool summed = binding.Cuda.AdjointGrid(binding.Grid, binding.Grid.KeyOf(points, policy), points,
-    useDouble ? VTK_DOUBLE : VTK_FLOAT, g.data(), sums.data(), bound, why);
+    useDouble ? VTK_DOUBLE : VTK_FLOAT, g, sums.data(), bound, why);
   this->NumberOfBindings += (rebound || (bound && !binding.Grid.GetLattice().Sparse)) ? 1 : 0;
   if (!summed)
   {

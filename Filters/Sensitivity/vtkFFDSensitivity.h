@@ -132,7 +132,7 @@ private:
     vtkPointSet* mesh, vtkUnstructuredGrid* lattice, vtkDataArray* gradient, std::vector<double>& sums);
   /// SumGrid() on the device, where the backend allows it; false where the CPU must sum (with a warning where
   /// CUDA was asked for or failed).
-  bool SumGridOnCuda(vtkPoints* points, const std::vector<double>& g, std::vector<double>& sums);
+  bool SumGridOnCuda(vtkPoints* points, const double* g, std::vector<double>& sums);
 
   // Whose binding and settings the sums use: the Deform's, else this filter's own.
   vtkFFDDeform* Engine();

@@ -28,9 +28,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace
@@ -91,9 +94,11 @@ void Objective(vtkFFDDeform* deform, vtkDataArray* g, double& j, double& s)
   }
 }
 
-vtkSmartPointer<vtkDataArray> Sensitivity(vtkPolyData* cloud, vtkPointSet* lattice, int policy)
+vtkSmartPointer<vtkDataArray> Sensitivity(
+  vtkPolyData* cloud, vtkPointSet* lattice, int policy, int backend = vtkFFDDeform::AUTOMATIC)
 {
   vtkNew<vtkFFDSensitivity> sensitivity;
+  sensitivity->SetBackend(backend);
   sensitivity->SetInputData(cloud);
   sensitivity->SetLatticeData(lattice);
   sensitivity->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "g");
@@ -105,10 +110,10 @@ vtkSmartPointer<vtkDataArray> Sensitivity(vtkPolyData* cloud, vtkPointSet* latti
 
 /// Central differences of `picks` random control points of `lattice` against vtkFFDSensitivity; the count of
 /// components beyond the tolerance, and the largest difference relative to it.
-void ExpectMatchesCentralDifferences(
-  vtkPolyData* cloud, vtkPointSet* lattice, int policy, int picks, std::mt19937& rng, const char* what)
+void ExpectMatchesCentralDifferences(vtkPolyData* cloud, vtkPointSet* lattice, int policy, int picks, std::mt19937& rng,
+  const char* what, int backend = vtkFFDDeform::AUTOMATIC)
 {
-  vtkSmartPointer<vtkDataArray> dJdP = Sensitivity(cloud, lattice, policy);
+  vtkSmartPointer<vtkDataArray> dJdP = Sensitivity(cloud, lattice, policy, backend);
   ASSERT_TRUE(dJdP) << what;
   ASSERT_EQ(dJdP->GetNumberOfTuples(), lattice->GetNumberOfPoints()) << what;
   vtkNew<vtkFFDDeform> deform;
@@ -175,6 +180,40 @@ TEST(vtkFFDSensitivity, MatchesCentralDifferencesForEveryGridBasis)
         ExpectMatchesCentralDifferences(cloud, lattice, policy, 12, rng, what.c_str());
       }
     }
+  }
+}
+
+// The CPU's sums at every SIMD level this machine runs (VOXELFFD_MAX_SIMD, read at each update; "none": point by
+// point), each against central differences as above.
+TEST(vtkFFDSensitivity, EverySimdLevelMatchesCentralDifferences)
+{
+  vtkSmartPointer<vtkPolyData> bear = ReadTestMesh("bear");
+  std::mt19937 rng(43);
+  vtkSmartPointer<vtkPolyData> cloud = CloudWithGradient(bear, 200, rng);
+  const int n[3] = { 3, 2, 3 };
+  const std::pair<int, int> cases[] = { { vtkFFDBuildLattice::BERNSTEIN, vtkFFDBuildLattice::DENSE },
+    { vtkFFDBuildLattice::TRIQUADRATIC_BEZIER, vtkFFDBuildLattice::SPARSE },
+    { vtkFFDBuildLattice::CUBIC_BSPLINE, vtkFFDBuildLattice::DENSE } };
+  const char* saved = std::getenv("VOXELFFD_MAX_SIMD");
+  const std::string restore = saved ? saved : "";
+  for (const char* level : { "none", "sse2", "avx2", "avx512" })
+  {
+    setenv("VOXELFFD_MAX_SIMD", level, 1);
+    for (const auto& [basis, form] : cases)
+    {
+      vtkSmartPointer<vtkPointSet> lattice = ffdtest::MovedLattice(bear, basis, n, form, rng);
+      const std::string what = std::string(level) + " " + vtkFFDBuildLattice::GetBasisAsString(basis);
+      ExpectMatchesCentralDifferences(
+        cloud, lattice, vtkFFDDeform::CLAMP_TO_EDGE, 6, rng, what.c_str(), vtkFFDDeform::CPU);
+    }
+  }
+  if (saved)
+  {
+    setenv("VOXELFFD_MAX_SIMD", restore.c_str(), 1);
+  }
+  else
+  {
+    unsetenv("VOXELFFD_MAX_SIMD");
   }
 }
 

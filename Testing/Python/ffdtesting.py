@@ -102,3 +102,17 @@ def offscreen_window(renderer, size=None, multisamples=None):
         window.SetSize(*size)
     window.AddRenderer(renderer)
     return window
+
+
+UNIT_ROUNDOFF = 2.0 ** -53
+
+
+def adjoint_bound(W, g):
+    """How far vtkFFDSensitivity's W^T g may be from W.T @ g: both sum k terms per control point in float64, in
+    different orders and associations, 2 (k + 8) u of the terms' sizes; and the weights themselves differ where
+    they are evaluated in SIMD lanes with FMA or on a GPU rather than one by one, by a few u of 1 (of the weight
+    where it is larger, extrapolated): a tiny weight's relative error is not small. 16 u max(1, |w|) a term."""
+    k = np.diff(W.tocsc().indptr)[:, None]
+    sizes = abs(W)
+    sizes.data = np.maximum(sizes.data, 1.0)
+    return 2 * (k + 8) * UNIT_ROUNDOFF * (abs(W).T @ np.abs(g)) + 16 * UNIT_ROUNDOFF * (sizes.T @ np.abs(g))
