@@ -15,7 +15,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <vector>
 
 #if FFD_HAVE_LANES
 namespace ffd
@@ -38,7 +37,8 @@ inline void SumChunkInLanes(const Deformation& deformation, const AdjointChunk& 
   const int terms = n0 * n1 * n2;
   // W doubles a term and component, moved as unaligned vectors: a std::vector of 64-byte lanes would need
   // aligned storage that the allocator of a build without AVX-512 does not promise.
-  std::vector<double> sums(3 * std::size_t(terms) * W, 0.0);
+  double* sums = chunk.Scratch;
+  std::fill(sums, sums + 3 * std::size_t(terms) * W, 0.0);
   int cell[3];
   deformation.CellIndices(chunk.Cell, cell);
   constexpr int M = Deformation::MaxWeights;
@@ -72,7 +72,7 @@ inline void SumChunkInLanes(const Deformation& deformation, const AdjointChunk& 
       for (int j = 0; j < n1; ++j)
       {
         const Lane w = axes[1].W[j] * axes[2].W[l];
-        double* row = sums.data() + 3 * std::size_t(n0) * std::size_t(j + n1 * l) * W;
+        double* row = sums + 3 * std::size_t(n0) * std::size_t(j + n1 * l) * W;
         for (int v = 0; v < 3 * n0; ++v)
         {
           Lane sum;

@@ -14,13 +14,15 @@
 
 #include "FFDGridPasses.h"
 
+#include <cstddef>
 #include <cstdint>
 
 namespace ffd
 {
 
 /// A chunk of the adjoint's sums: `Count` points of cell `Cell`, their coordinates X (3 each, in chunk order) and
-/// ids (where their gradient is: g + 3 id), summed into Partial (3 per term k = i + n0 (j + n1 l) of the support).
+/// ids (where their gradient is: g + 3 id), summed into Partial (3 per term k = i + n0 (j + n1 l) of the support),
+/// through Scratch, the lanes' sums: AdjointScratchSize() doubles of the caller's thread.
 struct AdjointChunk
 {
   int Cell;
@@ -29,7 +31,14 @@ struct AdjointChunk
   const std::int64_t* Ids;
   const double* G;
   double* Partial;
+  double* Scratch;
 };
+
+/// The doubles of an AdjointChunk's Scratch for `terms` terms a chunk: 3 a term in lanes of up to 8.
+inline std::size_t AdjointScratchSize(int terms)
+{
+  return 3 * std::size_t(terms) * 8;
+}
 
 /// Sums `chunk` in lanes of `level` on the lattice (its displacements are not read); false where the build has no
 /// lanes for it (the caller sums the chunk point by point).

@@ -7,6 +7,7 @@
 
 #include "vtkAlgorithm.h"
 #include "vtkPoints.h"
+#include "vtkSMPThreadLocal.h"
 #include "vtkSMPTools.h"
 
 #include "FFDAdjoint.h"
@@ -36,15 +37,18 @@ bool vtkFFDGridAdjoint::Sum(const vtkFFDGridDeformer& grid, const vtkFFDBindingK
       const ffd::SimdLevel level = ffd::SimdLevelOfCpu();
       std::vector<double> noTable;
       const ffd::GridLattice<double> lattice = grid.PassLattice(static_cast<const double*>(nullptr), false, noTable);
+      vtkSMPThreadLocal<std::vector<double>> scratches;
       vtkSMPTools::For(0, vtkIdType(this->Chunks.size()),
         [&](vtkIdType begin, vtkIdType end)
         {
+          std::vector<double>& scratch = scratches.Local();
+          scratch.resize(ffd::AdjointScratchSize(this->Terms));
           for (vtkIdType c = begin; c < end; ++c)
           {
             const Chunk& chunk = this->Chunks[c];
             const ffd::AdjointChunk lanes{ chunk.Cell, chunk.End - chunk.Begin, &this->X[3 * std::size_t(chunk.Begin)],
-              &this->Order[std::size_t(chunk.Begin)], g,
-              &this->Partials[3 * std::size_t(this->Terms) * std::size_t(c)] };
+              &this->Order[std::size_t(chunk.Begin)], g, &this->Partials[3 * std::size_t(this->Terms) * std::size_t(c)],
+              scratch.data() };
             if (!ffd::SumAdjointChunkInLanes(level, lattice, lanes))
             {
               this->SumChunk(deformation, lanes);
