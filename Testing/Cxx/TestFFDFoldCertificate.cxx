@@ -211,35 +211,41 @@ TEST(vtkFFDFoldCertificate, DenseAndSparseAgreeAndNeverCertifyAFold)
 }
 
 // A control point pushed along S far beyond its neighbours: voxel (1, 1, 1), on its +S side, turns inside out,
-// on the reference's word too.
+// on the reference's word too; in a frame of either orientation (U reversed: det(S, T, U) < 0, whose rest state
+// the certificate must read as unfolded).
 TEST(vtkFFDFoldCertificate, PushedControlPointFoldsItsVoxels)
 {
-  const ffdref::Frame f{ { 0, 0, 0 }, { 3, 0, 0 }, { 0, 3, 0 }, { 0, 0, 3 } };
+  const ffdref::Frame frames[2] = { { { 0, 0, 0 }, { 3, 0, 0 }, { 0, 3, 0 }, { 0, 0, 3 } },
+    { { 0, 0, 3 }, { 3, 0, 0 }, { 0, 3, 0 }, { 0, 0, -3 } } };
   const int n[3] = { 3, 3, 3 };
   for (int basis : { vtkFFDBuildLattice::TRILINEAR, vtkFFDBuildLattice::CUBIC_BSPLINE })
-  {
-    vtkSmartPointer<vtkStructuredGrid> lattice = ffdtest::MakeLattice(f, basis, n);
-    // Trilinear: the low corner of voxel (1, 1, 1), point 1; the B-spline's: its second, point 2, 6 spacings on.
-    const int dims = ffdtest::PointsAlongAxis(basis, 3), low = basis == vtkFFDBuildLattice::TRILINEAR ? 1 : 2;
-    const vtkIdType pushed = low + dims * (low + dims * low);
-    double x[3];
-    lattice->GetPoint(pushed, x);
-    lattice->GetPoints()->SetPoint(pushed, x[0] + 6.0, x[1], x[2]);
-    vtkNew<vtkFFDFoldCertificate> certificate;
-    const auto voxels = VoxelStates(lattice, Certify(certificate, lattice), basis);
-    EXPECT_EQ(voxels.size(), 27u);
-    EXPECT_GT(certificate->GetNumberOfFoldedCells(), 0);
-    const ffdtest::Reference ref = ffdtest::ReferenceOf(lattice);
-    EXPECT_EQ(voxels.at({ 1, 1, 1 }), vtkFFDFoldCertificate::FOLDED) << basis;
-    EXPECT_LE(SampledMinimum(ref, { 1, 1, 1 }), 0.0) << basis;
-    for (const auto& voxel : voxels)
+    for (const ffdref::Frame& f : frames)
     {
-      if (voxel.second == vtkFFDFoldCertificate::CERTIFIED)
+      vtkSmartPointer<vtkStructuredGrid> lattice = ffdtest::MakeLattice(f, basis, n);
+      vtkNew<vtkFFDFoldCertificate> atRest;
+      Certify(atRest, lattice);
+      EXPECT_EQ(atRest->GetNumberOfCertifiedCells(), 27) << basis;
+      // Trilinear: the low corner of voxel (1, 1, 1), point 1; the B-spline's: its second, point 2, 6 spacings on.
+      const int dims = ffdtest::PointsAlongAxis(basis, 3), low = basis == vtkFFDBuildLattice::TRILINEAR ? 1 : 2;
+      const vtkIdType pushed = low + dims * (low + dims * low);
+      double x[3];
+      lattice->GetPoint(pushed, x);
+      lattice->GetPoints()->SetPoint(pushed, x[0] + 6.0, x[1], x[2]);
+      vtkNew<vtkFFDFoldCertificate> certificate;
+      const auto voxels = VoxelStates(lattice, Certify(certificate, lattice), basis);
+      EXPECT_EQ(voxels.size(), 27u);
+      EXPECT_GT(certificate->GetNumberOfFoldedCells(), 0);
+      const ffdtest::Reference ref = ffdtest::ReferenceOf(lattice);
+      EXPECT_EQ(voxels.at({ 1, 1, 1 }), vtkFFDFoldCertificate::FOLDED) << basis;
+      EXPECT_LE(SampledMinimum(ref, { 1, 1, 1 }), 0.0) << basis;
+      for (const auto& voxel : voxels)
       {
-        EXPECT_GT(SampledMinimum(ref, voxel.first), 0.0) << basis;
+        if (voxel.second == vtkFFDFoldCertificate::CERTIFIED)
+        {
+          EXPECT_GT(SampledMinimum(ref, voxel.first), 0.0) << basis;
+        }
       }
     }
-  }
 }
 
 // Each tetrahedron against the sign of the reference's signed volumes, rest and moved; inverted rest tetrahedra
