@@ -22,12 +22,12 @@
  * the order of the coefficients' size times machine epsilon times the steps that made them), and the bound must
  * exceed BoundMargin() times its own terms' size. Where the bound fails, ExactCertifies() compares the exact
  * Bernstein coefficients of det J itself (degree 3n - 1 per axis; positive coefficients make a positive
- * polynomial): tighter, and dearer (~20 us a cubic cell), so it is tried on subcells only (and on the cell at depth
- * 0). A cell neither decides is split at 1/2 along every
- * axis (de Casteljau: the children's nets are exact Bezier forms of the same polynomial) down to a depth; at every
- * node's 8 corners the Bezier form interpolates, so det there is the triple product of the corner differences,
- * exact but for rounding: a value <= CornerMargin() times its size (zero to float64 precision, or negative) makes
- * the cell folded. A cell is certified when every leaf is, folded when a corner is, undecided otherwise.
+ * polynomial): tighter, and dearer than a level of subdivision, so it is tried on subcells only (and on the cell
+ * at depth 0). A cell neither decides is split at 1/2 along every axis (de Casteljau: the children's nets are
+ * exact Bezier forms of the same polynomial) down to a depth; at every node's 8 corners the Bezier form interpolates,
+ * so det there is the triple product of the corner differences, exact but for rounding: a value <= CornerMargin() times
+ * its size (zero to float64 precision, or negative) makes the cell folded. A cell is certified when every leaf is,
+ * folded when a corner is, undecided otherwise.
  *
  * Everything here is plain data and loops over caller-given storage (host and device alike).
  */
@@ -283,8 +283,8 @@ FFD_INLINE double SmallBinomial(int n, int k)
   return (k == 0 || k == n) ? 1.0 : double(n); // C(2, 1) = 2, C(3, 1) = C(3, 2) = 3
 }
 
-/// A column's net (the differences along one axis) with each coefficient times its Bernstein binomials, and
-/// those binomials' products (Scale): products of such nets are the scaled nets of the products.
+/// A column's net (the differences along one axis) with each coefficient times its Bernstein binomials: products
+/// of such nets are the scaled nets of the products. Norm and Wide feed the rounding bound of ExactCertifies().
 struct ScaledColumn
 {
   int Order[3];
