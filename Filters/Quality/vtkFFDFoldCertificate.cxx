@@ -164,7 +164,18 @@ void MapToCells(vtkPointSet* lattice, const vtkFFDGridLattice& view, const std::
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
-vtkFFDFoldCertificate::vtkFFDFoldCertificate() = default;
+struct vtkFFDFoldCertificate::vtkInternals
+{
+  vtkFFDGridDeformer Grid{ false }; // only the points are read, not the displacements
+  vtkFFDTetrahedralDeformer Tetrahedra;
+};
+
+vtkFFDFoldCertificate::vtkFFDFoldCertificate()
+  : Internals(new vtkInternals)
+{
+}
+
+vtkFFDFoldCertificate::~vtkFFDFoldCertificate() = default;
 
 int vtkFFDFoldCertificate::FillInputPortInformation(int port, vtkInformation* info)
 {
@@ -233,7 +244,7 @@ int vtkFFDFoldCertificate::RequestData(
 //------------------------------------------------------------------------------------------------------------
 bool vtkFFDFoldCertificate::CertifyGrid(vtkPointSet* lattice, vtkUnsignedCharArray* out)
 {
-  vtkFFDGridDeformer deformer(false);
+  vtkFFDGridDeformer& deformer = this->Internals->Grid;
   const std::string problem = deformer.SetLattice(lattice);
   if (!problem.empty())
   {
@@ -265,7 +276,7 @@ bool vtkFFDFoldCertificate::CertifyGrid(vtkPointSet* lattice, vtkUnsignedCharArr
 
 bool vtkFFDFoldCertificate::CertifyTetrahedra(vtkUnstructuredGrid* lattice, vtkUnsignedCharArray* out)
 {
-  vtkFFDTetrahedralDeformer tetrahedra;
+  vtkFFDTetrahedralDeformer& tetrahedra = this->Internals->Tetrahedra;
   const std::string problem = tetrahedra.SetLattice(lattice);
   if (!problem.empty())
   {

@@ -34,6 +34,8 @@
 #include "vtkFFDFiltersQualityModule.h" // For export macro
 #include "vtkPointSetAlgorithm.h"
 
+#include <memory> // For std::unique_ptr
+
 class vtkPointSet;
 class vtkUnsignedCharArray;
 class vtkUnstructuredGrid;
@@ -75,7 +77,7 @@ public:
 
 protected:
   vtkFFDFoldCertificate();
-  ~vtkFFDFoldCertificate() override = default;
+  ~vtkFFDFoldCertificate() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
   /// An allocation that fails becomes an error and an empty output, never an exception out of Update().
@@ -95,6 +97,10 @@ private:
   // The states of the lattice's cells into `states` (one per cell): false on an error (reported) or abort.
   bool CertifyGrid(vtkPointSet* lattice, vtkUnsignedCharArray* states);
   bool CertifyTetrahedra(vtkUnstructuredGrid* lattice, vtkUnsignedCharArray* states);
+
+  // The lattice readers, kept between updates: a lattice whose points alone moved is not checked again in full.
+  struct vtkInternals;
+  std::unique_ptr<vtkInternals> Internals;
 };
 
 #endif

@@ -7,8 +7,9 @@
  * The lattice: the unit box split into N^3 voxels, one point at each voxel's centre, so that every voxel is active;
  * vtkFFDBuildLattice's CUBIC_BSPLINE lattice, sparse and dense. Its points are moved by a mild deformation: a
  * smooth bend of 0.3 control-point spacings plus a random move of up to `--noise` spacings per component (default
- * 0.1, fixed seed). Each row is the median of 3 updates of the whole filter (reading and checking the lattice,
- * deciding every voxel, the cell array), on 1 and 2 threads, at MaxSubdivisionDepth 3.
+ * 0.1, fixed seed). Each row times a new filter's first update (reading and checking the lattice, deciding every
+ * voxel, the cell array), then the median of 3 re-updates after the lattice's points were marked modified (what
+ * a drag does: the filter keeps what it read of the rest state), on 1 and 2 threads, at MaxSubdivisionDepth 3.
  *
  * A second table times vtkFFDMeshInversion on a tetrahedral volume mesh (the Kuhn triangulation of a box, 6 M^3
  * tetrahedra, M = 55: 1.0 M tetrahedra) deformed by the same kind of lattice, against vtkMeshQuality's
@@ -141,10 +142,11 @@ int main(int argc, char* argv[])
     return status;
   }
   divisions = quick ? 30 : divisions;
-  std::printf("CUBIC_BSPLINE, %d^3 voxels (all active), noise %d %% of a spacing, depth 3; median of 3 updates\n\n",
-    divisions, noisePercent);
-  std::printf("| form | threads | voxels | certified | folded | undecided | seconds | M voxels/s |\n");
-  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::printf(
+    "CUBIC_BSPLINE, %d^3 voxels (all active), noise %d %% of a spacing, depth 3\n\n", divisions, noisePercent);
+  std::printf("| form | threads | voxels | certified | folded | undecided | first update s | M voxels/s | "
+              "re-update s |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (int form : { vtkFFDBuildLattice::SPARSE, vtkFFDBuildLattice::DENSE })
   {
     const vtkSmartPointer<vtkPointSet> lattice = MovedLattice(divisions, form, noisePercent / 100.0);
@@ -153,19 +155,24 @@ int main(int argc, char* argv[])
       vtkSMPTools::Initialize(threads);
       vtkNew<vtkFFDFoldCertificate> certificate;
       certificate->SetInputData(lattice);
-      const double seconds = MedianSeconds(3,
+      // A new filter reads and checks the whole lattice; then only its points move (as a drag moves them), and
+      // the filter keeps what it read of the rest (median of 3).
+      const Clock::time_point start = Clock::now();
+      certificate->Update();
+      const double first = Seconds(start);
+      const double again = MedianSeconds(3,
         [&]
         {
-          certificate->Modified();
+          lattice->GetPoints()->Modified();
           certificate->Update();
         });
       const vtkIdType voxels = certificate->GetNumberOfCertifiedCells() + certificate->GetNumberOfFoldedCells() +
         certificate->GetNumberOfUndecidedCells();
-      std::printf("| %s | %d | %lld | %lld | %lld | %lld | %.3f | %.2f |\n",
+      std::printf("| %s | %d | %lld | %lld | %lld | %lld | %.3f | %.2f | %.3f |\n",
         form == vtkFFDBuildLattice::SPARSE ? "sparse" : "dense", threads, static_cast<long long>(voxels),
         static_cast<long long>(certificate->GetNumberOfCertifiedCells()),
         static_cast<long long>(certificate->GetNumberOfFoldedCells()),
-        static_cast<long long>(certificate->GetNumberOfUndecidedCells()), seconds, voxels / seconds * 1e-6);
+        static_cast<long long>(certificate->GetNumberOfUndecidedCells()), first, voxels / first * 1e-6, again);
     }
   }
   MeshInversionTable(quick ? 15 : 55);
