@@ -18,7 +18,7 @@
  *   det >= det(c) - r_s |c_t x c_u| - r_t |c_u x c_s| - r_u |c_s x c_t| - r_s r_t |c_u| - r_t r_u |c_s| - r_u r_s |c_t|
  *          - r_s r_t r_u,
  * so a positive lower bound (times the orientation) certifies the whole cell. Rounding: the net is taken relative
- * to its first point, every radius is widened by Slack() (a bound on the rounding of the net's coefficients, of
+ * to its first point, every radius is widened by Slack() (a bound on the rounding of the net's differences, of
  * the order of the coefficients' size times machine epsilon times the steps that made them), and the bound must
  * exceed BoundMargin() times its own terms' size. Where the bound fails, ExactCertifies() compares the exact
  * Bernstein coefficients of det J itself (degree 3n - 1 per axis; positive coefficients make a positive
@@ -192,13 +192,14 @@ FFD_INLINE double CellNet(
   return largest;
 }
 
-/// How far rounding may have moved the coefficients of a net of `order` made by CellNet() and split `depth` times
-/// from those of the exact polynomial, with `largest` its largest |coordinate|: each de Casteljau or basis-change
-/// step rounds by at most a few units of the coordinates' size; 16 eps per step, over every step, with room to spare.
+/// How far rounding may have moved the differences of neighbouring coefficients (the columns' nets) of a net of
+/// `order` made by CellNet() and split `depth` times from those of the exact polynomial, with `largest` its largest
+/// |coordinate|: each de Casteljau or basis-change step rounds a coefficient by at most a few units of the
+/// coordinates' size; 16 eps per step, over every step, twice (a difference of two), with room to spare.
 FFD_INLINE double Slack(const int order[3], int depth, double largest)
 {
   const int steps = (order[0] + order[1] + order[2]) * (2 + depth) + 4;
-  return 16.0 * 2.220446049250313e-16 * steps * largest * 1.7320508075688772; // |v| <= sqrt(3) max |v_i|
+  return 2.0 * 16.0 * 2.220446049250313e-16 * steps * largest * 1.7320508075688772; // |v| <= sqrt(3) max |v_i|
 }
 
 /// The relative margin by which the bound must exceed its terms' size: its 40-odd roundings, with room to spare.
