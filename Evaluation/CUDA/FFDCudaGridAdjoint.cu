@@ -152,7 +152,8 @@ void SortAdjointPoints(AdjointPlan& plan, const int* cells, std::int64_t count, 
   Check(cudaStreamSynchronize(stream), "planning the adjoint");
 }
 
-void FinishAdjointPlan(AdjointPlan& plan, std::int64_t controlPoints, cudaStream_t stream)
+void FinishAdjointPlan(
+  AdjointPlan& plan, std::int64_t points, std::int64_t controlPoints, std::size_t realBytes, cudaStream_t stream)
 {
   const std::int64_t terms = plan.Chunks * plan.Terms;
   Buffer sortedKeys;
@@ -167,13 +168,23 @@ void FinishAdjointPlan(AdjointPlan& plan, std::int64_t controlPoints, cudaStream
   plan.Values.Free();
   plan.Flags.Free();
   plan.Scratch.Free();
+  plan.Partials.Reserve(std::size_t(terms) * 3 * sizeof(double), "allocating the adjoint's partials");
+  plan.Sums.Reserve(std::size_t(controlPoints) * 3 * sizeof(double), "allocating the sensitivities");
+  plan.Gradient.Reserve(std::size_t(points) * 3 * realBytes, "allocating the gradient");
 }
 
-void GatherAdjoint(AdjointPlan& plan, std::int64_t controlPoints, cudaStream_t stream)
+std::size_t GatherAndDownloadAdjoint(AdjointPlan& plan, std::int64_t controlPoints, cudaStream_t stream,
+  cudaEvent_t start, cudaEvent_t stop, float& milliseconds, double* sums)
 {
   GatherKernel<<<BlocksFor(controlPoints), ThreadsPerBlock, 0, stream>>>(plan.TermOrder.As<int>(),
     plan.TermStart.As<int>(), plan.Partials.As<double>(), controlPoints, plan.Sums.As<double>());
   Check(cudaGetLastError(), "launching the adjoint's gather");
+  Check(cudaEventRecord(stop, stream), "recording an event");
+  Check(cudaEventSynchronize(stop), "computing the adjoint");
+  Check(cudaEventElapsedTime(&milliseconds, start, stop), "timing the adjoint");
+  const std::size_t bytes = std::size_t(controlPoints) * 3 * sizeof(double);
+  Check(cudaMemcpy(sums, plan.Sums.Data, bytes, cudaMemcpyDeviceToHost), "downloading the sensitivities");
+  return bytes;
 }
 
 } // namespace detail

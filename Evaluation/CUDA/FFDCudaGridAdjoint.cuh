@@ -20,6 +20,7 @@
 #include "FFDGridDeformation.h"
 
 #include <cstdint>
+#include <vector>
 
 namespace ffd
 {
@@ -53,12 +54,41 @@ struct AdjointPlan
  */
 void SortAdjointPoints(AdjointPlan& plan, const int* cells, std::int64_t count, cudaStream_t stream);
 
-/// The plan's last part: the Chunks x Terms terms, whose control points AdjointTermKernel wrote into Keys (and
-/// their indices into Values, both reserved for them), sorted by control point.
-void FinishAdjointPlan(AdjointPlan& plan, std::int64_t controlPoints, cudaStream_t stream);
+/// The plan's last part: the Chunks x Terms terms, whose control points AdjointTermKernel (or the tetrahedra's
+/// term kernel) wrote into Keys (and their indices into Values, both reserved for them), sorted by control
+/// point; then the partials, sums and gradient (`realBytes` a value) allocated.
+void FinishAdjointPlan(
+  AdjointPlan& plan, std::int64_t points, std::int64_t controlPoints, std::size_t realBytes, cudaStream_t stream);
 
-/// Gathers the partials into Sums (3 per control point) in the plan's order.
-void GatherAdjoint(AdjointPlan& plan, std::int64_t controlPoints, cudaStream_t stream);
+/**
+ * An adjoint's update once its plan is made, for a grid or a tetrahedral lattice alike: the gradient (3 doubles a
+ * point) uploaded in the points' precision Real, sumChunks() (the lattice's chunk kernel, into Partials), the
+ * partials gathered into Sums in the plan's order, the kernels timed from `start` to `stop` into `milliseconds`,
+ * and the sums (3 doubles per control point) downloaded into `sums`. Returns the bytes downloaded.
+ */
+template <typename Real, typename SumChunks>
+std::size_t RunAdjointUpdate(AdjointPlan& plan, const double* gradient, std::int64_t points, std::int64_t controlPoints,
+  cudaStream_t stream, cudaEvent_t start, cudaEvent_t stop, float& milliseconds, double* sums, SumChunks&& sumChunks);
+
+/// The steps of RunAdjointUpdate() that do not depend on the precision: the gather, the timing, the download.
+std::size_t GatherAndDownloadAdjoint(AdjointPlan& plan, std::int64_t controlPoints, cudaStream_t stream,
+  cudaEvent_t start, cudaEvent_t stop, float& milliseconds, double* sums);
+
+template <typename Real, typename SumChunks>
+std::size_t RunAdjointUpdate(AdjointPlan& plan, const double* gradient, std::int64_t points, std::int64_t controlPoints,
+  cudaStream_t stream, cudaEvent_t start, cudaEvent_t stop, float& milliseconds, double* sums, SumChunks&& sumChunks)
+{
+  const std::vector<Real> g(gradient, gradient + 3 * points);
+  Check(cudaMemcpy(plan.Gradient.Data, g.data(), g.size() * sizeof(Real), cudaMemcpyHostToDevice),
+    "uploading the gradient");
+  Check(cudaEventRecord(start, stream), "recording an event");
+  if (plan.Chunks > 0)
+  {
+    sumChunks();
+    Check(cudaGetLastError(), "launching the adjoint");
+  }
+  return GatherAndDownloadAdjoint(plan, controlPoints, stream, start, stop, milliseconds, sums);
+}
 
 /// Keys[e] = the control point of term e = chunk K + k (k = i + c0 (j + c1 l) of the support, K = c0 c1 c2),
 /// Values[e] = e: from the weights of the chunk's first point (their First is the cell's).

@@ -593,12 +593,11 @@ struct GridDeformer::Impl : ResidentPoints::State
               this->WithCells(Deformation{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
                 { dims[0], dims[1], dims[2] }, nullptr, frame });
             this->EnsureAdjointPlan<Real, MaxCount>(deformation, controlPoints);
-            this->LaunchAdjoint<Real, MaxCount>(deformation, gradient, controlPoints);
+            this->Counts.BytesDownloaded += detail::RunAdjointUpdate<Real>(*this->Plan, gradient, this->Count,
+              controlPoints, this->Stream, this->KernelStart, this->KernelStop, this->Counts.LastKernelMilliseconds,
+              sums, [&] { this->LaunchAdjointChunks<Real, MaxCount>(deformation); });
           });
       });
-    const std::size_t bytes = std::size_t(controlPoints) * 3 * sizeof(double);
-    Check(cudaMemcpy(sums, this->Plan->Sums.Data, bytes, cudaMemcpyDeviceToHost), "downloading the sensitivities");
-    this->Counts.BytesDownloaded += bytes;
   }
 
   // The adjoint's plan for the current binding, made where there is none.
@@ -628,38 +627,22 @@ struct GridDeformer::Impl : ResidentPoints::State
         terms, plan.Counts[0], plan.Counts[1], plan.Counts[2], deformation, plan.Keys.As<int>(), plan.Values.As<int>());
       Check(cudaGetLastError(), "launching the adjoint's plan");
     }
-    detail::FinishAdjointPlan(plan, controlPoints, this->Stream);
-    plan.Partials.Reserve(std::size_t(terms) * 3 * sizeof(double), "allocating the adjoint's partials");
-    plan.Sums.Reserve(std::size_t(controlPoints) * 3 * sizeof(double), "allocating the sensitivities");
-    plan.Gradient.Reserve(std::size_t(this->Count) * 3 * sizeof(Real), "allocating the gradient");
+    detail::FinishAdjointPlan(plan, this->Count, controlPoints, sizeof(Real), this->Stream);
     plan.ForBinding = this->Counts.Bindings;
     ++this->Counts.AdjointPlans;
   }
 
-  // Uploads the gradient (in the points' precision), sums the chunks and gathers them, timed by the events.
+  // The chunks' sums (AdjointChunkKernel), a block per chunk and block of columns.
   template <typename Real, int MaxCount, typename Deformation>
-  void LaunchAdjoint(const Deformation& deformation, const double* gradient, std::int64_t controlPoints)
+  void LaunchAdjointChunks(const Deformation& deformation)
   {
-    detail::AdjointPlan& plan = *this->Plan;
-    const std::vector<Real> g(gradient, gradient + 3 * this->Count);
-    Check(cudaMemcpy(plan.Gradient.Data, g.data(), g.size() * sizeof(Real), cudaMemcpyHostToDevice),
-      "uploading the gradient");
-    Check(cudaEventRecord(this->KernelStart, this->Stream), "recording an event");
-    if (plan.Chunks > 0)
-    {
-      const detail::AdjointLayout layout(plan.Counts, sizeof(Real));
-      const dim3 blocks(unsigned(plan.Chunks), unsigned(layout.ColumnBlocks()));
-      detail::AdjointChunkKernel<Deformation, Real, MaxCount>
-        <<<blocks, detail::AdjointThreads, layout.SharedBytes(sizeof(Real)), this->Stream>>>(this->Points.As<Real>(),
-          plan.Order.As<int>(), plan.ChunkStart.As<std::int64_t>(), plan.ChunkCell.As<int>(), plan.Gradient.As<Real>(),
-          layout, deformation, plan.Partials.As<double>());
-      Check(cudaGetLastError(), "launching the adjoint");
-    }
-    detail::GatherAdjoint(plan, controlPoints, this->Stream);
-    Check(cudaEventRecord(this->KernelStop, this->Stream), "recording an event");
-    Check(cudaEventSynchronize(this->KernelStop), "computing the adjoint");
-    Check(cudaEventElapsedTime(&this->Counts.LastKernelMilliseconds, this->KernelStart, this->KernelStop),
-      "timing the adjoint");
+    const detail::AdjointPlan& plan = *this->Plan;
+    const detail::AdjointLayout layout(plan.Counts, sizeof(Real));
+    const dim3 blocks(unsigned(plan.Chunks), unsigned(layout.ColumnBlocks()));
+    detail::AdjointChunkKernel<Deformation, Real, MaxCount>
+      <<<blocks, detail::AdjointThreads, layout.SharedBytes(sizeof(Real)), this->Stream>>>(this->Points.As<Real>(),
+        plan.Order.As<int>(), plan.ChunkStart.As<std::int64_t>(), plan.ChunkCell.As<int>(), plan.Gradient.As<Real>(),
+        layout, deformation, plan.Partials.As<double>());
   }
 
   // DeformKernel on a lattice of 3 numbers per control point: with the Jacobian, float64 points, and float32

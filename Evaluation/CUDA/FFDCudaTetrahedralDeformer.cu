@@ -2,9 +2,11 @@
 #include "FFDCudaTetrahedralDeformer.h"
 
 #include "FFDCudaDevice.cuh"
+#include "FFDCudaGridAdjoint.cuh"
 #include "FFDTetrahedra.h"
 
 #include <cstring>
+#include <memory>
 #include <type_traits>
 
 namespace ffd
@@ -34,6 +36,66 @@ __global__ void MapKernel(const ffd::Frame<double>* __restrict__ frames, const i
   maps[t] = ffd::MakeTetrahedronMap(frames[t], d(n.x), d(n.y), d(n.z), d(n.w)).template As<Real>();
 }
 
+// The adjoint's terms (FFDCudaGridAdjoint.cuh): term e = 4 chunk + k is node k of the chunk's tetrahedron.
+__global__ void TetrahedronTermKernel(
+  const int* __restrict__ chunkCell, const int4* __restrict__ nodes, std::int64_t terms, int* keys, int* values)
+{
+  const std::int64_t e = blockIdx.x * std::int64_t(blockDim.x) + threadIdx.x;
+  if (e < terms)
+  {
+    const int4 n = nodes[chunkCell[e / 4]];
+    const int k = int(e % 4);
+    keys[e] = k == 0 ? n.x : (k == 1 ? n.y : (k == 2 ? n.z : n.w));
+    values[e] = int(e);
+  }
+}
+
+// The adjoint's partials, a warp per chunk of one tetrahedron: lane l sums the chunk's points l, l + 32, ... with
+// their barycentric weights (1 - s - t - u, s, t, u) at the point, in float64 as the CPU's; then the lanes are
+// added in a fixed tree (offsets 16, 8, 4, 2, 1), the same order at every run.
+template <typename Real>
+__global__ void TetrahedronChunkKernel(const Real* __restrict__ points, const int* __restrict__ order,
+  const std::int64_t* __restrict__ chunkStart, const int* __restrict__ chunkCell, const Real* __restrict__ gradient,
+  const ffd::Frame<double>* __restrict__ frames, std::int64_t chunks, double* __restrict__ partials)
+{
+  const std::int64_t chunk = (blockIdx.x * std::int64_t(blockDim.x) + threadIdx.x) / 32;
+  const int lane = threadIdx.x % 32;
+  if (chunk >= chunks)
+  {
+    return; // a whole warp
+  }
+  const ffd::Frame<double> frame = frames[chunkCell[chunk]];
+  double sum[4][3] = {};
+  for (std::int64_t q = chunkStart[chunk] + lane; q < chunkStart[chunk + 1]; q += 32)
+  {
+    const std::int64_t p = order[q];
+    const Real* x = points + 3 * p;
+    const ffd::Vec3<double> stu = frame.ToParametric({ double(x[0]), double(x[1]), double(x[2]) });
+    const double w[4] = { 1.0 - stu.x - stu.y - stu.z, stu.x, stu.y, stu.z };
+    for (int k = 0; k < 4; ++k)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        sum[k][c] += w[k] * double(gradient[3 * p + c]);
+      }
+    }
+  }
+  for (int k = 0; k < 4; ++k)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      for (int offset = 16; offset > 0; offset /= 2)
+      {
+        sum[k][c] += __shfl_down_sync(0xffffffffu, sum[k][c], offset);
+      }
+      if (lane == 0)
+      {
+        partials[3 * (4 * chunk + k) + c] = sum[k][c];
+      }
+    }
+  }
+}
+
 } // namespace
 
 //------------------------------------------------------------------------------------------------------------
@@ -41,9 +103,11 @@ struct TetrahedralDeformer::Impl : ResidentPoints::State
 {
   Buffer Frames, Nodes, Maps; // rest frame and nodes (int4) per tetrahedron; this update's maps
   std::int64_t Tetrahedra = 0, NodeCount = 0;
+  std::unique_ptr<detail::AdjointPlan> Plan; // the adjoint's, made for the binding it names
 
   void Release() override
   {
+    this->Plan.reset();
     this->Frames.Free();
     this->Nodes.Free();
     this->Maps.Free();
@@ -131,6 +195,48 @@ struct TetrahedralDeformer::Impl : ResidentPoints::State
       this->OutPoints.As<Real>(), this->Normals.As<Real>(), normalsOut, determinantsOut, this->Stream);
     this->FinishEvaluation(withNormals, withDeterminants, true);
   }
+
+  // W^T g of the nodes: the plan (chunks of one tetrahedron, its 4 nodes their terms) made once per binding, then
+  // the chunks' partials and their gather (FFDCudaGridAdjoint.cuh).
+  template <typename Real>
+  void RunAdjoint(const double* gradient, std::int64_t nodes, double* sums)
+  {
+    this->RequireBound<Real>(false);
+    if (nodes != this->NodeCount)
+    {
+      throw CudaError{ cudaErrorInvalidValue, "the adjoint: the nodes do not match the bound ones" };
+    }
+    if (!this->Plan || this->Plan->ForBinding != this->Counts.Bindings)
+    {
+      this->Plan.reset(new detail::AdjointPlan);
+      detail::AdjointPlan& plan = *this->Plan;
+      plan.Counts[0] = plan.Counts[1] = 1;
+      plan.Counts[2] = plan.Terms = 4;
+      plan.ChunkPoints = ffd::AdjointChunkPoints(this->Count, plan.Terms);
+      detail::SortAdjointPoints(plan, this->Cells.As<int>(), this->Count, this->Stream);
+      const std::int64_t terms = 4 * plan.Chunks;
+      plan.Keys.Reserve(std::size_t(terms) * sizeof(int), "allocating the adjoint's plan");
+      plan.Values.Reserve(std::size_t(terms) * sizeof(int), "allocating the adjoint's plan");
+      if (terms > 0)
+      {
+        TetrahedronTermKernel<<<BlocksFor(terms), ThreadsPerBlock, 0, this->Stream>>>(
+          plan.ChunkCell.As<int>(), this->Nodes.As<int4>(), terms, plan.Keys.As<int>(), plan.Values.As<int>());
+        Check(cudaGetLastError(), "launching the adjoint's plan");
+      }
+      detail::FinishAdjointPlan(plan, this->Count, nodes, sizeof(Real), this->Stream);
+      plan.ForBinding = this->Counts.Bindings;
+      ++this->Counts.AdjointPlans;
+    }
+    detail::AdjointPlan& plan = *this->Plan;
+    this->Counts.BytesDownloaded += detail::RunAdjointUpdate<Real>(plan, gradient, this->Count, nodes, this->Stream,
+      this->KernelStart, this->KernelStop, this->Counts.LastKernelMilliseconds, sums,
+      [&]
+      {
+        TetrahedronChunkKernel<Real><<<BlocksFor(32 * plan.Chunks), ThreadsPerBlock, 0, this->Stream>>>(
+          this->Points.As<Real>(), plan.Order.As<int>(), plan.ChunkStart.As<std::int64_t>(), plan.ChunkCell.As<int>(),
+          plan.Gradient.As<Real>(), this->Frames.As<ffd::Frame<double>>(), plan.Chunks, plan.Partials.As<double>());
+      });
+  }
 };
 
 //------------------------------------------------------------------------------------------------------------
@@ -144,6 +250,23 @@ bool TetrahedralDeformer::Bind(const int* tetrahedronOfPoint, const ffd::Frame<d
 {
   Impl& p = static_cast<Impl&>(*this->S);
   return p.Guard([&] { p.RunBind(tetrahedronOfPoint, restFrames, tetrahedronNodes, tetrahedra, nodes); });
+}
+
+bool TetrahedralDeformer::Adjoint(const double* gradient, std::int64_t nodes, double* sums)
+{
+  Impl& p = static_cast<Impl&>(*this->S);
+  return p.Guard(
+    [&]
+    {
+      if (p.IsDouble)
+      {
+        p.RunAdjoint<double>(gradient, nodes, sums);
+      }
+      else
+      {
+        p.RunAdjoint<float>(gradient, nodes, sums);
+      }
+    });
 }
 
 bool TetrahedralDeformer::Evaluate(

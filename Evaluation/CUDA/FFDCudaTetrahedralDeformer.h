@@ -47,6 +47,15 @@ public:
   /// stay on the device until Download().
   bool Evaluate(const double* displacements, std::int64_t nodes, bool withNormals, bool withDeterminants);
 
+  /**
+   * W^T g, the adjoint of Evaluate() in the nodes: for the gradient g of an objective at the deformed points (3
+   * doubles per point), the gradient at the nodes into `sums` (3 doubles per node, `nodes` as Evaluate()), each
+   * point's term its barycentric weights in its tetrahedron in float64 (the points the host clamps to the control
+   * mesh are not the device's: a binding with any is summed on the host). Summed without atomics in one order
+   * set by the binding: the same bits at every run. Its plan is made at the first call after a binding.
+   */
+  bool Adjoint(const double* gradient, std::int64_t nodes, double* sums);
+
 private:
   struct Impl;
 };

@@ -203,13 +203,7 @@ struct vtkFFDCudaBackend::vtkState : std::enable_shared_from_this<vtkFFDCudaBack
     const bool rebind = uploadPoints || tetrahedra.GetBindTime() != this->TetrahedraBindTime;
     this->TetrahedraPoints = nullptr; // valid again once everything succeeded
     const vtkIdType nodes = static_cast<vtkIdType>(tetrahedra.GetDisplacements().size() / 3);
-    auto bind = [&]
-    {
-      const std::vector<vtkIdType>& ids = tetrahedra.GetNodes();
-      const std::vector<int> nodeIds(ids.begin(), ids.end());
-      return this->Tetrahedra.Bind(tetrahedra.GetCellOfPoint().data(), tetrahedra.GetFrames().data(), nodeIds.data(),
-        tetrahedra.GetNumberOfTetrahedra(), nodes);
-    };
+    auto bind = [&] { return this->BindTetrahedra(tetrahedra); };
     auto evaluate = [&](bool withNormals, bool withDeterminants)
     { return this->Tetrahedra.Evaluate(tetrahedra.GetDisplacements().data(), nodes, withNormals, withDeterminants); };
     if (!Run(this->Tetrahedra, this->shared_from_this(), this->TetrahedraNormals, uploadPoints, rebind, points, normals,
@@ -225,6 +219,39 @@ struct vtkFFDCudaBackend::vtkState : std::enable_shared_from_this<vtkFFDCudaBack
     {
       tetrahedra.ApplyClampedPoints(points, normals, outPoints, outNormals, outDeterminants);
     }
+    return true;
+  }
+
+  // Uploads the host's binding of `tetrahedra`.
+  bool BindTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra)
+  {
+    const std::vector<vtkIdType>& ids = tetrahedra.GetNodes();
+    const std::vector<int> nodeIds(ids.begin(), ids.end());
+    return this->Tetrahedra.Bind(tetrahedra.GetCellOfPoint().data(), tetrahedra.GetFrames().data(), nodeIds.data(),
+      tetrahedra.GetNumberOfTetrahedra(), static_cast<vtkIdType>(tetrahedra.GetDisplacements().size() / 3));
+  }
+
+  // W^T g on the device's binding of `tetrahedra`, uploaded (with the points, in the precision Real) where the
+  // device holds another.
+  template <typename Real>
+  bool AdjointTetrahedra(
+    const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points, const double* gradient, double* sums)
+  {
+    const int type = std::is_same<Real, double>::value ? VTK_DOUBLE : VTK_FLOAT;
+    const bool uploadPoints = points != this->TetrahedraPoints || points->GetMTime() != this->TetrahedraPointsMTime ||
+      type != this->TetrahedraType;
+    const bool rebind = uploadPoints || tetrahedra.GetBindTime() != this->TetrahedraBindTime;
+    this->TetrahedraPoints = nullptr; // valid again once everything succeeded
+    if (!UploadAndBind<Real>(this->Tetrahedra, this->TetrahedraNormals, uploadPoints, rebind, points,
+          [&] { return this->BindTetrahedra(tetrahedra); }) ||
+      !this->Tetrahedra.Adjoint(gradient, vtkIdType(tetrahedra.GetDisplacements().size() / 3), sums))
+    {
+      return false;
+    }
+    this->TetrahedraPoints = points;
+    this->TetrahedraPointsMTime = points->GetMTime();
+    this->TetrahedraType = type;
+    this->TetrahedraBindTime = tetrahedra.GetBindTime();
     return true;
   }
 
@@ -303,6 +330,21 @@ bool vtkFFDCudaBackend::AdjointGrid(const vtkFFDGridDeformer& grid, const vtkFFD
   return ok;
 }
 
+bool vtkFFDCudaBackend::AdjointTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points, int precision,
+  const double* gradient, double* sums, std::string& why)
+{
+  vtkState& state = *this->State;
+  const bool resident = points == state.TetrahedraPoints && points->GetMTime() == state.TetrahedraPointsMTime;
+  const int type = resident ? state.TetrahedraType : precision;
+  const bool ok = type == VTK_DOUBLE ? state.AdjointTetrahedra<double>(tetrahedra, points, gradient, sums)
+                                     : state.AdjointTetrahedra<float>(tetrahedra, points, gradient, sums);
+  if (!ok)
+  {
+    why = state.Tetrahedra.GetLastError();
+  }
+  return ok;
+}
+
 bool vtkFFDCudaBackend::DeformTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points,
   vtkDataArray* normals, vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
   vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice, std::string& why)
@@ -345,6 +387,12 @@ bool vtkFFDCudaBackend::AdjointGrid(const vtkFFDGridDeformer&, const vtkFFDBindi
   double*, bool& bound, std::string& why)
 {
   bound = false;
+  return vtkFFDCudaBackend::IsAvailable(why);
+}
+
+bool vtkFFDCudaBackend::AdjointTetrahedra(
+  const vtkFFDTetrahedralDeformer&, vtkPoints*, int, const double*, double*, std::string& why)
+{
   return vtkFFDCudaBackend::IsAvailable(why);
 }
 

@@ -77,6 +77,15 @@ public:
     vtkDataArray* outPoints, vtkDataArray* outNormals, vtkDataArray* outDeterminants,
     vtkSmartPointer<vtkFFDDeviceOutput>* keptOnDevice, std::string& why);
 
+  /**
+   * W^T g on the device for the tetrahedral lattice of `tetrahedra` (whose Bind() ran for these points, with no
+   * point clamped to the control mesh: those are the host's): its binding uploaded, with the points in `precision`
+   * where the device holds other points (else in theirs), then ffd::cuda::TetrahedralDeformer::Adjoint(). Failures
+   * as DeformGrid().
+   */
+  bool AdjointTetrahedra(const vtkFFDTetrahedralDeformer& tetrahedra, vtkPoints* points, int precision,
+    const double* gradient, double* sums, std::string& why);
+
   ///@{
   /// What crossed the bus, in all (both lattice kinds): the lattices' displacements uploaded, and the bytes
   /// downloaded (deformed points, normals, determinants, bounds).

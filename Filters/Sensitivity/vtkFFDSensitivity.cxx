@@ -77,8 +77,8 @@ inline void AddTerm(double* sums, int controlPoint, double w, const double* g)
 // to the control mesh, at its nearest point there (as ApplyClampedPoints()). Each tetrahedron sums its points'
 // terms in increasing id (in parallel over tetrahedra), then each node adds its tetrahedra's sums in increasing
 // tetrahedron order (in parallel over nodes): one order whatever the threads.
-void TetrahedralSums(const vtkFFDTetrahedralDeformer& tetrahedra, const std::vector<double>& x,
-  const std::vector<double>& g, std::vector<double>& out)
+void TetrahedralSums(
+  const vtkFFDTetrahedralDeformer& tetrahedra, const std::vector<double>& x, const double* g, std::vector<double>& out)
 {
   // Each weighted point, with where its weights are taken (the point, or its nearest point of the mesh).
   std::vector<int> cellOf = tetrahedra.GetCellOfPoint();
@@ -286,7 +286,7 @@ bool vtkFFDSensitivity::SumGrid(
   return true;
 }
 
-bool vtkFFDSensitivity::SumGridOnCuda(vtkPoints* points, const double* g, std::vector<double>& sums)
+bool vtkFFDSensitivity::CudaAllowed()
 {
   const int backend = this->Deform ? this->Deform->GetBackend() : this->Backend;
   std::string why;
@@ -298,6 +298,24 @@ bool vtkFFDSensitivity::SumGridOnCuda(vtkPoints* points, const double* g, std::v
     }
     return false;
   }
+  return true;
+}
+
+int vtkFFDSensitivity::DevicePrecision(vtkPoints* points) const
+{
+  const int precision = this->Deform ? this->Deform->GetOutputPointsPrecision() : vtkAlgorithm::DEFAULT_PRECISION;
+  return precision == vtkAlgorithm::DOUBLE_PRECISION ||
+      (precision == vtkAlgorithm::DEFAULT_PRECISION && points->GetDataType() == VTK_DOUBLE)
+    ? VTK_DOUBLE
+    : VTK_FLOAT;
+}
+
+bool vtkFFDSensitivity::SumGridOnCuda(vtkPoints* points, const double* g, std::vector<double>& sums)
+{
+  if (!this->CudaAllowed())
+  {
+    return false;
+  }
   vtkFFDDeform::vtkBinding binding = this->Engine()->GetBinding();
   const int policy = this->EngineOutsidePolicy();
   bool rebound = false;
@@ -306,12 +324,10 @@ bool vtkFFDSensitivity::SumGridOnCuda(vtkPoints* points, const double* g, std::v
   {
     return false;
   }
-  const int precision = this->Deform ? this->Deform->GetOutputPointsPrecision() : vtkAlgorithm::DEFAULT_PRECISION;
-  const bool useDouble = precision == vtkAlgorithm::DOUBLE_PRECISION ||
-    (precision == vtkAlgorithm::DEFAULT_PRECISION && points->GetDataType() == VTK_DOUBLE);
   bool bound = false;
+  std::string why;
   const bool summed = binding.Cuda.AdjointGrid(binding.Grid, binding.Grid.KeyOf(points, policy), points,
-    useDouble ? VTK_DOUBLE : VTK_FLOAT, g, sums.data(), bound, why);
+    this->DevicePrecision(points), g, sums.data(), bound, why);
   this->NumberOfBindings += (rebound || (bound && !binding.Grid.GetLattice().Sparse)) ? 1 : 0;
   if (!summed)
   {
@@ -342,7 +358,22 @@ bool vtkFFDSensitivity::SumTetrahedral(
     return false;
   }
   this->NumberOfBindings += rebound ? 1 : 0;
-  TetrahedralSums(tetrahedra, AsDoubles(mesh->GetPoints()->GetData()), AsDoubles(gradient), sums);
+  std::vector<double> copy;
+  const double* g = GradientValues(gradient, copy);
+  // The points clamped to the control mesh take their nearest point's weights, which the host holds.
+  if (!tetrahedra.HasClampedPoints() && this->CudaAllowed())
+  {
+    std::string why;
+    if (this->Engine()->GetBinding().Cuda.AdjointTetrahedra(
+          tetrahedra, mesh->GetPoints(), this->DevicePrecision(mesh->GetPoints()), g, sums.data(), why))
+    {
+      this->LastBackendUsed = "CUDA";
+      return true;
+    }
+    vtkWarningMacro("The CUDA backend failed (" << why << "); summing on the CPU.");
+  }
+  std::fill(sums.begin(), sums.end(), 0.0);
+  TetrahedralSums(tetrahedra, AsDoubles(mesh->GetPoints()->GetData()), g, sums);
   this->LastBackendUsed = "CPU";
   return true;
 }

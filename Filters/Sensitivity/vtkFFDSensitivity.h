@@ -37,7 +37,8 @@
  * precision; the mesh's points' without SetDeform()) and sums in float64 without atomics: each cell's points in
  * chunks, then each control point's chunks, in an order set by the binding alone, so the same bits at every run;
  * in float64 it agrees with the CPU to the rounding of the sums. Tetrahedral lattices, bound on the host, are
- * summed on the CPU. GetLastBackendUsed() tells which ran.
+ * summed on the device too, but where points are clamped to the control mesh (CLAMP_TO_EDGE: their nearest
+ * points are the host's), on the CPU. GetLastBackendUsed() tells which ran.
  *
  * @sa vtkFFDDeform
  */
@@ -133,6 +134,10 @@ private:
   /// SumGrid() on the device, where the backend allows it; false where the CPU must sum (with a warning where
   /// CUDA was asked for or failed).
   bool SumGridOnCuda(vtkPoints* points, const double* g, std::vector<double>& sums);
+  /// Whether the sums may run on the device (the Backend, a device); a warning where CUDA was asked for and cannot.
+  bool CudaAllowed();
+  /// VTK_FLOAT or VTK_DOUBLE: the precision of the points where the device binds them (the Deform's output's).
+  int DevicePrecision(vtkPoints* points) const;
 
   // Whose binding and settings the sums use: the Deform's, else this filter's own.
   vtkFFDDeform* Engine();

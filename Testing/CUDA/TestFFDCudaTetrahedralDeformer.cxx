@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The CUDA backend for tetrahedral lattices against an independent float64 reference written from the paper's
 // equation 5 (barycentric weights as signed sub-volume ratios, the deformed point as the weighted sum of the
-// moved nodes), on random tetrahedral meshes with fixed seeds, in float32 and float64; device residency (an
-// update uploads only the nodes' displacements); failures. Without a CUDA device every test skips but the last.
+// moved nodes), on random tetrahedral meshes with fixed seeds, in float32 and float64, the deformation and its
+// adjoint; device residency (an update uploads only the nodes' displacements); failures. Without a CUDA device every
+// test skips but the last.
 #include "FFDCudaTestSupport.h"
 #include "FFDCudaTetrahedralDeformer.h"
 #include "FFDTestComparisons.h"
@@ -287,6 +288,79 @@ TYPED_TEST(CudaTetrahedralDeformerTest, MatchesFloat64Reference)
   }
   std::printf("tetrahedra, %s against float64: largest position error %.2e of the mesh's size\n",
     single ? "float32" : "float64", worst);
+}
+
+// The adjoint W^T g on the device against the reference's weights (equation 5, volume ratios: independent of the
+// device's frames), for every bound point. Per node, both sum the same points' terms: in float64 their weights
+// differ by rounding (a few eps, conditioning included: the mesh is jittered by at most 0.1) and the sums by
+// their order, |difference| <= 1e-12 (S_n + G_n), S_n the terms' sizes and G_n = sum |g| of the node's points;
+// in float32 the device's weights are those of the points rounded to float (their parameters move by about
+// 6e-8 |x| / h, under 1e-6 here), |difference| <= 1e-5 G_n. Then the same bits twice and on a fresh deformer, one
+// plan per binding.
+TYPED_TEST(CudaTetrahedralDeformerTest, AdjointMatchesReference)
+{
+  FFD_REQUIRE_DEVICE();
+  using Real = TypeParam;
+  const bool single = sizeof(Real) == sizeof(float);
+  std::mt19937 rng(808);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const Problem p(5, 30011, true, rng);
+  std::vector<double> g(p.Points.size());
+  for (double& v : g)
+  {
+    v = unit(rng);
+  }
+  const std::int64_t nodes = p.Mesh.NumberOfNodes();
+  std::vector<double> expected(3 * nodes, 0.0), sizes(nodes, 0.0), gradients(nodes, 0.0);
+  for (std::int64_t i = 0; i < p.Count(); ++i)
+  {
+    if (p.Cells[i] < 0)
+    {
+      continue;
+    }
+    const Real rounded[3] = { Real(p.Points[3 * i]), Real(p.Points[3 * i + 1]), Real(p.Points[3 * i + 2]) };
+    const double x[3] = { double(rounded[0]), double(rounded[1]), double(rounded[2]) };
+    double w[4];
+    Weights(p.Mesh, p.Cells[i], x, w);
+    for (int k = 0; k < 4; ++k)
+    {
+      const int n = p.Mesh.Tetrahedra[4 * p.Cells[i] + k];
+      for (int c = 0; c < 3; ++c)
+      {
+        expected[3 * n + c] += w[k] * g[3 * i + c];
+        sizes[n] += std::fabs(w[k] * g[3 * i + c]);
+        gradients[n] += std::fabs(g[3 * i + c]);
+      }
+    }
+  }
+  auto adjoint = [&](int calls, std::uint64_t* plans)
+  {
+    const std::vector<Real> points(p.Points.begin(), p.Points.end());
+    ffd::cuda::TetrahedralDeformer gpu;
+    std::vector<double> sums(3 * nodes, -12345.0); // poisoned: unwritten values show
+    EXPECT_TRUE(gpu.SetPoints(points.data(), p.Count()) && p.Bind(gpu)) << gpu.GetLastError();
+    for (int call = 0; call < calls; ++call)
+    {
+      EXPECT_TRUE(gpu.Adjoint(g.data(), nodes, sums.data())) << gpu.GetLastError();
+    }
+    *plans = gpu.GetCounters().AdjointPlans;
+    return sums;
+  };
+  std::uint64_t plans = 0;
+  const std::vector<double> got = adjoint(2, &plans);
+  EXPECT_EQ(plans, 1u);
+  ffdtest::Mismatches wrong;
+  for (std::int64_t n = 0; n < nodes; ++n)
+  {
+    const double tolerance = single ? 1e-5 * gradients[n] : 1e-12 * (sizes[n] + gradients[n]);
+    for (int c = 0; c < 3; ++c)
+    {
+      wrong.Check("sensitivity", n, got[3 * n + c], expected[3 * n + c], tolerance);
+    }
+  }
+  EXPECT_EQ(wrong.Count, 0) << wrong.First;
+  const std::vector<double> again = adjoint(1, &plans);
+  EXPECT_EQ(std::memcmp(got.data(), again.data(), got.size() * sizeof(double)), 0) << "not the same bits";
 }
 
 // Only the nodes' displacements cross the bus on an update; moving one node moves only the points of the
