@@ -19,6 +19,7 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -69,6 +70,29 @@ inline vtkSmartPointer<vtkPolyData> ReadTestMeshOrReport(const std::string& name
     std::cerr << e.what() << "\n";
     return nullptr;
   }
+}
+
+/// The mesh's points in float64 and `outside` more, uniform in a box 60 % larger than its bounds (30 % beyond
+/// each side): a cloud with points inside and outside a lattice over the mesh.
+inline vtkSmartPointer<vtkPolyData> PointsAround(vtkPolyData* mesh, int outside, std::mt19937& rng)
+{
+  double b[6];
+  mesh->GetBounds(b);
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  for (vtkIdType p = 0; p < mesh->GetNumberOfPoints(); ++p)
+  {
+    points->InsertNextPoint(mesh->GetPoint(p));
+  }
+  std::uniform_real_distribution<double> unit(-0.3, 1.3);
+  for (int p = 0; p < outside; ++p)
+  {
+    points->InsertNextPoint(
+      b[0] + unit(rng) * (b[1] - b[0]), b[2] + unit(rng) * (b[3] - b[2]), b[4] + unit(rng) * (b[5] - b[4]));
+  }
+  auto cloud = vtkSmartPointer<vtkPolyData>::New();
+  cloud->SetPoints(points);
+  return cloud;
 }
 
 /// A point set of the given points (double precision), without cells.

@@ -44,24 +44,9 @@ constexpr double Eps = std::numeric_limits<double>::epsilon();
 /// gradient array `g` of components in [-1, 1].
 vtkSmartPointer<vtkPolyData> CloudWithGradient(vtkPolyData* bear, int outside, std::mt19937& rng)
 {
-  double b[6];
-  bear->GetBounds(b);
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  for (vtkIdType p = 0; p < bear->GetNumberOfPoints(); ++p)
-  {
-    points->InsertNextPoint(bear->GetPoint(p));
-  }
-  std::uniform_real_distribution<double> unit(0.0, 1.0), component(-1.0, 1.0);
-  for (int p = 0; p < outside; ++p)
-  {
-    double x[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      x[a] = b[2 * a] + (1.6 * unit(rng) - 0.3) * (b[2 * a + 1] - b[2 * a]);
-    }
-    points->InsertNextPoint(x);
-  }
+  vtkSmartPointer<vtkPolyData> cloud = PointsAround(bear, outside, rng);
+  vtkPoints* points = cloud->GetPoints();
+  std::uniform_real_distribution<double> component(-1.0, 1.0);
   vtkNew<vtkDoubleArray> g;
   g->SetName("g");
   g->SetNumberOfComponents(3);
@@ -70,8 +55,6 @@ vtkSmartPointer<vtkPolyData> CloudWithGradient(vtkPolyData* bear, int outside, s
   {
     g->SetValue(v, component(rng));
   }
-  auto cloud = vtkSmartPointer<vtkPolyData>::New();
-  cloud->SetPoints(points);
   cloud->GetPointData()->AddArray(g);
   return cloud;
 }

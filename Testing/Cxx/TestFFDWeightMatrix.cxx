@@ -51,28 +51,6 @@ struct Csr
   }
 };
 
-/// The bear's points and `outside` more in a box 60 % larger than its bounds, as float64.
-vtkSmartPointer<vtkPolyData> Cloud(vtkPolyData* bear, int outside, std::mt19937& rng)
-{
-  double b[6];
-  bear->GetBounds(b);
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  for (vtkIdType p = 0; p < bear->GetNumberOfPoints(); ++p)
-  {
-    points->InsertNextPoint(bear->GetPoint(p));
-  }
-  std::uniform_real_distribution<double> unit(-0.3, 1.3);
-  for (int p = 0; p < outside; ++p)
-  {
-    points->InsertNextPoint(
-      b[0] + unit(rng) * (b[1] - b[0]), b[2] + unit(rng) * (b[3] - b[2]), b[4] + unit(rng) * (b[5] - b[4]));
-  }
-  auto cloud = vtkSmartPointer<vtkPolyData>::New();
-  cloud->SetPoints(points);
-  return cloud;
-}
-
 vtkSmartPointer<vtkUnstructuredGrid> Tetrahedra(vtkPolyData* bear)
 {
   vtkNew<vtkFFDBuildTetrahedralLattice> build;
@@ -100,7 +78,7 @@ TEST(vtkFFDWeightMatrix, SameArraysForAnyNumberOfThreads)
 {
   vtkSmartPointer<vtkPolyData> bear = ReadTestMesh("bear");
   std::mt19937 rng(11);
-  vtkSmartPointer<vtkPolyData> cloud = Cloud(bear, 1000, rng);
+  vtkSmartPointer<vtkPolyData> cloud = PointsAround(bear, 1000, rng);
   for (vtkPointSet* lattice : Lattices(bear, rng))
   {
     std::vector<Csr> runs;
@@ -128,7 +106,7 @@ TEST(vtkFFDWeightMatrix, RowsGiveTheDeformation)
 {
   vtkSmartPointer<vtkPolyData> bear = ReadTestMesh("bear");
   std::mt19937 rng(12);
-  vtkSmartPointer<vtkPolyData> cloud = Cloud(bear, 500, rng);
+  vtkSmartPointer<vtkPolyData> cloud = PointsAround(bear, 500, rng);
   for (vtkPointSet* lattice : Lattices(bear, rng))
   {
     vtkNew<vtkFFDWeightMatrix> matrix;
