@@ -79,7 +79,7 @@ std::size_t RunAdjointUpdate(AdjointPlan& plan, const double* gradient, std::int
   cudaStream_t stream, cudaEvent_t start, cudaEvent_t stop, float& milliseconds, double* sums, SumChunks&& sumChunks)
 {
   const std::vector<Real> g(gradient, gradient + 3 * points);
-  Check(cudaMemcpy(plan.Gradient.Data, g.data(), g.size() * sizeof(Real), cudaMemcpyHostToDevice),
+  Check(cudaMemcpyAsync(plan.Gradient.Data, g.data(), g.size() * sizeof(Real), cudaMemcpyHostToDevice, stream),
     "uploading the gradient");
   Check(cudaEventRecord(start, stream), "recording an event");
   if (plan.Chunks > 0)

@@ -490,10 +490,11 @@ struct GridDeformer::Impl : ResidentPoints::State
     this->Cells.Reserve(pointBytes, "allocating the binding");
     this->CellVoxels.Reserve(voxelBytes, "allocating the lattice's cells");
     this->CellSupports.Reserve(supportBytes, "allocating the lattice's cells");
-    Check(cudaMemcpy(this->Cells.Data, cellOfPoint, pointBytes, cudaMemcpyHostToDevice), "uploading the binding");
-    Check(cudaMemcpy(this->CellVoxels.Data, cellVoxels, voxelBytes, cudaMemcpyHostToDevice),
+    Check(cudaMemcpyAsync(this->Cells.Data, cellOfPoint, pointBytes, cudaMemcpyHostToDevice, this->Stream),
+      "uploading the binding");
+    Check(cudaMemcpyAsync(this->CellVoxels.Data, cellVoxels, voxelBytes, cudaMemcpyHostToDevice, this->Stream),
       "uploading the lattice's cells");
-    Check(cudaMemcpy(this->CellSupports.Data, cellSupports, supportBytes, cudaMemcpyHostToDevice),
+    Check(cudaMemcpyAsync(this->CellSupports.Data, cellSupports, supportBytes, cudaMemcpyHostToDevice, this->Stream),
       "uploading the lattice's cells");
     this->SparseControlPoints = controlPoints;
   }

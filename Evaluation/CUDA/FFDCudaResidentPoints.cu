@@ -128,7 +128,7 @@ void ResidentPoints::State::Upload(const Real* xyz, std::int64_t count)
   this->EnsureStream();
   const std::size_t bytes = std::size_t(count) * 3 * sizeof(Real);
   this->Points.Reserve(bytes, "allocating the points");
-  Check(cudaMemcpy(this->Points.Data, xyz, bytes, cudaMemcpyHostToDevice), "uploading the points");
+  Check(cudaMemcpyAsync(this->Points.Data, xyz, bytes, cudaMemcpyHostToDevice, this->Stream), "uploading the points");
   this->Count = count;
   this->IsDouble = sizeof(Real) == sizeof(double);
   ++this->Counts.PointUploads;
@@ -209,7 +209,8 @@ void ResidentPoints::State::SetNormals(const Real* normals)
   }
   const std::size_t bytes = std::size_t(this->Count) * 3 * sizeof(Real);
   this->Normals.Reserve(bytes, "allocating the normals");
-  Check(cudaMemcpy(this->Normals.Data, normals, bytes, cudaMemcpyHostToDevice), "uploading the normals");
+  Check(
+    cudaMemcpyAsync(this->Normals.Data, normals, bytes, cudaMemcpyHostToDevice, this->Stream), "uploading the normals");
   this->HasNormals = true;
   ++this->Counts.NormalUploads;
 }

@@ -144,9 +144,12 @@ struct TetrahedralDeformer::Impl : ResidentPoints::State
     this->Cells.Reserve(cellBytes, "allocating the binding");
     this->Frames.Reserve(frameBytes, "allocating the tetrahedra");
     this->Nodes.Reserve(nodeBytes, "allocating the tetrahedra");
-    Check(cudaMemcpy(this->Cells.Data, cells, cellBytes, cudaMemcpyHostToDevice), "uploading the binding");
-    Check(cudaMemcpy(this->Frames.Data, frames, frameBytes, cudaMemcpyHostToDevice), "uploading the tetrahedra");
-    Check(cudaMemcpy(this->Nodes.Data, nodes, nodeBytes, cudaMemcpyHostToDevice), "uploading the tetrahedra");
+    Check(cudaMemcpyAsync(this->Cells.Data, cells, cellBytes, cudaMemcpyHostToDevice, this->Stream),
+      "uploading the binding");
+    Check(cudaMemcpyAsync(this->Frames.Data, frames, frameBytes, cudaMemcpyHostToDevice, this->Stream),
+      "uploading the tetrahedra");
+    Check(cudaMemcpyAsync(this->Nodes.Data, nodes, nodeBytes, cudaMemcpyHostToDevice, this->Stream),
+      "uploading the tetrahedra");
     this->Tetrahedra = tetrahedra;
     this->NodeCount = nodeCount;
     this->Bound = true;
