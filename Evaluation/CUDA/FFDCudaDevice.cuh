@@ -123,8 +123,10 @@ __global__ void __launch_bounds__(ThreadsPerBlock, WithJacobian ? 4 : 6) DeformK
 // Float32 points without the Jacobian (the common update): each thread deforms four consecutive points, read as
 // three 16-byte words (and their cells as one) with streaming hints (they are touched once) and written alike.
 // Launch bounds allow 64 registers, so that all four points' loads are issued before the first lattice gather.
-template <typename Deformation>
-__global__ void __launch_bounds__(ThreadsPerBlock, 4) DeformPointsKernel(const float* __restrict__ points,
+// Grouped: where the four share their cell (points in mesh order mostly do), deformation.DeformGroup() deforms
+// them together, each control point read once for the four (the same results); that takes up to 128 registers.
+template <typename Deformation, bool Grouped = false>
+__global__ void __launch_bounds__(ThreadsPerBlock, Grouped ? 2 : 4) DeformPointsKernel(const float* __restrict__ points,
   const int* __restrict__ cells, std::int64_t count, Deformation deformation, float* __restrict__ outPoints)
 {
   auto deform = [&](ffd::Vec3<float>& x, int cell)
@@ -142,10 +144,22 @@ __global__ void __launch_bounds__(ThreadsPerBlock, 4) DeformPointsKernel(const f
     const float4 a = __ldcs(in), b = __ldcs(in + 1), c = __ldcs(in + 2);
     const int4 cell = __ldcs(reinterpret_cast<const int4*>(cells) + group);
     ffd::Vec3<float> x[4] = { { a.x, a.y, a.z }, { a.w, b.x, b.y }, { b.z, b.w, c.x }, { c.y, c.z, c.w } };
-    deform(x[0], cell.x);
-    deform(x[1], cell.y);
-    deform(x[2], cell.z);
-    deform(x[3], cell.w);
+    bool together = false;
+    if constexpr (Grouped)
+    {
+      together = cell.x >= 0 && cell.x == cell.y && cell.x == cell.z && cell.x == cell.w;
+      if (together)
+      {
+        deformation.DeformGroup(x, cell.x);
+      }
+    }
+    if (!together)
+    {
+      deform(x[0], cell.x);
+      deform(x[1], cell.y);
+      deform(x[2], cell.z);
+      deform(x[3], cell.w);
+    }
     float4* out = reinterpret_cast<float4*>(outPoints) + 3 * group;
     __stcs(out, make_float4(x[0].x, x[0].y, x[0].z, x[1].x));
     __stcs(out + 1, make_float4(x[1].y, x[1].z, x[2].x, x[2].y));
@@ -181,11 +195,11 @@ void LaunchDeform(const Deformation& deformation, const Real* points, const int*
 }
 
 // Launches DeformPointsKernel over `count` float32 points on `stream`.
-template <typename Deformation>
+template <bool Grouped = false, typename Deformation>
 void LaunchDeformPoints(const Deformation& deformation, const float* points, const int* cells, std::int64_t count,
   float* outPoints, cudaStream_t stream)
 {
-  DeformPointsKernel<Deformation>
+  DeformPointsKernel<Deformation, Grouped>
     <<<BlocksFor((count + 3) / 4), ThreadsPerBlock, 0, stream>>>(points, cells, count, deformation, outPoints);
 }
 } // namespace detail

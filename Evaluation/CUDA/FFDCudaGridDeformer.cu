@@ -47,6 +47,20 @@ struct SplitCellDeformation
     this->Grid.CellIndices(this->Split, cell, c);
     return this->Grid.DeformInCell(x, cell, c);
   }
+
+  /// Four points of one cell, in place (DeformPointsKernel's Grouped path).
+  __device__ __forceinline__ void DeformGroup(ffd::Vec3<float>* x, int cell) const
+  {
+    int c[3];
+    this->Grid.CellIndices(this->Split, cell, c);
+    ffd::Vec3<float> y[4];
+    this->Grid.template DeformInCell<4>(x, cell, c, y);
+    FFD_UNROLL
+    for (int g = 0; g < 4; ++g)
+    {
+      x[g] = y[g];
+    }
+  }
 };
 
 //------------------------------------------------------------------------------------------------------------
@@ -663,6 +677,19 @@ struct GridDeformer::Impl : ResidentPoints::State
             const Deformation deformation =
               this->WithCells(Deformation{ this->Basis, { this->Divisions[0], this->Divisions[1], this->Divisions[2] },
                 { dims[0], dims[1], dims[2] }, d, frame });
+            // Float32 points alone on a local basis: four consecutive points a thread, those of one cell deformed
+            // together, each control point read once for the four (DeformPointsKernel's Grouped path).
+            if constexpr (std::is_same<Real, float>::value && decltype(basis)::value != int(ffd::GridBasis::Bernstein))
+            {
+              if (!normalsOut && !determinantsOut)
+              {
+                detail::LaunchDeformPoints<true>(
+                  SplitCellDeformation<Deformation>{ deformation, ffd::CellSplit::For(this->Basis, this->Divisions) },
+                  this->Points.As<float>(), this->Cells.As<int>(), this->Count, this->OutPoints.As<float>(),
+                  this->Stream);
+                return;
+              }
+            }
             detail::LaunchDeform(deformation, this->Points.As<Real>(), this->Cells.As<int>(), this->Count,
               this->OutPoints.As<Real>(), this->Normals.As<Real>(), normalsOut, determinantsOut, this->Stream);
           });

@@ -368,6 +368,76 @@ FFD_INLINE Vec3<Real> SumTensorProduct(const Value* values, const int dims[3], c
   return sum;
 }
 
+/**
+ * SumTensorProduct() of G points of one cell (their supports the same: axes[g] of point g): each value is read
+ * once for the G points, and each point's sum is made by the same operations in the same order as
+ * SumTensorProduct()'s, so the results are the same bits.
+ */
+template <int G, int MaxCount, typename Real, typename Value>
+FFD_INLINE void SumTensorProducts(
+  const Value* values, const int dims[3], const AxisWeights<MaxCount, Real> (*axes)[3], Vec3<Real>* sums)
+{
+  const AxisWeights<MaxCount, Real>* first = axes[0];
+  FFD_UNROLL
+  for (int g = 0; g < G; ++g)
+  {
+    sums[g] = { 0, 0, 0 };
+  }
+  FFD_UNROLL
+  for (int k = 0; k < detail::LoopCount(first[2]); ++k)
+  {
+    if (k >= first[2].Count)
+    {
+      break;
+    }
+    Vec3<Real> sumJ[G];
+    FFD_UNROLL
+    for (int g = 0; g < G; ++g)
+    {
+      sumJ[g] = { 0, 0, 0 };
+    }
+    FFD_UNROLL
+    for (int j = 0; j < detail::LoopCount(first[1]); ++j)
+    {
+      if (j >= first[1].Count)
+      {
+        break;
+      }
+      const int row = first[0].First + dims[0] * ((first[1].First + j) + dims[1] * (first[2].First + k));
+      Vec3<Real> sumI[G];
+      FFD_UNROLL
+      for (int g = 0; g < G; ++g)
+      {
+        sumI[g] = { 0, 0, 0 };
+      }
+      FFD_UNROLL
+      for (int i = 0; i < detail::LoopCount(first[0]); ++i)
+      {
+        if (i >= first[0].Count)
+        {
+          break;
+        }
+        const Vec3<Real> v = LatticeValues<Value>::template Get<Real>(values, row + i);
+        FFD_UNROLL
+        for (int g = 0; g < G; ++g)
+        {
+          sumI[g] = sumI[g] + axes[g][0].W[i] * v;
+        }
+      }
+      FFD_UNROLL
+      for (int g = 0; g < G; ++g)
+      {
+        sumJ[g] = sumJ[g] + axes[g][1].W[j] * sumI[g];
+      }
+    }
+    FFD_UNROLL
+    for (int g = 0; g < G; ++g)
+    {
+      sums[g] = sums[g] + axes[g][2].W[k] * sumJ[g];
+    }
+  }
+}
+
 /// SumTensorProduct() and its derivatives with respect to (s, t, u): gradient's columns are d/ds, d/dt, d/du.
 template <int MaxCount, typename Real, typename Value>
 FFD_INLINE Vec3<Real> SumTensorProductWithGradient(

@@ -269,6 +269,39 @@ struct GridDeformation
     return x + SumTensorProduct(this->Displacements, this->Dims, axes);
   }
 
+  /// DeformInCell() of G points of one cell at once: each control point read once for all of them
+  /// (SumTensorProducts()), the same results as G calls.
+  template <int G>
+  FFD_INLINE void DeformInCell(const Vec3<Lane>* x, int cell, const int indices[3], Vec3<Lane>* y) const
+  {
+    AxisWeights<MaxCount, Lane> axes[G][3];
+    FFD_UNROLL
+    for (int g = 0; g < G; ++g)
+    {
+      this->Weights(this->Frame.ToParametric(x[g]), indices, false, axes[g]);
+    }
+    Vec3<Lane> sums[G];
+    if (this->IsSparse())
+    {
+      SupportValues<Real> values{};
+      FFD_UNROLL
+      for (int g = 0; g < G; ++g)
+      {
+        values = this->CellValues(cell, axes[g]);
+      }
+      SumTensorProducts<G>(&values, this->CellDims().D, axes, sums);
+    }
+    else
+    {
+      SumTensorProducts<G>(this->Displacements, this->Dims, axes, sums);
+    }
+    FFD_UNROLL
+    for (int g = 0; g < G; ++g)
+    {
+      y[g] = x[g] + sums[g];
+    }
+  }
+
   /// The index along each axis of a bound cell: BindToGrid()'s flat index ci + cx (cj + cy ck) taken apart, or
   /// a sparse lattice's CellVoxels.
   FFD_INLINE void CellIndices(int cell, int c[3]) const

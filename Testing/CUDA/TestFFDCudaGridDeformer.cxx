@@ -201,6 +201,29 @@ TYPED_TEST(CudaGridDeformerTest, MatchesCpuForEveryBasis)
   }
 }
 
+// The problem's points (and normals) in the order of the cells they are bound to (unbound ones first).
+void SortByCell(Problem& p, bool clamp)
+{
+  const ffd::Frame<double> frame = ffd::Frame<double>::FromArray(p.Frame);
+  std::vector<std::pair<int, std::int64_t>> order;
+  for (std::int64_t i = 0; i < p.Count(); ++i)
+  {
+    order.emplace_back(
+      ffd::BindToGrid(frame, ffd::GridBasis(p.Basis), p.Divisions, ffd::Vec3<double>::From(&p.Points[3 * i]), clamp),
+      i);
+  }
+  std::stable_sort(order.begin(), order.end());
+  std::vector<double> points;
+  std::vector<float> normals;
+  for (const auto& entry : order)
+  {
+    points.insert(points.end(), p.Points.begin() + 3 * entry.second, p.Points.begin() + 3 * entry.second + 3);
+    normals.insert(normals.end(), p.Normals.begin() + 3 * entry.second, p.Normals.begin() + 3 * entry.second + 3);
+  }
+  p.Points.swap(points);
+  p.Normals.swap(normals);
+}
+
 // Float32 points without normals or determinants (the kernels of an ordinary update: the float4 lattice, the
 // global basis's tensor-core and shared-memory kernels, DeformPointsKernel, DeformKernel) against the CPU path, on
 // fresh random problems, within 1e-5 of the frame's scale (about 3), the bound: for the global basis
@@ -212,9 +235,13 @@ TYPED_TEST(CudaGridDeformerTest, MatchesCpuForEveryBasis)
 // points where the tensor-core kernel takes over; for the local ones many voxels per axis (the cell index is
 // split by multiplications on the device).
 void ExpectFloatMatchesCpu(int basis, const int divisions[3], std::int64_t count, bool clamp, bool againstDouble,
-  std::mt19937& rng, double* worst = nullptr)
+  std::mt19937& rng, double* worst = nullptr, bool cellOrder = false)
 {
-  const Problem p(basis, count, rng, divisions);
+  Problem p(basis, count, rng, divisions);
+  if (cellOrder) // grouped by cell, as a mesh's points mostly are: the kernels' paths for points of one cell
+  {
+    SortByCell(p, clamp);
+  }
   std::vector<double> cpuPoints, cpuNormals, cpuDeterminants, jacobianScales;
   if (againstDouble)
   {
@@ -284,6 +311,8 @@ TEST(CudaGridDeformer, LocalBasesInFloatMatchCpu)
     for (int c = 0; c < 5; ++c)
     {
       ExpectFloatMatchesCpu(basis, cases[c], counts[(c + basis) % 5], (c + basis) % 2 == 0, false, rng, &worst);
+      // Points grouped by cell: most fours of a thread share their cell (DeformPointsKernel's Grouped path).
+      ExpectFloatMatchesCpu(basis, cases[c], counts[(c + basis) % 5], (c + basis) % 2 == 1, false, rng, &worst, true);
     }
   }
   std::printf("local bases, float32 without Jacobian against the CPU in float32: largest error %.2e\n", worst);
