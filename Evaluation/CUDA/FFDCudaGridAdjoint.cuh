@@ -61,6 +61,33 @@ void FinishAdjointPlan(
   AdjointPlan& plan, std::int64_t points, std::int64_t controlPoints, std::size_t realBytes, cudaStream_t stream);
 
 /**
+ * Makes `plan` for a binding (`cells`, one per point of `count`) whose chunks' supports have `counts` control
+ * points along each axis: SortAdjointPoints(), then writeTerms(terms) (the lattice's term kernel, writing Keys
+ * and Values, launched where there are terms), then FinishAdjointPlan(). The same steps for grids and tetrahedra.
+ */
+template <typename WriteTerms>
+void MakeAdjointPlan(AdjointPlan& plan, const int counts[3], const int* cells, std::int64_t count,
+  std::int64_t controlPoints, std::size_t realBytes, cudaStream_t stream, WriteTerms&& writeTerms)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    plan.Counts[a] = counts[a];
+  }
+  plan.Terms = counts[0] * counts[1] * counts[2];
+  plan.ChunkPoints = ffd::AdjointChunkPoints(count, plan.Terms);
+  SortAdjointPoints(plan, cells, count, stream);
+  const std::int64_t terms = plan.Chunks * plan.Terms;
+  plan.Keys.Reserve(std::size_t(terms) * sizeof(int), "allocating the adjoint's plan");
+  plan.Values.Reserve(std::size_t(terms) * sizeof(int), "allocating the adjoint's plan");
+  if (terms > 0)
+  {
+    writeTerms(terms);
+    Check(cudaGetLastError(), "launching the adjoint's plan");
+  }
+  FinishAdjointPlan(plan, count, controlPoints, realBytes, stream);
+}
+
+/**
  * An adjoint's update once its plan is made, for a grid or a tetrahedral lattice alike: the gradient (3 doubles a
  * point) uploaded in the points' precision Real, sumChunks() (the lattice's chunk kernel, into Partials), the
  * partials gathered into Sums in the plan's order, the kernels timed from `start` to `stop` into `milliseconds`,

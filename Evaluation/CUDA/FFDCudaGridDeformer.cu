@@ -284,24 +284,18 @@ struct GridDeformer::Impl : ResidentPoints::State
     }
     this->Plan.reset(new detail::AdjointPlan);
     detail::AdjointPlan& plan = *this->Plan;
+    int counts[3];
     for (int a = 0; a < 3; ++a)
     {
-      plan.Counts[a] = ffd::SupportSize(this->Basis, this->Divisions[a]);
+      counts[a] = ffd::SupportSize(this->Basis, this->Divisions[a]);
     }
-    plan.Terms = plan.Counts[0] * plan.Counts[1] * plan.Counts[2];
-    plan.ChunkPoints = ffd::AdjointChunkPoints(this->Count, plan.Terms);
-    detail::SortAdjointPoints(plan, this->Cells.As<int>(), this->Count, this->Stream);
-    const std::int64_t terms = plan.Chunks * plan.Terms;
-    plan.Keys.Reserve(std::size_t(terms) * sizeof(int), "allocating the adjoint's plan");
-    plan.Values.Reserve(std::size_t(terms) * sizeof(int), "allocating the adjoint's plan");
-    if (terms > 0)
-    {
-      detail::AdjointTermKernel<Deformation, Real, MaxCount><<<BlocksFor(terms), ThreadsPerBlock, 0, this->Stream>>>(
-        this->Points.As<Real>(), plan.Order.As<int>(), plan.ChunkStart.As<std::int64_t>(), plan.ChunkCell.As<int>(),
-        terms, plan.Counts[0], plan.Counts[1], plan.Counts[2], deformation, plan.Keys.As<int>(), plan.Values.As<int>());
-      Check(cudaGetLastError(), "launching the adjoint's plan");
-    }
-    detail::FinishAdjointPlan(plan, this->Count, controlPoints, sizeof(Real), this->Stream);
+    detail::MakeAdjointPlan(plan, counts, this->Cells.As<int>(), this->Count, controlPoints, sizeof(Real), this->Stream,
+      [&](std::int64_t terms)
+      {
+        detail::AdjointTermKernel<Deformation, Real, MaxCount><<<BlocksFor(terms), ThreadsPerBlock, 0, this->Stream>>>(
+          this->Points.As<Real>(), plan.Order.As<int>(), plan.ChunkStart.As<std::int64_t>(), plan.ChunkCell.As<int>(),
+          terms, counts[0], counts[1], counts[2], deformation, plan.Keys.As<int>(), plan.Values.As<int>());
+      });
     plan.ForBinding = this->Counts.Bindings;
     ++this->Counts.AdjointPlans;
   }

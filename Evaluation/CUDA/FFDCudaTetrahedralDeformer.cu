@@ -213,20 +213,13 @@ struct TetrahedralDeformer::Impl : ResidentPoints::State
     {
       this->Plan.reset(new detail::AdjointPlan);
       detail::AdjointPlan& plan = *this->Plan;
-      plan.Counts[0] = plan.Counts[1] = 1;
-      plan.Counts[2] = plan.Terms = 4;
-      plan.ChunkPoints = ffd::AdjointChunkPoints(this->Count, plan.Terms);
-      detail::SortAdjointPoints(plan, this->Cells.As<int>(), this->Count, this->Stream);
-      const std::int64_t terms = 4 * plan.Chunks;
-      plan.Keys.Reserve(std::size_t(terms) * sizeof(int), "allocating the adjoint's plan");
-      plan.Values.Reserve(std::size_t(terms) * sizeof(int), "allocating the adjoint's plan");
-      if (terms > 0)
-      {
-        TetrahedronTermKernel<<<BlocksFor(terms), ThreadsPerBlock, 0, this->Stream>>>(
-          plan.ChunkCell.As<int>(), this->Nodes.As<int4>(), terms, plan.Keys.As<int>(), plan.Values.As<int>());
-        Check(cudaGetLastError(), "launching the adjoint's plan");
-      }
-      detail::FinishAdjointPlan(plan, this->Count, nodes, sizeof(Real), this->Stream);
+      const int counts[3] = { 1, 1, 4 }; // a tetrahedron's 4 nodes
+      detail::MakeAdjointPlan(plan, counts, this->Cells.As<int>(), this->Count, nodes, sizeof(Real), this->Stream,
+        [&](std::int64_t terms)
+        {
+          TetrahedronTermKernel<<<BlocksFor(terms), ThreadsPerBlock, 0, this->Stream>>>(
+            plan.ChunkCell.As<int>(), this->Nodes.As<int4>(), terms, plan.Keys.As<int>(), plan.Values.As<int>());
+        });
       plan.ForBinding = this->Counts.Bindings;
       ++this->Counts.AdjointPlans;
     }

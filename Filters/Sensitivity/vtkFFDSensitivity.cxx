@@ -6,7 +6,6 @@
 #include "vtkFFDGridDeformer.h"
 #include "vtkFFDGroupedIds.h"
 #include "vtkFFDInputChecks.h"
-#include "vtkFFDLatticeQueries.h"
 #include "vtkFFDMemory.h"
 #include "vtkFFDTetrahedralDeformer.h"
 
