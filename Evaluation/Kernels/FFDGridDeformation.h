@@ -110,7 +110,7 @@ FFD_INLINE constexpr int CellTableStride(int degree)
 }
 
 /// D of a cell table's entry at local coordinates r[g] of G lane groups, by Horner's rule, with its derivatives
-/// where dDdr is not null: defined with the table (Evaluation/CPU/FFDCellTable.h), which only the CPU builds.
+/// where dDdr is not null: defined with the table (FFDCellTable.h).
 template <int Degree, int G, typename Lane, typename Real>
 FFD_INLINE void PowerForm(const Real* entry, const Lane (*r)[3], Vec3<Lane>* d, Mat3<Lane>* dDdr);
 

@@ -1,18 +1,19 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
  * @file FFDCellTable.h
- * @brief A local basis's cells in power form, for GridDeformation's WithCellTable evaluation (host only).
+ * @brief A local basis's cells in power form, for GridDeformation's WithCellTable evaluation.
  *
- * The CPU builds the table at every update where ffd::WorthCellTable() says it pays (FillCellTable());
- * GridDeformation (Evaluation/Kernels/FFDGridDeformation.h) WithCellTable evaluates it by Horner's rule
- * (PowerForm(), declared there and defined here: the CUDA backend never instantiates it).
+ * The CPU builds the table at every update where ffd::WorthCellTable() says it pays (FillCellTable(), cells in
+ * parallel), the CUDA backend for the triquadratic and cubic B-spline bases on the device (a thread per cell,
+ * detail::FillCellTableOf()); GridDeformation (FFDGridDeformation.h) WithCellTable evaluates it by Horner's rule
+ * (PowerForm(), declared there and defined here), so both backends evaluate the same table the same way.
  */
 #ifndef FFDCellTable_h
 #define FFDCellTable_h
 
 #include "FFDGridDeformation.h"
 
-#include <algorithm>
+#include <cstddef>
 
 namespace ffd
 {
@@ -39,7 +40,7 @@ struct ToMonomials
   static constexpr int N = CellDegree(Basis) + 1;
   double M[4][4] = {};
 
-  constexpr ToMonomials()
+  FFD_HOST_DEVICE constexpr ToMonomials()
   {
     if (Basis == GridBasis::CubicBSpline)
     {
@@ -64,7 +65,7 @@ struct ToMonomials
     }
   }
 
-  static constexpr double Choose(int m, int k)
+  FFD_HOST_DEVICE static constexpr double Choose(int m, int k)
   {
     double c = 1.0;
     for (int i = 1; i <= k; ++i)
@@ -75,111 +76,109 @@ struct ToMonomials
   }
 };
 
-/// v (N^3 points of 3 components, x fastest) with its axis of stride Stride (1, N or N^2) changed to monomials
-/// by M (ToMonomials). M is a compile-time constant, so that its zeros and ones cost nothing, and the three
-/// components go together: the table is rebuilt at every update.
+/// One component of a cell's N^3 control points v (x fastest) with its axis of stride Stride (1, N or N^2) changed
+/// to monomials by M (ToMonomials), a compile-time constant, so that its zeros and ones cost nothing.
 template <int N, int Stride>
-inline void ToMonomialsAlong(const double (&m)[4][4], double (&v)[N * N * N][3])
+FFD_INLINE void ToMonomialsAlong(const double (&m)[4][4], double (&v)[N * N * N])
 {
+  FFD_UNROLL
   for (int outer = 0; outer < N * N * N; outer += N * Stride) // the axes above
   {
+    FFD_UNROLL
     for (int inner = 0; inner < Stride; ++inner) // the axes below
     {
-      double out[N][3];
+      double out[N];
+      FFD_UNROLL
       for (int j = 0; j < N; ++j)
       {
-        for (int k = 0; k < 3; ++k)
+        double sum = 0.0;
+        FFD_UNROLL
+        for (int a = 0; a < N; ++a)
         {
-          double sum = 0.0;
-          for (int a = 0; a < N; ++a)
-          {
-            sum += m[j][a] * v[outer + a * Stride + inner][k];
-          }
-          out[j][k] = sum;
+          sum += m[j][a] * v[outer + a * Stride + inner];
         }
+        out[j] = sum;
       }
+      FFD_UNROLL
       for (int j = 0; j < N; ++j)
       {
-        for (int k = 0; k < 3; ++k)
-        {
-          v[outer + j * Stride + inner][k] = out[j][k];
-        }
+        v[outer + j * Stride + inner] = out[j];
       }
+    }
+  }
+}
+
+/**
+ * Components [componentBegin, componentEnd) of the entry of `cell` in the table of a local basis (FillCellTable()),
+ * and its header (the cell's indices) with component 0: the control points of that component (x fastest), changed
+ * to monomials along x, then y, then z, in double. The CPU fills a cell's three components in one call, the CUDA
+ * backend each in a thread of its own.
+ */
+template <GridBasis Basis, typename Real>
+FFD_INLINE void FillCellEntry(const Real* displacements, const int voxels[3], const int dims[3], const int* cellVoxels,
+  const int* cellSupports, Real* table, int cell, int componentBegin, int componentEnd)
+{
+  constexpr ToMonomials<Basis> toMonomials{};
+  constexpr int N = ToMonomials<Basis>::N;
+  int c[3] = { cell % voxels[0], cell / voxels[0] % voxels[1], cell / (voxels[0] * voxels[1]) };
+  if (cellVoxels)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      c[a] = cellVoxels[3 * std::size_t(cell) + a];
+    }
+  }
+  int first[3], count;
+  for (int a = 0; a < 3; ++a)
+  {
+    VoxelSupport(Basis, voxels[a], c[a], first[a], count);
+  }
+  Real* entry = table + std::size_t(cell) * CellTableStride(N - 1);
+  if (componentBegin == 0)
+  {
+    for (int u = 0; u < 8; ++u)
+    {
+      entry[u] = Real(u < 3 ? c[u] : 0);
+    }
+  }
+  const Real* corner = displacements + 3 * (first[0] + dims[0] * (first[1] + dims[1] * first[2]));
+  const int* support = cellSupports ? cellSupports + std::size_t(cell) * (N * N * N) : nullptr;
+  for (int k = componentBegin; k < componentEnd; ++k)
+  {
+    double v[N * N * N];
+    FFD_UNROLL
+    for (int local = 0; local < N * N * N; ++local)
+    {
+      const int x = local % N, y = local / N % N, z = local / (N * N);
+      const Real* value =
+        support ? displacements + 3 * std::size_t(support[local]) : corner + 3 * (x + dims[0] * (y + dims[1] * z));
+      v[local] = double(value[k]);
+    }
+    ToMonomialsAlong<N, 1>(toMonomials.M, v);
+    ToMonomialsAlong<N, N>(toMonomials.M, v);
+    ToMonomialsAlong<N, N * N>(toMonomials.M, v);
+    FFD_UNROLL
+    for (int i = 0; i < N * N * N; ++i)
+    {
+      entry[8 + 3 * i + k] = Real(v[i]);
     }
   }
 }
 
 /// FillCellTable() for one local basis.
 template <GridBasis Basis, typename Real>
-inline void FillCellTableOf(const Real* displacements, const int voxels[3], const int dims[3], const int* cellVoxels,
-  const int* cellSupports, Real* table, int cellBegin, int cellEnd)
+FFD_INLINE void FillCellTableOf(const Real* displacements, const int voxels[3], const int dims[3],
+  const int* cellVoxels, const int* cellSupports, Real* table, int cellBegin, int cellEnd)
 {
-  static constexpr ToMonomials<Basis> toMonomials;
-  constexpr int N = ToMonomials<Basis>::N;
-  constexpr int stride = CellTableStride(N - 1);
-  int c[3] = { cellBegin % voxels[0], cellBegin / voxels[0] % voxels[1], cellBegin / (voxels[0] * voxels[1]) };
   for (int cell = cellBegin; cell < cellEnd; ++cell)
   {
-    if (cellVoxels)
-    {
-      std::copy(cellVoxels + 3 * std::size_t(cell), cellVoxels + 3 * std::size_t(cell) + 3, c);
-    }
-    int first[3], count;
-    for (int a = 0; a < 3; ++a)
-    {
-      VoxelSupport(Basis, voxels[a], c[a], first[a], count);
-    }
-    Real* entry = table + std::size_t(cell) * stride;
-    for (int u = 0; u < 8; ++u)
-    {
-      entry[u] = Real(u < 3 ? c[u] : 0);
-    }
-    // The control points (x fastest), changed to monomials along x, then y, then z.
-    const Real* corner = displacements + 3 * (first[0] + dims[0] * (first[1] + dims[1] * first[2]));
-    const int* support = cellSupports ? cellSupports + std::size_t(cell) * (N * N * N) : nullptr;
-    double v[N * N * N][3];
-    for (int z = 0; z < N; ++z)
-    {
-      for (int y = 0; y < N; ++y)
-      {
-        for (int x = 0; x < N; ++x)
-        {
-          const int local = x + N * (y + N * z);
-          const Real* value =
-            support ? displacements + 3 * std::size_t(support[local]) : corner + 3 * (x + dims[0] * (y + dims[1] * z));
-          for (int k = 0; k < 3; ++k)
-          {
-            v[local][k] = double(value[k]);
-          }
-        }
-      }
-    }
-    ToMonomialsAlong<N, 1>(toMonomials.M, v);
-    ToMonomialsAlong<N, N>(toMonomials.M, v);
-    ToMonomialsAlong<N, N * N>(toMonomials.M, v);
-    for (int i = 0; i < N * N * N; ++i)
-    {
-      for (int k = 0; k < 3; ++k)
-      {
-        entry[8 + 3 * i + k] = Real(v[i][k]);
-      }
-    }
-    // The next cell's indices (x fastest).
-    if (++c[0] == voxels[0])
-    {
-      c[0] = 0;
-      if (++c[1] == voxels[1])
-      {
-        c[1] = 0;
-        ++c[2];
-      }
-    }
+    FillCellEntry<Basis>(displacements, voxels, dims, cellVoxels, cellSupports, table, cell, 0, 3);
   }
 }
 } // namespace detail
 
 template <typename Real>
-inline void FillCellTable(GridBasis basis, const Real* displacements, const int voxels[3], const int dims[3],
+FFD_INLINE void FillCellTable(GridBasis basis, const Real* displacements, const int voxels[3], const int dims[3],
   const int* cellVoxels, const int* cellSupports, Real* table, int cellBegin, int cellEnd)
 {
   switch (basis)
