@@ -120,16 +120,67 @@ __global__ void __launch_bounds__(ThreadsPerBlock, WithJacobian ? 4 : 6) DeformK
   }
 }
 
-// Float32 points without the Jacobian (the common update): each thread deforms four consecutive points, read as
-// three 16-byte words (and their cells as one) with streaming hints (they are touched once) and written alike.
-// Launch bounds allow 64 registers, so that all four points' loads are issued before the first lattice gather.
-// Grouped: where the four share their cell (points in mesh order mostly do), deformation.DeformGroup() deforms
-// them together, each control point read once for the four (the same results); that takes up to 128 registers.
-template <typename Deformation, bool Grouped = false>
-__global__ void __launch_bounds__(ThreadsPerBlock, Grouped ? 2 : 4) DeformPointsKernel(const float* __restrict__ points,
-  const int* __restrict__ cells, std::int64_t count, Deformation deformation, float* __restrict__ outPoints)
+// Four consecutive points (12 numbers from 16-byte-aligned storage) read and written as 16-byte words with
+// streaming hints: they are touched once.
+__device__ __forceinline__ void LoadFour(const float* points, std::int64_t group, ffd::Vec3<float>* x)
 {
-  auto deform = [&](ffd::Vec3<float>& x, int cell)
+  const float4* in = reinterpret_cast<const float4*>(points) + 3 * group;
+  const float4 a = __ldcs(in), b = __ldcs(in + 1), c = __ldcs(in + 2);
+  x[0] = { a.x, a.y, a.z };
+  x[1] = { a.w, b.x, b.y };
+  x[2] = { b.z, b.w, c.x };
+  x[3] = { c.y, c.z, c.w };
+}
+
+__device__ __forceinline__ void LoadFour(const double* points, std::int64_t group, ffd::Vec3<double>* x)
+{
+  const double2* in = reinterpret_cast<const double2*>(points) + 6 * group;
+  double v[12];
+  FFD_UNROLL
+  for (int w = 0; w < 6; ++w)
+  {
+    const double2 d = __ldcs(in + w);
+    v[2 * w] = d.x;
+    v[2 * w + 1] = d.y;
+  }
+  FFD_UNROLL
+  for (int g = 0; g < 4; ++g)
+  {
+    x[g] = { v[3 * g], v[3 * g + 1], v[3 * g + 2] };
+  }
+}
+
+__device__ __forceinline__ void StoreFour(float* points, std::int64_t group, const ffd::Vec3<float>* x)
+{
+  float4* out = reinterpret_cast<float4*>(points) + 3 * group;
+  __stcs(out, make_float4(x[0].x, x[0].y, x[0].z, x[1].x));
+  __stcs(out + 1, make_float4(x[1].y, x[1].z, x[2].x, x[2].y));
+  __stcs(out + 2, make_float4(x[2].z, x[3].x, x[3].y, x[3].z));
+}
+
+__device__ __forceinline__ void StoreFour(double* points, std::int64_t group, const ffd::Vec3<double>* x)
+{
+  double2* out = reinterpret_cast<double2*>(points) + 6 * group;
+  const double v[12] = { x[0].x, x[0].y, x[0].z, x[1].x, x[1].y, x[1].z, x[2].x, x[2].y, x[2].z, x[3].x, x[3].y,
+    x[3].z };
+  FFD_UNROLL
+  for (int w = 0; w < 6; ++w)
+  {
+    __stcs(out + w, make_double2(v[2 * w], v[2 * w + 1]));
+  }
+}
+
+// Points without the Jacobian (the common update): each thread deforms four consecutive points, read with their
+// cells as 16-byte words (LoadFour()) and written alike. Launch bounds keep MinBlocks blocks of 256 threads on a
+// multiprocessor: 4 (64 registers, so that all four points' loads are issued before the first lattice gather)
+// one point at a time. Grouped: where the four share their cell (points in mesh order mostly do),
+// deformation.DeformGroup() deforms them together, each control point (or cell table coefficient) read once for the
+// four (the same results); a weighted sum then takes up to 128 registers (2 blocks), a float32 power form 80 (3).
+template <typename Deformation, typename Real, bool Grouped, int MinBlocks>
+__global__ void __launch_bounds__(ThreadsPerBlock, MinBlocks) DeformPointsKernel(const Real* __restrict__ points,
+  const int* __restrict__ cells, std::int64_t count, Deformation deformation, Real* __restrict__ outPoints)
+{
+  auto deform = [&](ffd::Vec3<Real>& x, int cell)
   {
     if (cell >= 0)
     {
@@ -140,10 +191,9 @@ __global__ void __launch_bounds__(ThreadsPerBlock, Grouped ? 2 : 4) DeformPoints
   const std::int64_t first = 4 * group;
   if (first + 4 <= count)
   {
-    const float4* in = reinterpret_cast<const float4*>(points) + 3 * group;
-    const float4 a = __ldcs(in), b = __ldcs(in + 1), c = __ldcs(in + 2);
+    ffd::Vec3<Real> x[4];
+    LoadFour(points, group, x);
     const int4 cell = __ldcs(reinterpret_cast<const int4*>(cells) + group);
-    ffd::Vec3<float> x[4] = { { a.x, a.y, a.z }, { a.w, b.x, b.y }, { b.z, b.w, c.x }, { c.y, c.z, c.w } };
     bool together = false;
     if constexpr (Grouped)
     {
@@ -160,15 +210,12 @@ __global__ void __launch_bounds__(ThreadsPerBlock, Grouped ? 2 : 4) DeformPoints
       deform(x[2], cell.z);
       deform(x[3], cell.w);
     }
-    float4* out = reinterpret_cast<float4*>(outPoints) + 3 * group;
-    __stcs(out, make_float4(x[0].x, x[0].y, x[0].z, x[1].x));
-    __stcs(out + 1, make_float4(x[1].y, x[1].z, x[2].x, x[2].y));
-    __stcs(out + 2, make_float4(x[2].z, x[3].x, x[3].y, x[3].z));
+    StoreFour(outPoints, group, x);
     return;
   }
   for (std::int64_t i = first; i < count; ++i) // the last one to three points
   {
-    ffd::Vec3<float> x = { points[3 * i], points[3 * i + 1], points[3 * i + 2] };
+    ffd::Vec3<Real> x = { points[3 * i], points[3 * i + 1], points[3 * i + 2] };
     deform(x, cells[i]);
     outPoints[3 * i] = x.x;
     outPoints[3 * i + 1] = x.y;
@@ -194,12 +241,12 @@ void LaunchDeform(const Deformation& deformation, const Real* points, const int*
   }
 }
 
-// Launches DeformPointsKernel over `count` float32 points on `stream`.
-template <bool Grouped = false, typename Deformation>
-void LaunchDeformPoints(const Deformation& deformation, const float* points, const int* cells, std::int64_t count,
-  float* outPoints, cudaStream_t stream)
+// Launches DeformPointsKernel over `count` points on `stream`.
+template <bool Grouped = false, int MinBlocks = Grouped ? 2 : 4, typename Deformation, typename Real>
+void LaunchDeformPoints(const Deformation& deformation, const Real* points, const int* cells, std::int64_t count,
+  Real* outPoints, cudaStream_t stream)
 {
-  DeformPointsKernel<Deformation, Grouped>
+  DeformPointsKernel<Deformation, Real, Grouped, MinBlocks>
     <<<BlocksFor((count + 3) / 4), ThreadsPerBlock, 0, stream>>>(points, cells, count, deformation, outPoints);
 }
 } // namespace detail

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "FFDCudaGridDeformer.h"
 
+#include "FFDCellTable.h"
 #include "FFDCudaBernsteinKernels.cuh"
 #include "FFDCudaDevice.cuh"
 #include "FFDCudaGridAdjoint.cuh"
@@ -69,6 +70,47 @@ struct SplitCellDeformation
   }
 };
 
+// A grid's deformation from its cell table, for DeformPointsKernel: four points of one cell in power form together,
+// each coefficient read once for them (GridDeformation::Deform<4>()).
+template <typename GridDeformationT>
+struct CellTableDeformation
+{
+  using Real = typename GridDeformationT::Value;
+  GridDeformationT Grid;
+
+  __device__ __forceinline__ ffd::Vec3<Real> Deform(const ffd::Vec3<Real>& x, int cell) const
+  {
+    return this->Grid.Deform(x, cell);
+  }
+
+  __device__ __forceinline__ void DeformGroup(ffd::Vec3<Real>* x, int cell) const
+  {
+    ffd::Vec3<Real> y[4];
+    this->Grid.template Deform<4>(x, cell, y);
+    FFD_UNROLL
+    for (int g = 0; g < 4; ++g)
+    {
+      x[g] = y[g];
+    }
+  }
+};
+
+// The cell table of a local basis (ffd::FillCellTable()): a thread per cell and component, the CPU's function.
+template <ffd::GridBasis Basis, typename Real>
+__global__ void FillCellTableKernel(const Real* displacements, int3 voxels, int3 dims, const int* cellVoxels,
+  const int* cellSupports, int cells, Real* table)
+{
+  const std::int64_t i = blockIdx.x * std::int64_t(blockDim.x) + threadIdx.x;
+  if (i >= 3 * std::int64_t(cells))
+  {
+    return;
+  }
+  const int v[3] = { voxels.x, voxels.y, voxels.z }, d[3] = { dims.x, dims.y, dims.z };
+  const int cell = int(i / 3), component = int(i % 3);
+  ffd::detail::FillCellEntry<Basis>(
+    displacements, v, d, cellVoxels, cellSupports, table, cell, component, component + 1);
+}
+
 //------------------------------------------------------------------------------------------------------------
 template <typename Real>
 __global__ void BindKernel(const Real* points, std::int64_t count, ffd::Frame<double> frame, ffd::GridBasis basis,
@@ -95,13 +137,31 @@ struct GridDeformer::Impl : ResidentPoints::State
   double Frame[12] = {};
   // A sparse lattice's cells (BindSparse()); SparseControlPoints is 0 for a dense lattice.
   Buffer CellVoxels, CellSupports;
-  std::int64_t SparseControlPoints = 0;
+  std::int64_t SparseControlPoints = 0, SparseCells = 0;
+  Buffer CellTable; // FillCellTable() of the last evaluation's lattice, where it took one
+  bool CellTablesAllowed = true;
   std::unique_ptr<detail::AdjointPlan> Plan; // the adjoint's, made for the binding it names
 
   void Release() override
   {
     this->Plan.reset();
+    this->CellTable.Free();
     this->State::Release();
+  }
+
+  // The cells of the bound lattice: its voxels, a sparse lattice's cells, one for the global basis.
+  std::int64_t LatticeCells() const
+  {
+    if (this->SparseControlPoints > 0)
+    {
+      return this->SparseCells;
+    }
+    std::int64_t cells = 1;
+    for (int a = 0; a < 3; ++a)
+    {
+      cells *= ffd::BindingCells(this->Basis, this->Divisions[a]);
+    }
+    return cells;
   }
 
   // Calls f(storage) with the ffd::GridStorage of the bound lattice (a std::integral_constant): the kernels are
@@ -170,6 +230,7 @@ struct GridDeformer::Impl : ResidentPoints::State
     Check(cudaMemcpyAsync(this->CellSupports.Data, cellSupports, supportBytes, cudaMemcpyHostToDevice, this->Stream),
       "uploading the lattice's cells");
     this->SparseControlPoints = controlPoints;
+    this->SparseCells = cells;
   }
 
   template <typename Real>
@@ -228,6 +289,13 @@ struct GridDeformer::Impl : ResidentPoints::State
     this->BeginEvaluation<Real>(withNormals, withDeterminants);
     Real* normalsOut = withNormals ? this->OutNormals.As<Real>() : nullptr;
     Real* determinantsOut = withDeterminants ? this->OutDeterminants.As<Real>() : nullptr;
+    if (this->CellTablesAllowed && GridDeformer::WorthCellTable(int(this->Basis), this->LatticeCells(), this->Count))
+    {
+      this->LaunchFromCellTable<Real>(this->Lattice.As<Real>(), dims, normalsOut, determinantsOut);
+      this->FinishEvaluation(withNormals, withDeterminants, true);
+      ++this->Counts.CellTables;
+      return;
+    }
     if constexpr (std::is_same<Real, float>::value)
     {
       if (asFloat4)
@@ -347,6 +415,50 @@ struct GridDeformer::Impl : ResidentPoints::State
               this->OutPoints.As<Real>(), this->Normals.As<Real>(), normalsOut, determinantsOut, this->Stream);
           });
       });
+  }
+
+  // The triquadratic or cubic B-spline lattice d through its cell table: the table built (FillCellTableKernel),
+  // then every point in power form, four of one cell together where the points go alone (no Jacobian).
+  template <typename Real>
+  void LaunchFromCellTable(const Real* d, const int dims[3], Real* normalsOut, Real* determinantsOut)
+  {
+    const std::int64_t cells = this->LatticeCells();
+    const int stride = ffd::CellTableStride(ffd::CellDegree(this->Basis));
+    this->CellTable.Reserve(std::size_t(cells) * stride * sizeof(Real), "allocating the cell table");
+    const ffd::Frame<Real> frame = ffd::Frame<Real>::FromArray(this->Frame);
+    auto launch = [&](auto basis)
+    {
+      constexpr ffd::GridBasis Basis = ffd::GridBasis(decltype(basis)::value);
+      this->WithStorage<int(Basis)>(
+        [&](auto storage)
+        {
+          using Deformation = ffd::GridDeformation<4, Real, int(Basis), Real, true, decltype(storage)::value>;
+          Deformation deformation = this->WithCells(Deformation{ this->Basis,
+            { this->Divisions[0], this->Divisions[1], this->Divisions[2] }, { dims[0], dims[1], dims[2] }, d, frame });
+          deformation.CellTable = this->CellTable.As<Real>();
+          FillCellTableKernel<Basis, Real><<<BlocksFor(3 * cells), ThreadsPerBlock, 0, this->Stream>>>(d,
+            make_int3(this->Divisions[0], this->Divisions[1], this->Divisions[2]), make_int3(dims[0], dims[1], dims[2]),
+            deformation.CellVoxels, deformation.CellSupports, int(cells), this->CellTable.As<Real>());
+          this->LatticeKernelsDone();
+          if (!normalsOut && !determinantsOut)
+          {
+            constexpr int minBlocks = std::is_same<Real, float>::value ? 3 : 2;
+            detail::LaunchDeformPoints<true, minBlocks>(CellTableDeformation<Deformation>{ deformation },
+              this->Points.As<Real>(), this->Cells.As<int>(), this->Count, this->OutPoints.As<Real>(), this->Stream);
+            return;
+          }
+          detail::LaunchDeform(deformation, this->Points.As<Real>(), this->Cells.As<int>(), this->Count,
+            this->OutPoints.As<Real>(), this->Normals.As<Real>(), normalsOut, determinantsOut, this->Stream);
+        });
+    };
+    if (this->Basis == ffd::GridBasis::TriquadraticBezier)
+    {
+      launch(std::integral_constant<int, int(ffd::GridBasis::TriquadraticBezier)>());
+    }
+    else
+    {
+      launch(std::integral_constant<int, int(ffd::GridBasis::CubicBSpline)>());
+    }
   }
 
   // Float32 without the Jacobian on the float4 lattice (trilinear and the global basis): the global basis's own
@@ -540,6 +652,17 @@ bool GridDeformer::BindSparse(const double frame[12], int basis, const int divis
       p.Evaluated = false;
       ++p.Counts.Bindings;
     });
+}
+
+void GridDeformer::SetCellTables(bool allowed)
+{
+  static_cast<Impl&>(*this->S).CellTablesAllowed = allowed;
+}
+
+bool GridDeformer::WorthCellTable(int basis, std::int64_t cells, std::int64_t points)
+{
+  const bool powerForm = basis == int(ffd::GridBasis::TriquadraticBezier) || basis == int(ffd::GridBasis::CubicBSpline);
+  return powerForm && cells > 0 && cells <= points / 64;
 }
 
 bool GridDeformer::Adjoint(const double* gradient, std::int64_t controlPoints, double* sums)

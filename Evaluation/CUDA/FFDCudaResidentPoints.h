@@ -42,10 +42,11 @@ struct Counters
   std::uint64_t LatticeBytes = 0; ///< bytes of displacements uploaded, in all
   std::uint64_t Evaluations = 0;
   std::uint64_t AdjointPlans = 0; ///< plans of GridDeformer::Adjoint() made (one per binding)
+  std::uint64_t CellTables = 0;   ///< evaluations of a grid's cells in power form (tables built on the device)
   std::uint64_t BytesDownloaded = 0;
   float LastKernelMilliseconds = 0; ///< device time of the last evaluation's (or adjoint's) kernels (CUDA events)
-  /// Device time of the last update's work on the lattice before the points' kernel (the tetrahedra's maps;
-  /// 0 for grids, which have none).
+  /// Device time of the last update's work on the lattice before the points' kernel (the tetrahedra's maps, a
+  /// grid's cell table; 0 where there was none).
   float LastLatticeKernelMilliseconds = 0;
 };
 

@@ -3,9 +3,9 @@
 // basis, on fresh random inputs with fixed seeds, the deformation and its adjoint; device residency (what is
 // uploaded on an update); failures.
 // Without a CUDA device every test skips.
+#include "FFDCellTable.h"
 #include "FFDCudaGridDeformer.h"
 #include "FFDCudaTestSupport.h"
-#include "FFDGridDeformation.h"
 #include "FFDTestComparisons.h"
 
 #include <gtest/gtest.h>
@@ -87,19 +87,33 @@ struct Problem
 
   std::int64_t Count() const { return std::int64_t(this->Points.size() / 3); }
   std::int64_t ControlPoints() const { return std::int64_t(this->Dims[0]) * this->Dims[1] * this->Dims[2]; }
+  int Cells() const { return this->Divisions[0] * this->Divisions[1] * this->Divisions[2]; }
+  bool TakesCellTable() const
+  {
+    return ffd::cuda::GridDeformer::WorthCellTable(this->Basis, this->Cells(), this->Count());
+  }
 };
 
 // The CPU path: the same kernels on the host, in the precision Real of the GPU run (the binding in double, as
-// on both backends).
-template <int MaxCount, typename Real>
+// on both backends), from a cell table (ffd::FillCellTable()) where CellTable.
+template <int MaxCount, typename Real, bool CellTable>
 void CpuDeform(const Problem& p, bool clampOutside, std::vector<double>& points, std::vector<double>& normals,
   std::vector<double>& determinants, std::vector<double>& jacobianScales)
 {
   const ffd::Frame<double> binding = ffd::Frame<double>::FromArray(p.Frame);
   const std::vector<Real> displacements(p.Displacements.begin(), p.Displacements.end());
-  const ffd::GridDeformation<MaxCount, Real> deformation{ ffd::GridBasis(p.Basis),
+  ffd::GridDeformation<MaxCount, Real, -1, Real, CellTable> deformation{ ffd::GridBasis(p.Basis),
     { p.Divisions[0], p.Divisions[1], p.Divisions[2] }, { p.Dims[0], p.Dims[1], p.Dims[2] }, displacements.data(),
     ffd::Frame<Real>::FromArray(p.Frame) };
+  std::vector<Real> table;
+  if constexpr (CellTable)
+  {
+    const int cells = p.Cells();
+    table.resize(std::size_t(cells) * ffd::CellTableStride(ffd::CellDegree(ffd::GridBasis(p.Basis))));
+    ffd::FillCellTable(
+      ffd::GridBasis(p.Basis), displacements.data(), p.Divisions, p.Dims, nullptr, nullptr, table.data(), 0, cells);
+    deformation.CellTable = table.data();
+  }
   for (std::int64_t i = 0; i < p.Count(); ++i)
   {
     const ffd::Vec3<Real> x = ffd::Vec3<Real>::From(&p.Points[3 * i]);
@@ -121,17 +135,23 @@ void CpuDeform(const Problem& p, bool clampOutside, std::vector<double>& points,
   }
 }
 
+// The CPU path as the device takes it: from a cell table where GridDeformer::WorthCellTable() says the device
+// builds one, the same table evaluated by the same Horner's rule (PowerForm()).
 template <typename Real>
 void CpuDeform(const Problem& p, bool clampOutside, std::vector<double>& points, std::vector<double>& normals,
   std::vector<double>& determinants, std::vector<double>& jacobianScales)
 {
   if (p.Basis == int(ffd::GridBasis::Bernstein))
   {
-    CpuDeform<ffd::MaxBernsteinDegree + 1, Real>(p, clampOutside, points, normals, determinants, jacobianScales);
+    CpuDeform<ffd::MaxBernsteinDegree + 1, Real, false>(p, clampOutside, points, normals, determinants, jacobianScales);
+  }
+  else if (p.TakesCellTable())
+  {
+    CpuDeform<4, Real, true>(p, clampOutside, points, normals, determinants, jacobianScales);
   }
   else
   {
-    CpuDeform<4, Real>(p, clampOutside, points, normals, determinants, jacobianScales);
+    CpuDeform<4, Real, false>(p, clampOutside, points, normals, determinants, jacobianScales);
   }
 }
 
@@ -197,6 +217,10 @@ TYPED_TEST(CudaGridDeformerTest, MatchesCpuForEveryBasis)
         check("position without Jacobian", std::int64_t(v / 3), double(outPoints[v]), cpuPoints[v], tolerance);
       }
       EXPECT_EQ(wrong.Count, 0) << "basis " << basis << (clamp ? " clamped" : " kept") << ": " << wrong.First;
+      // 100003 points in at most 125 cells: both evaluations of the triquadratic and B-spline bases from tables.
+      const bool tables =
+        basis == int(ffd::GridBasis::TriquadraticBezier) || basis == int(ffd::GridBasis::CubicBSpline);
+      EXPECT_EQ(gpu.GetCounters().CellTables, tables ? 2u : 0u) << "basis " << basis;
     }
   }
 }
@@ -225,7 +249,8 @@ void SortByCell(Problem& p, bool clamp)
 }
 
 // Float32 points without normals or determinants (the kernels of an ordinary update: the float4 lattice, the
-// global basis's tensor-core and shared-memory kernels, DeformPointsKernel, DeformKernel) against the CPU path, on
+// global basis's tensor-core and shared-memory kernels, DeformPointsKernel, DeformKernel, the cell tables) against
+// the CPU path (from the same cell table where the device takes one, which the device's counter confirms), on
 // fresh random problems, within 1e-5 of the frame's scale (about 3), the bound: for the global basis
 // against the CPU in float64 (the tensor cores' error-compensated TF32 must keep float32 accuracy), for the local
 // ones against the CPU in float32, the same function in the same precision (at 255 voxels along an axis float32
@@ -276,6 +301,7 @@ void ExpectFloatMatchesCpu(int basis, const int divisions[3], std::int64_t count
   EXPECT_EQ(wrong.Count, 0) << "basis " << basis << " divisions " << divisions[0] << "x" << divisions[1] << "x"
                             << divisions[2] << ", " << count << " points" << (clamp ? " clamped" : "") << ": "
                             << wrong.First;
+  EXPECT_EQ(gpu.GetCounters().CellTables, p.TakesCellTable() ? 1u : 0u) << "the reference took the other path";
   if (worst)
   {
     *worst = std::max(*worst, largest);
@@ -314,6 +340,10 @@ TEST(CudaGridDeformer, LocalBasesInFloatMatchCpu)
       // Points grouped by cell: most fours of a thread share their cell (DeformPointsKernel's Grouped path).
       ExpectFloatMatchesCpu(basis, cases[c], counts[(c + basis) % 5], (c + basis) % 2 == 1, false, rng, &worst, true);
     }
+    // Enough points a cell for a cell table (triquadratic and B-spline), in random and in cell order.
+    const int few[3] = { 3, 4, 2 };
+    ExpectFloatMatchesCpu(basis, few, 20011, basis % 2 == 0, false, rng, &worst);
+    ExpectFloatMatchesCpu(basis, few, 20011, basis % 2 == 1, false, rng, &worst, true);
   }
   std::printf("local bases, float32 without Jacobian against the CPU in float32: largest error %.2e\n", worst);
 }
