@@ -44,16 +44,15 @@ constexpr std::size_t GatherStaging = 3 * std::size_t(GatherTile) + 1;
 /**
  * True when a deformation of `points` points over `cells` cells of a local basis is worth a cell table
  * (FillCellTable(), rebuilt at every update): when building the table costs less than it saves, with at least 8
- * points a cell for the trilinear basis, 64 for the triquadratic one and 256 for the cubic B-spline (a cell's
- * table costs about as much as deforming 6, 40 and 150 of its points). Never for the tricubic Bezier basis: its
- * monomial coefficients reach 8 times its control points along each axis, and the power form loses more bits
- * than the float32 error bound of the weighted sum allows.
+ * points a cell for the trilinear basis, 64 for the triquadratic one and 256 for the cubic ones (a cell's table
+ * costs about as much as deforming 6, 40 and 150 of its points). The tricubic Bezier basis's table is centred
+ * (CenteredCellTable()), so that its power form keeps within the weighted sum's float32 error bound.
  */
 inline bool WorthCellTable(GridBasis basis, std::int64_t cells, std::int64_t points)
 {
   const int degree = CellDegree(basis);
   const std::int64_t pointsPerCell = degree == 1 ? 8 : (degree == 2 ? 64 : 256);
-  return degree > 0 && basis != GridBasis::TricubicBezier && cells * pointsPerCell <= points;
+  return degree > 0 && cells * pointsPerCell <= points;
 }
 
 /**

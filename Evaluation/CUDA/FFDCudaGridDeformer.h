@@ -53,17 +53,17 @@ public:
   bool Adjoint(const double* gradient, std::int64_t controlPoints, double* sums);
 
   /**
-   * Whether Evaluate() may evaluate the triquadratic and cubic B-spline bases from a cell table (on by default):
-   * each cell's polynomial in power form, built on the device at each update where the points number at least
-   * WorthCellTable()'s per cell, as the CPU path does (ffd::FillCellTable(), FFDCellTable.h); the same function,
-   * rounded differently. Off, every point is the weighted sum of its control points (benchmarks and tests compare
-   * the two in one run). Counters::CellTables counts the evaluations that used one.
+   * Whether Evaluate() may evaluate the triquadratic and cubic bases from a cell table (on by default): each cell's
+   * polynomial in power form, built on the device at each update where WorthCellTable() says so, as the CPU path
+   * does (ffd::FillCellTable(), FFDCellTable.h); the same function, rounded differently. Off, every point is the
+   * weighted sum of its control points (benchmarks and tests compare the two in one run). Counters::CellTables
+   * counts the evaluations that used one.
    */
   void SetCellTables(bool allowed);
 
   /// True where an evaluation of `points` points over `cells` cells of `basis` (ffd::GridBasis value) on the
-  /// device takes a cell table: the triquadratic and cubic B-spline bases with at least 64 points a cell (a cell's
-  /// table, 384 or 800 bytes in float32, is written once and read once: the traffic of 15 to 30 points).
+  /// device takes a cell table: the triquadratic and cubic bases with at least 64 points a cell (a cell's table,
+  /// 384 or 800 bytes in float32, is written once and read once: the traffic of 15 to 30 points).
   static bool WorthCellTable(int basis, std::int64_t cells, std::int64_t points);
 
 private:

@@ -20,7 +20,8 @@ namespace ffd
 
 /**
  * A local basis's displacement in each of its cells [cellBegin, cellEnd) (flat indices, as BindToGrid()
- * numbers them) in power form: at local coordinates (a, b, c) in [0, 1]^3 of the cell,
+ * numbers them) in power form: at local coordinates (a, b, c) in [0, 1]^3 of the cell (in [-1, 1]^3, 2r - 1,
+ * where the table is centred: CenteredCellTable()),
  * D = sum over i, j, k <= degree of C_ijk a^i b^j c^k, the C from the cell's (degree + 1)^3 control points by the
  * basis's change to monomials along each axis, in double. Horner's rule then takes (degree + 1)^3 - 1
  * multiply-adds a component, against about 1.3 times that and the weights for the weighted sum of the control
@@ -32,8 +33,8 @@ namespace ffd
  */
 namespace detail
 {
-/// The change to monomials along an axis of a local basis: M[j][a], the coefficient of r^j in the basis function
-/// of the cell's control point a.
+/// The change to monomials along an axis of a local basis: M[j][a], the coefficient of r^j (u^j for a centred
+/// table, CenteredCellTable()) in the basis function of the cell's control point a.
 template <GridBasis Basis>
 struct ToMonomials
 {
@@ -42,7 +43,8 @@ struct ToMonomials
 
   FFD_HOST_DEVICE constexpr ToMonomials()
   {
-    if (Basis == GridBasis::CubicBSpline)
+    constexpr int d = N - 1;
+    if constexpr (Basis == GridBasis::CubicBSpline)
     {
       const double m[4][4] = { { 1, 4, 1, 0 }, { -3, 0, 3, 0 }, { 3, -6, 3, 0 }, { -1, 3, -3, 1 } };
       for (int j = 0; j < 4; ++j)
@@ -52,15 +54,34 @@ struct ToMonomials
           this->M[j][a] = m[j][a] / 6.0;
         }
       }
-      return;
     }
-    // Bernstein: C(d, a) r^a (1 - r)^(d - a) = sum over j >= a of C(d, a) C(d - a, j - a) (-1)^(j - a) r^j.
-    const int d = N - 1;
-    for (int a = 0; a <= d; ++a)
+    else if constexpr (CenteredCellTable(Basis))
     {
-      for (int j = a; j <= d; ++j)
+      // Bernstein in u = 2r - 1: C(d, a) 2^-d (1 + u)^a (1 - u)^(d - a), the coefficient of u^j summed over the
+      // ways to take p of the j powers from (1 + u)^a and j - p from (1 - u)^(d - a).
+      for (int a = 0; a <= d; ++a)
       {
-        this->M[j][a] = Choose(d, a) * Choose(d - a, j - a) * ((j - a) % 2 == 0 ? 1.0 : -1.0);
+        for (int j = 0; j <= d; ++j)
+        {
+          double sum = 0.0;
+          for (int p = 0; p <= j && p <= a; ++p)
+          {
+            const int q = j - p;
+            sum += q <= d - a ? Choose(a, p) * Choose(d - a, q) * (q % 2 == 0 ? 1.0 : -1.0) : 0.0;
+          }
+          this->M[j][a] = Choose(d, a) * sum / double(1 << d);
+        }
+      }
+    }
+    else
+    {
+      // Bernstein: C(d, a) r^a (1 - r)^(d - a) = sum over j >= a of C(d, a) C(d - a, j - a) (-1)^(j - a) r^j.
+      for (int a = 0; a <= d; ++a)
+      {
+        for (int j = a; j <= d; ++j)
+        {
+          this->M[j][a] = Choose(d, a) * Choose(d - a, j - a) * ((j - a) % 2 == 0 ? 1.0 : -1.0);
+        }
       }
     }
   }
@@ -109,14 +130,14 @@ FFD_INLINE void ToMonomialsAlong(const double (&m)[4][4], double (&v)[N * N * N]
 }
 
 /**
- * Components [componentBegin, componentEnd) of the entry of `cell` in the table of a local basis (FillCellTable()),
- * and its header (the cell's indices) with component 0: the control points of that component (x fastest), changed
- * to monomials along x, then y, then z, in double. The CPU fills a cell's three components in one call, the CUDA
- * backend each in a thread of its own.
+ * Components [componentBegin, componentEnd) of `entry`, that of `cell` in the table of a local basis
+ * (FillCellTable()), and its header (the cell's indices) with component 0: the control points of that component
+ * (x fastest), changed to monomials along x, then y, then z, in double. The CPU fills a cell's three components in
+ * one call, the CUDA backend each in a thread of its own.
  */
 template <GridBasis Basis, typename Real>
 FFD_INLINE void FillCellEntry(const Real* displacements, const int voxels[3], const int dims[3], const int* cellVoxels,
-  const int* cellSupports, Real* table, int cell, int componentBegin, int componentEnd)
+  const int* cellSupports, int cell, int componentBegin, int componentEnd, Real* entry)
 {
   constexpr ToMonomials<Basis> toMonomials{};
   constexpr int N = ToMonomials<Basis>::N;
@@ -133,7 +154,6 @@ FFD_INLINE void FillCellEntry(const Real* displacements, const int voxels[3], co
   {
     VoxelSupport(Basis, voxels[a], c[a], first[a], count);
   }
-  Real* entry = table + std::size_t(cell) * CellTableStride(N - 1);
   if (componentBegin == 0)
   {
     for (int u = 0; u < 8; ++u)
@@ -170,9 +190,11 @@ template <GridBasis Basis, typename Real>
 FFD_INLINE void FillCellTableOf(const Real* displacements, const int voxels[3], const int dims[3],
   const int* cellVoxels, const int* cellSupports, Real* table, int cellBegin, int cellEnd)
 {
+  constexpr int stride = CellTableStride(CellDegree(Basis));
   for (int cell = cellBegin; cell < cellEnd; ++cell)
   {
-    FillCellEntry<Basis>(displacements, voxels, dims, cellVoxels, cellSupports, table, cell, 0, 3);
+    FillCellEntry<Basis>(
+      displacements, voxels, dims, cellVoxels, cellSupports, cell, 0, 3, table + std::size_t(cell) * stride);
   }
 }
 } // namespace detail

@@ -102,6 +102,17 @@ FFD_INLINE constexpr int CellDegree(GridBasis basis)
   return basis == GridBasis::CubicBSpline ? 3 : BezierDegree(basis);
 }
 
+/**
+ * True where a basis's cell table is a polynomial in the centred local coordinate u = 2r - 1 in [-1, 1] rather
+ * than in r in [0, 1]: the tricubic Bezier basis. Its monomial coefficients in r reach 8 times its control points
+ * along an axis (27 times in sum over the powers), and Horner's rule in float32 then lost more than the weighted
+ * sum's error bound allows; in u they reach 1.5 times (5 in sum), below the cubic B-spline's 5.3 in r.
+ */
+FFD_INLINE constexpr bool CenteredCellTable(GridBasis basis)
+{
+  return basis == GridBasis::TricubicBezier;
+}
+
 /// Reals per cell in a cell table of a basis of that degree (FillCellTable()): the cell's indices along the
 /// three axes, 5 unused, then the (degree + 1)^3 coefficients x y z each, rounded up to 32 bytes of floats.
 FFD_INLINE constexpr int CellTableStride(int degree)
@@ -462,24 +473,30 @@ struct GridDeformation
   }
 
   /// The local coordinates in the cells of indices `cell` (as numbers) of points at parameters stu, as
-  /// ComputeAxisWeights() computes them.
+  /// ComputeAxisWeights() computes them, centred (2r - 1) where the table is (CenteredCellTable()).
   FFD_INLINE void TableCoordinates(const Vec3<Lane>& stu, const Vec3<Lane>& cell, Lane r[3]) const
   {
+    const bool centered = CenteredCellTable(this->BasisOf());
     FFD_UNROLL
     for (int a = 0; a < 3; ++a)
     {
       const Lane n = Lane(this->Voxels[a]);
       r[a] = Clamp01(stu[a] * n - cell[a]);
+      if (centered)
+      {
+        r[a] = Lane(2) * r[a] - Lane(1);
+      }
     }
   }
 
-  /// dD/d(s, t, u) from the dD/dr of PowerForm(): r = s n - c along each axis.
+  /// dD/d(s, t, u) from the dD/dr of PowerForm(): r = s n - c along each axis (2 (s n - c) - 1 centred).
   FFD_INLINE Mat3<Lane> TableGradient(Mat3<Lane> dDdr) const
   {
+    const bool centered = CenteredCellTable(this->BasisOf());
     FFD_UNROLL
     for (int a = 0; a < 3; ++a)
     {
-      const Lane n = Lane(this->Voxels[a]);
+      const Lane n = Lane(centered ? 2 * this->Voxels[a] : this->Voxels[a]);
       for (int row = 0; row < 3; ++row)
       {
         dDdr.M[row][a] = dDdr.M[row][a] * n;

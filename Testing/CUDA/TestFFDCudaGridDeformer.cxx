@@ -217,9 +217,8 @@ TYPED_TEST(CudaGridDeformerTest, MatchesCpuForEveryBasis)
         check("position without Jacobian", std::int64_t(v / 3), double(outPoints[v]), cpuPoints[v], tolerance);
       }
       EXPECT_EQ(wrong.Count, 0) << "basis " << basis << (clamp ? " clamped" : " kept") << ": " << wrong.First;
-      // 100003 points in at most 125 cells: both evaluations of the triquadratic and B-spline bases from tables.
-      const bool tables =
-        basis == int(ffd::GridBasis::TriquadraticBezier) || basis == int(ffd::GridBasis::CubicBSpline);
+      // 100003 points in at most 125 cells: both evaluations of the triquadratic and cubic bases from tables.
+      const bool tables = basis >= int(ffd::GridBasis::TriquadraticBezier);
       EXPECT_EQ(gpu.GetCounters().CellTables, tables ? 2u : 0u) << "basis " << basis;
     }
   }
@@ -340,7 +339,7 @@ TEST(CudaGridDeformer, LocalBasesInFloatMatchCpu)
       // Points grouped by cell: most fours of a thread share their cell (DeformPointsKernel's Grouped path).
       ExpectFloatMatchesCpu(basis, cases[c], counts[(c + basis) % 5], (c + basis) % 2 == 1, false, rng, &worst, true);
     }
-    // Enough points a cell for a cell table (triquadratic and B-spline), in random and in cell order.
+    // Enough points a cell for a cell table (triquadratic and cubic bases), in random and in cell order.
     const int few[3] = { 3, 4, 2 };
     ExpectFloatMatchesCpu(basis, few, 20011, basis % 2 == 0, false, rng, &worst);
     ExpectFloatMatchesCpu(basis, few, 20011, basis % 2 == 1, false, rng, &worst, true);

@@ -377,7 +377,7 @@ public:
 
 /// Calls f(kernel) with the Kernels of lat that the filters may build: MaxCount 4 for the local bases and for
 /// the global basis of degree <= 3 (one cubic voxel), MaxBernsteinDegree + 1 for the global basis, and for a
-/// local basis but the tricubic Bezier one, one with a cell table too.
+/// local basis one with a cell table too.
 template <typename Real, typename F>
 void WithKernel(const GridLattice& lat, F&& f)
 {
@@ -391,7 +391,7 @@ void WithKernel(const GridLattice& lat, F&& f)
     const Kernel<Real, 4> k(lat);
     f(k);
   }
-  if (lat.Basis != ffdref::Basis::Bernstein && lat.Basis != ffdref::Basis::TricubicBezier) // ffd::WorthCellTable()
+  if (lat.Basis != ffdref::Basis::Bernstein) // ffd::WorthCellTable()
   {
     const Kernel<Real, 4, true> k(lat);
     f(k);
