@@ -54,7 +54,7 @@ inline void WithGridDeformation(const GridLattice<Real>& lattice, F&& f)
           { lattice.Dims[0], lattice.Dims[1], lattice.Dims[2] }, lattice.Displacements, lattice.Frame,
           lattice.CellTable, lattice.CellVoxels, lattice.CellSupports };
       };
-      if constexpr (Basis != int(GridBasis::Bernstein) && Basis != int(GridBasis::TricubicBezier))
+      if constexpr (Basis != int(GridBasis::Bernstein))
       {
         if (lattice.CellTable)
         {
