@@ -1,15 +1,17 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// GPU benchmark of the CUDA backend (ffd::cuda::GridDeformer): points per second of the evaluation of every grid
-// basis for 1 M, 16 M and 64 M points, beside the device-to-device copy bandwidth measured in the same run, the
-// fraction of the bandwidth roofline each evaluation reaches (bytes it must move: the point and its 4-byte
-// binding in, the deformed point out), the float32 accuracy of the global basis against float64, and the
-// end-to-end update (lattice upload + evaluation + download) against the bare download of the same bytes; and the
-// tetrahedral lattices' evaluation (ffd::cuda::TetrahedralDeformer) for 1 M and 16 M points in about 10 k and
-// 100 k tetrahedra, float32 and float64, beside the trilinear grid's in the same run, with what an update would
-// cost if it uploaded the tetrahedra's maps instead of the nodes' displacements.
-// Last, the adjoint (W^T g) of every basis beside its forward evaluation, for 1 M and 16 M points.
-// It prints tables and asserts nothing. Options: --quick (1 M points only), --tetrahedra, --adjoint (that section
-// alone).
+// GPU benchmark of the CUDA backend's kernels (ffd::cuda::GridDeformer): points per second of the evaluation of
+// every grid basis for 1 M, 16 M and 64 M points, float32 and float64, the triquadratic and cubic B-spline bases
+// from cell tables and as weighted sums side by side, beside the device-to-device copy bandwidth measured in the
+// same run: the fraction of the bandwidth roofline each evaluation reaches (bytes it must move: the point and its
+// 4-byte binding in, the deformed point out) and of the multiply-add peak (multiply-adds counted from the
+// kernels); the float32 accuracy of the global basis against float64; the tetrahedral lattices' evaluation
+// (ffd::cuda::TetrahedralDeformer) for 1 M and 16 M points in about 10 k and 100 k tetrahedra, float32 and
+// float64, beside the trilinear grid's in the same run, with what an update would cost if it uploaded the
+// tetrahedra's maps instead of the nodes' displacements. Last, the adjoint (W^T g) of every basis beside its
+// forward evaluation, for 1 M and 16 M points. The host side (end-to-end updates, a billion points) is
+// BenchmarkFFDCudaTransfers's.
+// It prints tables and asserts nothing. Options: --quick (1 M points only), --grid, --tetrahedra, --adjoint (that
+// section alone), --profile (each grid evaluation of 16 M points once, for Nsight Compute).
 #include "FFDBenchmarkUtilities.h"
 #include "FFDCudaGridDeformer.h"
 #include "FFDCudaTestSupport.h"
@@ -73,6 +75,22 @@ double CopyBandwidth()
   return 2.0 * bytes / (best * 1e-3);
 }
 
+// What the device can do, measured or from its properties: the device-to-device copy bandwidth (bytes read plus
+// written per second) and the multiply-add peaks of its CUDA cores (128 float32 and 64 float64 lanes a
+// multiprocessor on sm_90, at the clock the device reports).
+struct Device
+{
+  double Bandwidth, Float32MultiplyAdds, Float64MultiplyAdds;
+};
+
+Device MeasureDevice(const cudaDeviceProp& prop)
+{
+  int kilohertz = 0;
+  RequireCuda(cudaDeviceGetAttribute(&kilohertz, cudaDevAttrClockRate, 0), "cudaDeviceGetAttribute");
+  const double lanes = double(prop.multiProcessorCount) * kilohertz * 1e3;
+  return { CopyBandwidth(), 128 * lanes, 64 * lanes };
+}
+
 const double Frame[12] = { -1.0, -1.5, -0.5, 2.0, 0.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 1.0 };
 
 struct Case
@@ -129,11 +147,11 @@ struct Times
 };
 
 template <typename Evaluate>
-Times TimeEvaluations(const ffd::cuda::ResidentPoints& gpu, Evaluate&& evaluate)
+Times TimeEvaluations(const ffd::cuda::ResidentPoints& gpu, Evaluate&& evaluate, int runs = 20)
 {
   evaluate();
   std::vector<double> lattice, points;
-  const double call = MedianSeconds(20,
+  const double call = MedianSeconds(runs,
     [&]
     {
       evaluate();
@@ -144,25 +162,80 @@ Times TimeEvaluations(const ffd::cuda::ResidentPoints& gpu, Evaluate&& evaluate)
 }
 
 // TimeEvaluations() of the grid's evaluation of `displacements` into its resident points.
-Times TimeGridEvaluation(ffd::cuda::GridDeformer& gpu, const std::vector<double>& displacements)
+Times TimeGridEvaluation(ffd::cuda::GridDeformer& gpu, const std::vector<double>& displacements, int runs = 20)
 {
   const std::int64_t controlPoints = std::int64_t(displacements.size() / 3);
   return TimeEvaluations(
-    gpu, [&] { Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate"); });
-}
-
-// One row of the grid table (float32 points). Bytes a point must move: the point and its binding in, the point out.
-void PrintGridRow(const char* basis, const char* order, std::int64_t n, const Times& t, double bandwidth)
-{
-  const double bytes = double(n) * (12 + 4 + 12);
-  std::printf("| %s%s | %lld | %.3f | %.3f | %.2f | %.0f | %.0f %% |\n", basis, order, static_cast<long long>(n),
-    t.Call * 1e3, t.Points * 1e3, n / t.Points * 1e-9, bytes / t.Points * 1e-9, 100.0 * bytes / t.Points / bandwidth);
+    gpu, [&] { Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate"); }, runs);
 }
 
 template <typename Real>
 const char* PrecisionName()
 {
   return sizeof(Real) == sizeof(float) ? "float32" : "float64";
+}
+
+// Multiply-adds a point of an evaluation without the Jacobian, counted from the kernels: the parametric coordinates
+// (9), then the weighted sum over n control points an axis, 3 (n^3 + n^2 + n), or from a cell table the local
+// coordinates (3) and Horner's rule over the cell's n^3 monomials, 3 (n^3 - 1). The weights are not counted (about
+// 10 operations an axis), nor the global basis's tensor cores (its count is that of the same sum on CUDA cores).
+int MultiplyAdds(ffd::GridBasis basis, int divisions, bool cellTable)
+{
+  const int n = ffd::SupportSize(basis, divisions);
+  return 9 + (cellTable ? 3 + 3 * (n * n * n - 1) : 3 * (n * n * n + n * n + n));
+}
+
+// One row of the grid table. Bytes a point must move: the point and its 4-byte binding in, the point out; rates
+// from the kernels' time, the cell table's included.
+template <typename Real>
+void PrintGridRow(
+  const char* basis, const char* variant, std::int64_t n, const Times& t, const Device& device, int multiplyAdds)
+{
+  const double seconds = t.Lattice + t.Points, bytes = double(n) * (6 * sizeof(Real) + 4);
+  const double peak = sizeof(Real) == sizeof(float) ? device.Float32MultiplyAdds : device.Float64MultiplyAdds;
+  std::printf("| %s%s | %s | %lld | %.3f | %.3f | %.3f | %.2f | %.0f %% | %d | %.0f %% |\n", basis, variant,
+    PrecisionName<Real>(), static_cast<long long>(n), t.Call * 1e3, t.Lattice * 1e3, t.Points * 1e3, n / seconds * 1e-9,
+    100.0 * bytes / seconds / device.Bandwidth, multiplyAdds, 100.0 * n * multiplyAdds / seconds / peak);
+}
+
+// The grid table's rows for points in voxel order in the precision Real: every basis (the global one in float32
+// only), the triquadratic and cubic B-spline bases from cell tables and as weighted sums, side by side on the same
+// points; `runs` evaluations a row (median).
+template <typename Real>
+void GridSection(const Case* cases, std::size_t caseCount, const std::vector<std::int64_t>& sizes, const Device& device,
+  int runs, std::mt19937& rng)
+{
+  for (std::int64_t n : sizes)
+  {
+    const std::vector<double> points64 = RandomPoints(n, rng);
+    const std::vector<Real> points(points64.begin(), points64.end());
+    for (std::size_t k = 0; k < caseCount; ++k)
+    {
+      const Case& c = cases[k];
+      if (sizeof(Real) == sizeof(double) && c.Basis == ffd::GridBasis::Bernstein)
+      {
+        continue;
+      }
+      const std::vector<double> displacements = RandomDisplacements(c, rng);
+      const int divisions[3] = { c.Divisions, c.Divisions, c.Divisions };
+      ffd::cuda::GridDeformer gpu;
+      Require(gpu.SetPoints(points.data(), n) && gpu.Bind(Frame, int(c.Basis), divisions, false), gpu, "Bind");
+      const std::int64_t cells = std::int64_t(c.Divisions) * c.Divisions * c.Divisions;
+      const bool worthTable = ffd::cuda::GridDeformer::WorthCellTable(int(c.Basis), cells, n);
+      for (bool table : { true, false })
+      {
+        gpu.SetCellTables(table);
+        const Times t = TimeGridEvaluation(gpu, displacements, runs);
+        const bool takesTable = table && worthTable;
+        PrintGridRow<Real>(c.Name, takesTable ? ", cell table" : (worthTable ? ", weighted sum" : ""), n, t, device,
+          MultiplyAdds(c.Basis, c.Divisions, takesTable));
+        if (!worthTable)
+        {
+          break; // no table to compare with
+        }
+      }
+    }
+  }
 }
 
 // One row of the tetrahedral table. Bytes a point must move: the point and its 4-byte binding in, the point out.
@@ -385,11 +458,12 @@ void AdjointSection(const Case* cases, std::size_t caseCount, const std::vector<
 
 int main(int argc, char* argv[])
 {
-  bool quick = false, tetrahedraOnly = false, adjointOnly = false;
+  bool quick = false, gridOnly = false, tetrahedraOnly = false, adjointOnly = false, profile = false;
   int status = 0;
   if (!ParseArguments(argc, argv,
-        { { "--quick", &quick }, { "--tetrahedra", &tetrahedraOnly }, { "--adjoint", &adjointOnly } },
-        "[--quick] [--tetrahedra] [--adjoint]", status))
+        { { "--quick", &quick }, { "--grid", &gridOnly }, { "--tetrahedra", &tetrahedraOnly },
+          { "--adjoint", &adjointOnly }, { "--profile", &profile } },
+        "[--quick] [--grid] [--tetrahedra] [--adjoint] [--profile]", status))
   {
     return status;
   }
@@ -401,9 +475,11 @@ int main(int argc, char* argv[])
   }
   cudaDeviceProp prop;
   RequireCuda(cudaGetDeviceProperties(&prop, 0), "cudaGetDeviceProperties");
-  const double bandwidth = CopyBandwidth();
-  std::printf("device: %s, %d SMs; device-to-device copy: %.0f GB/s (read + write)\n\n", prop.name,
-    prop.multiProcessorCount, bandwidth * 1e-9);
+  const Device device = MeasureDevice(prop);
+  std::printf("device: %s, %d SMs; device-to-device copy: %.0f GB/s (read + write); multiply-add peak: %.1f T/s "
+              "float32, %.1f T/s float64\n\n",
+    prop.name, prop.multiProcessorCount, device.Bandwidth * 1e-9, device.Float32MultiplyAdds * 1e-12,
+    device.Float64MultiplyAdds * 1e-12);
 
   const Case cases[] = {
     { ffd::GridBasis::Bernstein, "BERNSTEIN 11^3", 10 },
@@ -423,7 +499,7 @@ int main(int argc, char* argv[])
   std::mt19937 rng(2026);
   if (tetrahedraOnly)
   {
-    Tetrahedra(tetrahedraSizes, bandwidth, rng);
+    Tetrahedra(tetrahedraSizes, device.Bandwidth, rng);
     return 0;
   }
   if (adjointOnly)
@@ -431,45 +507,23 @@ int main(int argc, char* argv[])
     AdjointSection(cases, std::size(cases), tetrahedraSizes, rng);
     return 0;
   }
-  std::printf("Evaluation of float32 points in voxel order, median of 20: the whole Evaluate() call (lattice "
-              "upload, kernel, synchronize) and the kernel alone (CUDA events); rates from the kernel time\n");
-  std::printf("| basis | points | Evaluate() ms | kernel ms | G points/s | GB/s moved | %% of copy roofline |\n"
-              "|---|---:|---:|---:|---:|---:|---:|\n");
-  double endToEnd = 0, bareDownload = 0;
-  for (std::int64_t n : sizes)
+  const char* header = "| basis | precision | points | Evaluate() ms | cell table ms | points kernel ms | G points/s | "
+                       "%% of copy roofline | multiply-adds a point | %% of multiply-add peak |\n"
+                       "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  if (profile)
   {
-    const std::vector<double> points64 = RandomPoints(n, rng);
-    const std::vector<float> points(points64.begin(), points64.end());
-    std::vector<float> out(points.size());
-    for (const Case& c : cases)
-    {
-      const std::vector<double> displacements = RandomDisplacements(c, rng);
-      const std::int64_t controlPoints = std::int64_t(displacements.size() / 3);
-      const int divisions[3] = { c.Divisions, c.Divisions, c.Divisions };
-      ffd::cuda::GridDeformer gpu;
-      Require(gpu.SetPoints(points.data(), n), gpu, "SetPoints");
-      Require(gpu.Bind(Frame, int(c.Basis), divisions, false), gpu, "Bind");
-      PrintGridRow(c.Name, "", n, TimeGridEvaluation(gpu, displacements), bandwidth);
-
-      if (n == sizes.front() && c.Basis == ffd::GridBasis::Trilinear)
-      {
-        endToEnd = MedianSeconds(20,
-          [&]
-          {
-            Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate");
-            Require(gpu.Download(out.data(), nullptr, nullptr), gpu, "Download");
-          });
-        void* device = nullptr;
-        RequireCuda(cudaMalloc(&device, points.size() * sizeof(float)), "cudaMalloc");
-        bareDownload = MedianSeconds(20,
-          [&] {
-            RequireCuda(
-              cudaMemcpy(out.data(), device, points.size() * sizeof(float), cudaMemcpyDeviceToHost), "cudaMemcpy");
-          });
-        cudaFree(device);
-      }
-    }
+    const std::vector<std::int64_t> one = { std::int64_t(16) << 20 };
+    std::printf(header);
+    GridSection<float>(cases, std::size(cases), one, device, 1, rng);
+    GridSection<double>(cases, std::size(cases), one, device, 1, rng);
+    return 0;
   }
+  std::printf("Evaluation of points in voxel order, median of 20: the whole Evaluate() call (lattice upload, "
+              "kernels, synchronize) and the kernels alone (CUDA events); rates from the kernels' time\n");
+  std::printf(header);
+  GridSection<float>(cases, std::size(cases), sizes, device, 20, rng);
+  const std::vector<std::int64_t> larger(sizes.begin() + (sizes.size() > 1 ? 1 : 0), sizes.end()); // 16 M, 64 M
+  GridSection<double>(cases, std::size(cases), larger, device, 20, rng);
 
   // The same trilinear evaluation on points in random order.
   {
@@ -481,19 +535,16 @@ int main(int argc, char* argv[])
     const int divisions[3] = { c.Divisions, c.Divisions, c.Divisions };
     ffd::cuda::GridDeformer gpu;
     Require(gpu.SetPoints(points.data(), n) && gpu.Bind(Frame, int(c.Basis), divisions, false), gpu, "Bind");
-    PrintGridRow(c.Name, ", random point order", n, TimeGridEvaluation(gpu, displacements), bandwidth);
+    PrintGridRow<float>(c.Name, ", random point order", n, TimeGridEvaluation(gpu, displacements), device,
+      MultiplyAdds(c.Basis, c.Divisions, false));
   }
 
-  std::printf("\nEnd-to-end update of %lld points (TRILINEAR; lattice upload + evaluation + download into pageable "
-              "memory) against the bare download of the same %lld bytes (cudaMemcpy to pageable memory), median "
-              "of 20: %.3f ms vs %.3f ms, ratio %.2f\n",
-    static_cast<long long>(sizes.front()), static_cast<long long>(sizes.front() * 12), endToEnd * 1e3,
-    bareDownload * 1e3, endToEnd / bareDownload);
-
-  // float32 accuracy of the global basis against float64 on the device, relative to the frame's scale (3).
+  // float32 accuracy against float64 on the device, relative to the frame's scale (3): the global basis (its
+  // tensor cores) and the bases evaluated from cell tables (4 M points, 128 a cell).
+  for (std::size_t k : { std::size_t(0), std::size_t(2), std::size_t(3), std::size_t(4) })
   {
-    const std::int64_t n = std::int64_t(1) << 20;
-    const Case& c = cases[0];
+    const std::int64_t n = std::int64_t(4) << 20;
+    const Case& c = cases[k];
     const std::vector<double> points64 = RandomPoints(n, rng);
     const std::vector<float> points32(points64.begin(), points64.end());
     const std::vector<double> displacements = RandomDisplacements(c, rng);
@@ -516,9 +567,14 @@ int main(int argc, char* argv[])
     {
       worst = std::max(worst, std::fabs(double(out32[v]) - out64[v]));
     }
-    std::printf("BERNSTEIN 11^3 float32 vs float64: max error %.2e relative to the frame's scale\n", worst / 3.0);
+    std::printf("%s%s float32 vs float64: max error %.2e relative to the frame's scale\n", c.Name,
+      gpu32.GetCounters().CellTables > 0 ? " (cell table)" : "", worst / 3.0);
   }
-  Tetrahedra(tetrahedraSizes, bandwidth, rng);
+  if (gridOnly)
+  {
+    return 0;
+  }
+  Tetrahedra(tetrahedraSizes, device.Bandwidth, rng);
   AdjointSection(cases, std::size(cases), tetrahedraSizes, rng);
   return 0;
 }
