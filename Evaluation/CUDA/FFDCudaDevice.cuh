@@ -264,10 +264,19 @@ struct ResidentPoints::State
   bool Bound = false;
   bool Evaluated = false, EvaluatedNormals = false, EvaluatedDeterminants = false;
   Buffer Points, Normals, Cells, Lattice, OutPoints, OutNormals, OutDeterminants, Reduction;
-  Buffer Staging[2] = { Buffer(true), Buffer(true) };
   Buffer LatticeStaging{ true };
   cudaStream_t Stream = nullptr;
-  cudaEvent_t ChunkDone[2] = { nullptr, nullptr };
+  // A download goes through two lanes at once, each a stream with two pinned buffers and their events, its half
+  // copied out of pinned memory by a host thread of its own: that host copy, not the bus, bounds a download into
+  // pageable memory. Lane 0 runs on Stream.
+  struct DownloadLane
+  {
+    cudaStream_t Stream = nullptr;
+    Buffer Staging[2] = { Buffer(true), Buffer(true) };
+    cudaEvent_t ChunkDone[2] = { nullptr, nullptr };
+  };
+  DownloadLane Lanes[2];
+  cudaEvent_t DownloadReady = nullptr; // recorded on Stream: what lane 1 waits for
   // Around an evaluation: its start, the end of the lattice's own kernels (if any), the end of the points'.
   cudaEvent_t KernelStart = nullptr, LatticeDone = nullptr, KernelStop = nullptr;
   int Multiprocessors = 0; // of the current device, for persistent grids
@@ -370,9 +379,13 @@ struct ResidentPoints::State
   template <typename Real>
   void RunComputeBounds(double bounds[6]);
 
-  /// Copies `bytes` from the device to pageable host memory through the two pinned buffers, so that the host
-  /// copy of one chunk overlaps the transfer of the next.
+  /// Copies `bytes` from the device (what Stream wrote) to pageable host memory: from two staging buffers' worth
+  /// on, half through each lane (DownloadLane), the second in a thread of its own.
   void Download(const void* device, void* host, std::size_t bytes);
+
+  /// Copies `bytes` through `lane`'s two pinned buffers, so that the host copy of one chunk overlaps the transfer of
+  /// the next.
+  void DownloadThrough(DownloadLane& lane, const void* device, void* host, std::size_t bytes);
 };
 
 } // namespace cuda

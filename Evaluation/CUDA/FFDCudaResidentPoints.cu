@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cstring>
+#include <exception>
+#include <thread>
 
 namespace ffd
 {
@@ -86,8 +88,16 @@ void ResidentPoints::State::EnsureStream()
     Check(
       cudaDeviceGetAttribute(&this->Multiprocessors, cudaDevAttrMultiProcessorCount, device), "querying the device");
     Check(cudaStreamCreateWithFlags(&this->Stream, cudaStreamNonBlocking), "creating a stream");
-    Check(cudaEventCreateWithFlags(&this->ChunkDone[0], cudaEventDisableTiming), "creating an event");
-    Check(cudaEventCreateWithFlags(&this->ChunkDone[1], cudaEventDisableTiming), "creating an event");
+    Check(cudaStreamCreateWithFlags(&this->Lanes[1].Stream, cudaStreamNonBlocking), "creating a stream");
+    this->Lanes[0].Stream = this->Stream;
+    for (DownloadLane& lane : this->Lanes)
+    {
+      for (cudaEvent_t& e : lane.ChunkDone)
+      {
+        Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "creating an event");
+      }
+    }
+    Check(cudaEventCreateWithFlags(&this->DownloadReady, cudaEventDisableTiming), "creating an event");
     Check(cudaEventCreate(&this->KernelStart), "creating an event");
     Check(cudaEventCreate(&this->LatticeDone), "creating an event");
     Check(cudaEventCreate(&this->KernelStop), "creating an event");
@@ -97,12 +107,23 @@ void ResidentPoints::State::EnsureStream()
 void ResidentPoints::State::Release()
 {
   for (Buffer* b : { &this->Points, &this->Normals, &this->Cells, &this->Lattice, &this->OutPoints, &this->OutNormals,
-         &this->OutDeterminants, &this->Reduction, &this->Staging[0], &this->Staging[1], &this->LatticeStaging })
+         &this->OutDeterminants, &this->Reduction, &this->LatticeStaging })
   {
     b->Free();
   }
-  for (cudaEvent_t* e :
-    { &this->ChunkDone[0], &this->ChunkDone[1], &this->KernelStart, &this->LatticeDone, &this->KernelStop })
+  for (DownloadLane& lane : this->Lanes)
+  {
+    for (int c = 0; c < 2; ++c)
+    {
+      lane.Staging[c].Free();
+      if (lane.ChunkDone[c])
+      {
+        cudaEventDestroy(lane.ChunkDone[c]);
+      }
+      lane.ChunkDone[c] = nullptr;
+    }
+  }
+  for (cudaEvent_t* e : { &this->DownloadReady, &this->KernelStart, &this->LatticeDone, &this->KernelStop })
   {
     if (*e)
     {
@@ -110,11 +131,15 @@ void ResidentPoints::State::Release()
     }
     *e = nullptr;
   }
-  if (this->Stream)
+  for (cudaStream_t* stream : { &this->Stream, &this->Lanes[1].Stream })
   {
-    cudaStreamDestroy(this->Stream);
+    if (*stream)
+    {
+      cudaStreamDestroy(*stream);
+    }
+    *stream = nullptr;
   }
-  this->Stream = nullptr;
+  this->Lanes[0].Stream = nullptr;
   this->Count = 0;
   this->HasNormals = false;
   this->Bound = false;
@@ -177,27 +202,70 @@ void ResidentPoints::State::FinishEvaluation(bool withNormals, bool withDetermin
 
 void ResidentPoints::State::Download(const void* device, void* host, std::size_t bytes)
 {
+  if (bytes < 2 * detail::StagingBytes)
+  {
+    this->DownloadThrough(this->Lanes[0], device, host, bytes);
+    this->Counts.BytesDownloaded += bytes;
+    return;
+  }
+  Check(cudaEventRecord(this->DownloadReady, this->Stream), "recording an event");
+  Check(cudaStreamWaitEvent(this->Lanes[1].Stream, this->DownloadReady, 0), "ordering the download");
+  const std::size_t half = bytes / 2;
+  std::exception_ptr failure;
+  std::thread second(
+    [&]
+    {
+      try
+      {
+        this->DownloadThrough(
+          this->Lanes[1], static_cast<const char*>(device) + half, static_cast<char*>(host) + half, bytes - half);
+      }
+      catch (...)
+      {
+        failure = std::current_exception();
+      }
+    });
+  try
+  {
+    this->DownloadThrough(this->Lanes[0], device, host, half);
+  }
+  catch (...)
+  {
+    second.join();
+    throw;
+  }
+  second.join();
+  if (failure)
+  {
+    std::rethrow_exception(failure);
+  }
+  this->Counts.BytesDownloaded += bytes;
+}
+
+void ResidentPoints::State::DownloadThrough(DownloadLane& lane, const void* device, void* host, std::size_t bytes)
+{
   using detail::StagingBytes;
+  lane.Staging[0].Reserve(StagingBytes, "allocating the staging buffers");
+  lane.Staging[1].Reserve(StagingBytes, "allocating the staging buffers");
   const std::size_t chunks = (bytes + StagingBytes - 1) / StagingBytes;
   for (std::size_t c = 0; c <= chunks; ++c)
   {
     if (c < chunks)
     {
       const std::size_t offset = c * StagingBytes, size = std::min(StagingBytes, bytes - offset);
-      Check(cudaMemcpyAsync(this->Staging[c % 2].Data, static_cast<const char*>(device) + offset, size,
-              cudaMemcpyDeviceToHost, this->Stream),
+      Check(cudaMemcpyAsync(lane.Staging[c % 2].Data, static_cast<const char*>(device) + offset, size,
+              cudaMemcpyDeviceToHost, lane.Stream),
         "downloading");
-      Check(cudaEventRecord(this->ChunkDone[c % 2], this->Stream), "recording an event");
+      Check(cudaEventRecord(lane.ChunkDone[c % 2], lane.Stream), "recording an event");
     }
     if (c > 0)
     {
       const std::size_t previous = c - 1, offset = previous * StagingBytes;
       const std::size_t size = std::min(StagingBytes, bytes - offset);
-      Check(cudaEventSynchronize(this->ChunkDone[previous % 2]), "downloading");
-      std::memcpy(static_cast<char*>(host) + offset, this->Staging[previous % 2].Data, size);
+      Check(cudaEventSynchronize(lane.ChunkDone[previous % 2]), "downloading");
+      std::memcpy(static_cast<char*>(host) + offset, lane.Staging[previous % 2].Data, size);
     }
   }
-  this->Counts.BytesDownloaded += bytes;
 }
 
 template <typename Real>
@@ -223,8 +291,6 @@ void ResidentPoints::State::RunDownload(Real* outPoints, Real* outNormals, Real*
   {
     throw CudaError{ cudaErrorInvalidValue, "downloading: nothing of that was evaluated" };
   }
-  this->Staging[0].Reserve(detail::StagingBytes, "allocating the staging buffers");
-  this->Staging[1].Reserve(detail::StagingBytes, "allocating the staging buffers");
   this->Download(this->OutPoints.Data, outPoints, std::size_t(this->Count) * 3 * sizeof(Real));
   if (outNormals)
   {

@@ -347,6 +347,20 @@ TEST(CudaGridDeformer, LocalBasesInFloatMatchCpu)
   std::printf("local bases, float32 without Jacobian against the CPU in float32: largest error %.2e\n", worst);
 }
 
+// Downloads on either side of the size from which they go through two lanes (two staging buffers' worth, 4 MB:
+// each half through its own stream and host thread), the halves split inside a point: every value arrives, as the
+// CPU computes it (outputs poisoned first).
+TEST(CudaGridDeformer, DownloadsOfEverySizeArriveWhole)
+{
+  FFD_REQUIRE_DEVICE();
+  std::mt19937 rng(4096);
+  const int divisions[3] = { 3, 2, 4 };
+  for (std::int64_t count : { 349525, 349526, 1000003 }) // 4 MB = 349525.3 points
+  {
+    ExpectFloatMatchesCpu(int(ffd::GridBasis::Trilinear), divisions, count, false, false, rng);
+  }
+}
+
 // Only the lattice crosses the bus on an update: the points and the binding stay on the device.
 TEST(CudaGridDeformer, UpdatesUploadOnlyTheLattice)
 {
