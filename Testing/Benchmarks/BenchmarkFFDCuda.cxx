@@ -162,11 +162,15 @@ Times TimeEvaluations(const ffd::cuda::ResidentPoints& gpu, Evaluate&& evaluate,
 }
 
 // TimeEvaluations() of the grid's evaluation of `displacements` into its resident points.
-Times TimeGridEvaluation(ffd::cuda::GridDeformer& gpu, const std::vector<double>& displacements, int runs = 20)
+// With the Jacobian: the normals transformed and det J too (SetNormals() first).
+Times TimeGridEvaluation(
+  ffd::cuda::GridDeformer& gpu, const std::vector<double>& displacements, int runs = 20, bool withJacobian = false)
 {
   const std::int64_t controlPoints = std::int64_t(displacements.size() / 3);
   return TimeEvaluations(
-    gpu, [&] { Require(gpu.Evaluate(displacements.data(), controlPoints, false, false), gpu, "Evaluate"); }, runs);
+    gpu,
+    [&] { Require(gpu.Evaluate(displacements.data(), controlPoints, withJacobian, withJacobian), gpu, "Evaluate"); },
+    runs);
 }
 
 template <typename Real>
@@ -185,13 +189,22 @@ int MultiplyAdds(ffd::GridBasis basis, int divisions, bool cellTable)
   return 9 + (cellTable ? 3 + 3 * (n * n * n - 1) : 3 * (n * n * n + n * n + n));
 }
 
-// One row of the grid table. Bytes a point must move: the point and its 4-byte binding in, the point out; rates
-// from the kernels' time, the cell table's included.
+// One row of the grid table. Bytes a point must move: the point and its 4-byte binding in, the point out (and with
+// the Jacobian its normal in and out and det J out); rates from the kernels' time, the cell table's included.
+// multiplyAdds 0: not counted (the Jacobian's rows).
 template <typename Real>
-void PrintGridRow(
-  const char* basis, const char* variant, std::int64_t n, const Times& t, const Device& device, int multiplyAdds)
+void PrintGridRow(const char* basis, const char* variant, std::int64_t n, const Times& t, const Device& device,
+  int multiplyAdds, bool withJacobian = false)
 {
-  const double seconds = t.Lattice + t.Points, bytes = double(n) * (6 * sizeof(Real) + 4);
+  const double seconds = t.Lattice + t.Points;
+  const double bytes = double(n) * ((withJacobian ? 13 : 6) * sizeof(Real) + 4);
+  if (multiplyAdds == 0)
+  {
+    std::printf("| %s%s | %s | %lld | %.3f | %.3f | %.3f | %.2f | %.0f %% | | |\n", basis, variant,
+      PrecisionName<Real>(), static_cast<long long>(n), t.Call * 1e3, t.Lattice * 1e3, t.Points * 1e3,
+      n / seconds * 1e-9, 100.0 * bytes / seconds / device.Bandwidth);
+    return;
+  }
   const double peak = sizeof(Real) == sizeof(float) ? device.Float32MultiplyAdds : device.Float64MultiplyAdds;
   std::printf("| %s%s | %s | %lld | %.3f | %.3f | %.3f | %.2f | %.0f %% | %d | %.0f %% |\n", basis, variant,
     PrecisionName<Real>(), static_cast<long long>(n), t.Call * 1e3, t.Lattice * 1e3, t.Points * 1e3, n / seconds * 1e-9,
@@ -199,11 +212,11 @@ void PrintGridRow(
 }
 
 // The grid table's rows for points in voxel order in the precision Real: every basis (the global one in float32
-// only), the triquadratic and cubic B-spline bases from cell tables and as weighted sums, side by side on the same
-// points; `runs` evaluations a row (median).
+// only), the triquadratic and cubic bases from cell tables and as weighted sums, side by side on the same points;
+// `runs` evaluations a row (median); with the Jacobian, normals transformed and det J too.
 template <typename Real>
 void GridSection(const Case* cases, std::size_t caseCount, const std::vector<std::int64_t>& sizes, const Device& device,
-  int runs, std::mt19937& rng)
+  int runs, std::mt19937& rng, bool withJacobian = false)
 {
   for (std::int64_t n : sizes)
   {
@@ -220,15 +233,26 @@ void GridSection(const Case* cases, std::size_t caseCount, const std::vector<std
       const int divisions[3] = { c.Divisions, c.Divisions, c.Divisions };
       ffd::cuda::GridDeformer gpu;
       Require(gpu.SetPoints(points.data(), n) && gpu.Bind(Frame, int(c.Basis), divisions, false), gpu, "Bind");
+      if (withJacobian)
+      {
+        std::vector<Real> normals(points.size(), Real(0));
+        for (std::size_t v = 2; v < normals.size(); v += 3)
+        {
+          normals[v] = Real(1);
+        }
+        Require(gpu.SetNormals(normals.data()), gpu, "SetNormals");
+      }
       const std::int64_t cells = std::int64_t(c.Divisions) * c.Divisions * c.Divisions;
       const bool worthTable = ffd::cuda::GridDeformer::WorthCellTable(int(c.Basis), cells, n);
       for (bool table : { true, false })
       {
         gpu.SetCellTables(table);
-        const Times t = TimeGridEvaluation(gpu, displacements, runs);
+        const Times t = TimeGridEvaluation(gpu, displacements, runs, withJacobian);
         const bool takesTable = table && worthTable;
-        PrintGridRow<Real>(c.Name, takesTable ? ", cell table" : (worthTable ? ", weighted sum" : ""), n, t, device,
-          MultiplyAdds(c.Basis, c.Divisions, takesTable));
+        const std::string variant = std::string(withJacobian ? ", normals and det J" : "") +
+          (takesTable ? ", cell table" : (worthTable ? ", weighted sum" : ""));
+        PrintGridRow<Real>(c.Name, variant.c_str(), n, t, device,
+          withJacobian ? 0 : MultiplyAdds(c.Basis, c.Divisions, takesTable), withJacobian);
         if (!worthTable)
         {
           break; // no table to compare with
@@ -524,6 +548,9 @@ int main(int argc, char* argv[])
   GridSection<float>(cases, std::size(cases), sizes, device, 20, rng);
   const std::vector<std::int64_t> larger(sizes.begin() + (sizes.size() > 1 ? 1 : 0), sizes.end()); // 16 M, 64 M
   GridSection<double>(cases, std::size(cases), larger, device, 20, rng);
+  const std::vector<std::int64_t> middle(larger.begin(), larger.begin() + 1); // 16 M (1 M with --quick)
+  GridSection<float>(cases, std::size(cases), middle, device, 20, rng, true);
+  GridSection<double>(cases, std::size(cases), middle, device, 20, rng, true);
 
   // The same trilinear evaluation on points in random order.
   {
