@@ -211,12 +211,15 @@ void ResidentPoints::State::Download(const void* device, void* host, std::size_t
   Check(cudaEventRecord(this->DownloadReady, this->Stream), "recording an event");
   Check(cudaStreamWaitEvent(this->Lanes[1].Stream, this->DownloadReady, 0), "ordering the download");
   const std::size_t half = bytes / 2;
+  int gpu = 0;
+  Check(cudaGetDevice(&gpu), "querying the device");
   std::exception_ptr failure;
   std::thread second(
     [&]
     {
       try
       {
+        Check(cudaSetDevice(gpu), "selecting the device"); // a new thread starts on device 0
         this->DownloadThrough(
           this->Lanes[1], static_cast<const char*>(device) + half, static_cast<char*>(host) + half, bytes - half);
       }
