@@ -97,8 +97,9 @@ struct Buffer
 // (normals, determinants) one point a thread; without, four points a thread, ThreadsPerBlock apart (consecutive
 // threads, consecutive points), so that their independent lattice gathers overlap. Launch bounds keep at least
 // 4 (6) blocks of 256 threads on a multiprocessor: the gathers are dependent loads, and more threads in flight
-// hide their latency. DeformPointsKernel is the faster choice only for float32 trilinear grids and tetrahedra
-// (BENCHMARKS.md).
+// hide their latency. Without the Jacobian DeformPointsKernel is the faster choice for float32 points and for cell
+// tables in either precision (BENCHMARKS.md); this kernel takes the rest: float64 weighted sums, and every
+// evaluation with the Jacobian.
 template <typename Deformation, typename Real, bool WithJacobian>
 __global__ void __launch_bounds__(ThreadsPerBlock, WithJacobian ? 4 : 6) DeformKernel(const Real* __restrict__ points,
   const int* __restrict__ cells, std::int64_t count, Deformation deformation, Real* __restrict__ outPoints,
