@@ -4,9 +4,9 @@
  * @brief A local basis's cells in power form, for GridDeformation's WithCellTable evaluation.
  *
  * The CPU builds the table at every update where ffd::WorthCellTable() says it pays (FillCellTable(), cells in
- * parallel), the CUDA backend for the triquadratic and cubic B-spline bases on the device (a thread per cell,
- * detail::FillCellTableOf()); GridDeformation (FFDGridDeformation.h) WithCellTable evaluates it by Horner's rule
- * (PowerForm(), declared there and defined here), so both backends evaluate the same table the same way.
+ * parallel), the CUDA backend for the triquadratic and cubic bases on the device (a thread per cell and
+ * component, detail::FillCellEntry()); GridDeformation (FFDGridDeformation.h) WithCellTable evaluates it by Horner's
+ * rule (PowerForm(), declared there and defined here), so both backends evaluate the same table the same way.
  */
 #ifndef FFDCellTable_h
 #define FFDCellTable_h

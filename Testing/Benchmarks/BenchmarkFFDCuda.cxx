@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // GPU benchmark of the CUDA backend's kernels (ffd::cuda::GridDeformer): points per second of the evaluation of
-// every grid basis for 1 M, 16 M and 64 M points, float32 and float64, the triquadratic and cubic B-spline bases
+// every grid basis for 1 M, 16 M and 64 M points, float32 and float64, the triquadratic and cubic bases
 // from cell tables and as weighted sums side by side, beside the device-to-device copy bandwidth measured in the
 // same run: the fraction of the bandwidth roofline each evaluation reaches (bytes it must move: the point and its
 // 4-byte binding in, the deformed point out) and of the multiply-add peak (multiply-adds counted from the
